@@ -1,0 +1,2 @@
+//! System tests across crates live in `tests/tests/`; this library only
+//! holds helpers they share.
