@@ -6,10 +6,20 @@ cd "$(dirname "$0")/.."
 
 rustup target add thumbv7em-none-eabihf
 rustup component add rustfmt clippy
+# The QEMU probe's end-to-end tests need the emulator, and the budget
+# figures arm-none-eabi-size (Debian packages; CI runs this as root).
+if ! command -v qemu-system-arm >/dev/null || ! command -v arm-none-eabi-size >/dev/null; then
+  apt-get update
+  apt-get install -y qemu-system-arm binutils-arm-none-eabi
+fi
 
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
 # The probe's builds: the core alone, and the firmware crate.
 cargo build -p mwd-core --release --target thumbv7em-none-eabihf
 cargo build -p firmware --release --target thumbv7em-none-eabihf
+# The QEMU board binary, linted for its target (the end-to-end test in
+# tests/tests/qemu_probe.rs builds and runs it again on its own).
+cargo clippy -p firmware --release --target thumbv7em-none-eabihf --features qemu-fault-demo --bin probe-qemu -- -D warnings
+cargo build -p firmware --release --target thumbv7em-none-eabihf --features board-qemu --bin probe-qemu
 cargo test --workspace

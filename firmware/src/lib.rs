@@ -5,3 +5,6 @@
 #![forbid(unsafe_code)]
 
 pub use mwd_core;
+
+pub mod app;
+pub mod scc1300;

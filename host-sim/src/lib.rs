@@ -1,2 +1,10 @@
 //! Library side of the host tool: simulation, file formats, analysis. The
 //! CLI in `main.rs` is a thin layer over it, and the system tests use it.
+
+pub mod analysis;
+pub mod capture;
+pub mod coarse;
+pub mod paper_mgwd;
+pub mod replay;
+pub mod samples_csv;
+pub mod sim;

@@ -1,6 +1,91 @@
-#[derive(clap::Args, Debug)]
-pub struct Args {}
+//! `host-sim align`: coarse alignment of a recorded or simulated static file.
+use anyhow::{bail, Context, Result};
+use host_sim::coarse;
+use host_sim::samples_csv;
+use host_sim::sim::{DeterministicErrors, SensorModelFile, SAMPLE_INTERVAL};
+use mwd_core::alignment::{AlignmentConfig, PROBE_GYROS};
+use mwd_core::calibration::ProbeCalibration;
+use mwd_core::sensor_noise::ImuNoise;
+use std::path::PathBuf;
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not yet implemented")
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum CalibrationKind {
+    /// The paper's Table 3 (what the default simulation's probe has).
+    Paper,
+    /// The deterministic errors of --sensor-model (a perfect calibration).
+    Model,
+    /// No correction (for ideal simulations or pre-corrected files).
+    None,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Sample CSV (as written by `host-sim simulate`).
+    pub file: PathBuf,
+    /// Latitude of the site, degrees.
+    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
+    pub lat: f64,
+    /// Rough heading (degrees) to choose between ambiguous candidates, e.g.
+    /// the parent well's survey.
+    #[arg(long, allow_hyphen_values = true)]
+    pub prior_heading: Option<f64>,
+    /// Use only the first this many seconds (the paper aligns on 5 s).
+    #[arg(long)]
+    pub first: Option<f64>,
+    /// Sensor calibration applied before aligning.
+    #[arg(long, value_enum, default_value_t = CalibrationKind::Paper)]
+    pub calibration: CalibrationKind,
+    /// Sensor model JSON (as `simulate --print-sensor-model` writes): its
+    /// error budget sets the uncertainties (default: the SCC1300's).
+    #[arg(long)]
+    pub sensor_model: Option<PathBuf>,
+    /// Take the sensors as error-free when computing uncertainties.
+    #[arg(long, default_value_t = false, conflicts_with = "sensor_model")]
+    pub noise_free: bool,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let file = std::fs::File::open(&args.file)
+        .with_context(|| format!("opening {}", args.file.display()))?;
+    let mut records = samples_csv::read(std::io::BufReader::new(file))
+        .with_context(|| format!("reading {}", args.file.display()))?;
+    if let Some(first) = args.first {
+        let keep = (first / SAMPLE_INTERVAL).round() as usize;
+        if keep == 0 {
+            bail!("--first {first} keeps no sample");
+        }
+        records.truncate(keep);
+    }
+    let model = match &args.sensor_model {
+        Some(path) => Some(SensorModelFile::load(path, 0)?),
+        None => None,
+    };
+    let cal = match (args.calibration, &model) {
+        (CalibrationKind::Paper, _) => DeterministicErrors::paper_table3().calibration(),
+        (CalibrationKind::None, _) => ProbeCalibration::default(),
+        (CalibrationKind::Model, Some(m)) => m.deterministic.calibration(),
+        (CalibrationKind::Model, None) => bail!("--calibration model needs --sensor-model FILE"),
+    };
+    let noise = match (&model, args.noise_free) {
+        (Some(m), _) => m.noise,
+        (None, true) => ImuNoise::NONE,
+        (None, false) => ImuNoise::scc1300(),
+    };
+    let records: Vec<_> = records
+        .iter()
+        .map(|r| coarse::calibrated(r, &cal))
+        .collect();
+    let config = AlignmentConfig {
+        latitude: args.lat * DEG,
+        sample_interval: SAMPLE_INTERVAL,
+        gyro_axes: PROBE_GYROS,
+        noise,
+        heading_prior: args.prior_heading.map(|h| h * DEG),
+    };
+    let spans = coarse::find_segments(&records);
+    let report = coarse::align(&records, &spans, &config)?;
+    print!("{}", report.render());
+    Ok(())
 }

@@ -2,7 +2,14 @@
 use clap::{Parser, Subcommand};
 
 mod align;
+mod allan;
+mod arfit;
+mod calibrate;
+mod decode;
 mod demo;
+mod paper;
+mod paper_mgwd;
+mod replay;
 mod simulate;
 
 #[derive(Parser, Debug)]
@@ -19,14 +26,33 @@ pub enum Command {
     Demo(demo::Args),
     /// Simulate a trajectory and the probe's sensors; write the samples.
     Simulate(simulate::Args),
+    /// Decode a capture of the probe's UART frames: summary and CSV export.
+    Decode(decode::Args),
+    /// Replay a capture's raw frames through the probe's navigation (CSV out).
+    Replay(replay::Args),
     /// Coarse alignment of a recorded or simulated static file.
     Align(align::Args),
+    /// Overlapping Allan deviation of a static record, with noise coefficients.
+    Allan(allan::Args),
+    /// Autocorrelation and AR(p) fits (Yule-Walker, Burg, covariance method).
+    Arfit(arfit::Args),
+    /// Six-position calibration of accelerometer triads and gyro biases (LS and TLS).
+    Calibrate(calibrate::Args),
+    /// Reproductions of the papers' experiments.
+    #[command(subcommand)]
+    Paper(paper::PaperCommand),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Demo(args) => demo::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Decode(args) => decode::run(args),
+        Command::Replay(args) => replay::run(args),
         Command::Align(args) => align::run(args),
+        Command::Allan(args) => allan::run(args),
+        Command::Arfit(args) => arfit::run(args),
+        Command::Calibrate(args) => calibrate::run(args),
+        Command::Paper(cmd) => paper::run(cmd),
     }
 }

@@ -1,6 +1,202 @@
-#[derive(clap::Args, Debug)]
-pub struct Args {}
+//! `host-sim simulate`: a trajectory through the probe's sensor model,
+//! written as a sample CSV.
+use anyhow::{Context, Result};
+use clap::ValueEnum;
+use host_sim::sim::{
+    Motion, SensorModel, SensorModelFile, SensorSimulator, Trajectory, SAMPLE_INTERVAL,
+};
+use host_sim::{capture, samples_csv};
+use mwd_core::conventions::Euler;
+use mwd_core::earth::Position;
+use nalgebra::Vector3;
+use std::io::Write;
+use std::path::PathBuf;
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not yet implemented")
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum MotionKind {
+    /// At rest.
+    Static,
+    /// Toolface indexing: dwell, turn about the tool axis, dwell...
+    Toolface,
+    /// Constant body rate relative to the earth.
+    Rotate,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SensorKind {
+    /// SCC1300-D04 with the paper's error figures.
+    Scc1300,
+    /// A perfect probe (no errors, no quantisation).
+    Ideal,
+}
+
+/// Where and how the probe sits and moves (shared with `demo`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct TrajectoryArgs {
+    /// Roll (gravity toolface) at the start, degrees.
+    #[arg(long, default_value_t = -0.8061, allow_hyphen_values = true)]
+    pub roll: f64,
+    /// Pitch (tool axis above horizontal), degrees.
+    #[arg(long, default_value_t = 0.5371, allow_hyphen_values = true)]
+    pub pitch: f64,
+    /// Heading (azimuth of the tool axis), degrees.
+    #[arg(long, default_value_t = -150.9636, allow_hyphen_values = true)]
+    pub heading: f64,
+    /// Latitude, degrees (default: the paper's site).
+    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
+    pub lat: f64,
+    /// Longitude, degrees.
+    #[arg(long, default_value_t = 126.687898, allow_hyphen_values = true)]
+    pub lon: f64,
+    /// Height above the ellipsoid, metres.
+    #[arg(long, default_value_t = 124.0, allow_hyphen_values = true)]
+    pub height: f64,
+    #[arg(long, value_enum, default_value_t = MotionKind::Static)]
+    pub motion: MotionKind,
+    /// Toolface indexing: turn per step, degrees.
+    #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
+    pub step: f64,
+    /// Toolface indexing: time at rest at each toolface, seconds.
+    #[arg(long, default_value_t = 30.0)]
+    pub dwell: f64,
+    /// Toolface indexing: number of turns.
+    #[arg(long, default_value_t = 1)]
+    pub steps: usize,
+    /// Toolface indexing: turn rate, degrees per second.
+    #[arg(long, default_value_t = 30.0)]
+    pub turn_rate: f64,
+    /// Constant rotation: body rate x,y,z in degrees per second.
+    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.0, 1.0, 0.0], allow_hyphen_values = true)]
+    pub body_rate: Vec<f64>,
+}
+
+impl TrajectoryArgs {
+    pub fn trajectory(&self) -> Trajectory {
+        let motion = match self.motion {
+            MotionKind::Static => Motion::Static,
+            MotionKind::Toolface => Motion::ToolfaceSteps {
+                step: self.step * DEG,
+                turn_rate: self.turn_rate * DEG,
+                dwell: self.dwell,
+                steps: self.steps,
+            },
+            MotionKind::Rotate => {
+                let r = |i: usize| self.body_rate.get(i).copied().unwrap_or(0.0) * DEG;
+                Motion::ConstantRate {
+                    body_rate: Vector3::new(r(0), r(1), r(2)),
+                }
+            }
+        };
+        Trajectory {
+            position: Position::from_degrees(self.lat, self.lon, self.height),
+            start: Euler::new(self.roll * DEG, self.pitch * DEG, self.heading * DEG),
+            motion,
+        }
+    }
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub trajectory: TrajectoryArgs,
+    /// Length of the run, seconds (toolface indexing: at least its script).
+    #[arg(long, default_value_t = 60.0)]
+    pub duration: f64,
+    #[arg(long, value_enum, default_value_t = SensorKind::Scc1300)]
+    pub sensor: SensorKind,
+    /// Sensor model JSON in datasheet units (overrides --sensor); see
+    /// --print-sensor-model for the defaults.
+    #[arg(long)]
+    pub sensor_model: Option<PathBuf>,
+    /// Print the default SCC1300 sensor model as JSON and exit.
+    #[arg(long)]
+    pub print_sensor_model: bool,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output file (`-` for standard output, CSV only).
+    #[arg(short, long, default_value = "simulated.csv")]
+    pub output: PathBuf,
+    /// Output format; by default `bin` for a `.bin` output, else `csv`.
+    #[arg(long, value_enum)]
+    pub format: Option<OutputFormat>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OutputFormat {
+    /// Sample CSV in SI units with the truth (what `align` reads).
+    Csv,
+    /// The bytes the probe would send over its UART: raw-sample frames
+    /// (`docs/protocol.md`), quantised to sensor counts.
+    Bin,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    if args.print_sensor_model {
+        let file = SensorModelFile::from_model(&SensorModel::scc1300(args.seed));
+        println!("{}", serde_json::to_string_pretty(&file)?);
+        return Ok(());
+    }
+    let trajectory = args.trajectory.trajectory();
+    let duration = args.duration.max(trajectory.scripted_duration());
+    anyhow::ensure!(
+        duration.is_finite() && duration > 0.0,
+        "duration must be positive"
+    );
+    let model = match (&args.sensor_model, args.sensor) {
+        (Some(path), _) => SensorModelFile::load(path, args.seed)?,
+        (None, SensorKind::Scc1300) => SensorModel::scc1300(args.seed),
+        (None, SensorKind::Ideal) => SensorModel::ideal(),
+    };
+    let n = (duration / SAMPLE_INTERVAL).round() as usize;
+    let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL).take(n);
+    let format = args
+        .format
+        .unwrap_or(if args.output.extension().is_some_and(|e| e == "bin") {
+            OutputFormat::Bin
+        } else {
+            OutputFormat::Csv
+        });
+    let to_stdout = args.output.as_os_str() == "-";
+    if format == OutputFormat::Bin {
+        anyhow::ensure!(
+            !to_stdout,
+            "binary captures go to a file, not standard output"
+        );
+        let mut capture = capture::create_capture(&args.output)
+            .with_context(|| format!("creating {}", args.output.display()))?;
+        for (index, s) in samples.enumerate() {
+            // Both parts' triads see the same body-frame specific force; the
+            // capture's encoder turns each into its part's axes and counts.
+            let accel = [s.accel.x, s.accel.y, s.accel.z];
+            capture.write_si_sample(&capture::SiSample {
+                index: u32::try_from(index).context("more than 2^32 samples")?,
+                time_s: s.time,
+                gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
+                accel_body_m_s2: [accel, accel],
+                temperature_degc: 25.0,
+            })?;
+        }
+        let bytes = capture.bytes_written();
+        capture.finish()?;
+        eprintln!(
+            "wrote {n} raw-sample frames ({bytes} bytes) to {}",
+            args.output.display()
+        );
+    } else if to_stdout {
+        samples_csv::write(std::io::stdout().lock(), samples)?;
+    } else {
+        let file = std::fs::File::create(&args.output)
+            .with_context(|| format!("creating {}", args.output.display()))?;
+        let mut out = std::io::BufWriter::new(file);
+        samples_csv::write(&mut out, samples)?;
+        out.flush()?;
+        eprintln!(
+            "wrote {n} samples ({duration} s at 20 Hz) to {}",
+            args.output.display()
+        );
+    }
+    Ok(())
 }

@@ -1,0 +1,209 @@
+//! One 20 Hz acquisition cycle, as the timer interrupt runs it: the two
+//! parts' readings become a raw-sample frame, and every sensor fault in them
+//! becomes an event frame, so the surface sees each fault and the stream
+//! goes on.
+//!
+//! The cycle never waits: a part that needs its (blocking) recovery is
+//! reported to the caller, which hands it to the lower-priority main loop;
+//! the samples taken while the parts are away still go out as raw frames
+//! with no valid flags, so the sample counter and the 20 Hz rate stay
+//! intact and the host sees exactly which samples were skipped.
+
+use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
+
+use super::frame_queue::FrameQueue;
+use crate::scc1300::{Error, PartReading};
+
+/// The sample period of the probe: 20 Hz.
+pub const SAMPLE_PERIOD_US: u64 = 50_000;
+
+/// What one cycle asks of its caller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CycleReport {
+    /// Parts (by index) whose reading asks for the recovery sequence.
+    pub recovery_needed: [bool; 2],
+    /// Sensor faults seen in this cycle.
+    pub faults: u32,
+    /// The sample sent, for the main loop's navigation.
+    pub sample: RawSample,
+}
+
+impl CycleReport {
+    pub fn any_recovery(&self) -> bool {
+        self.recovery_needed.iter().any(|&r| r)
+    }
+}
+
+/// The acquisition side's bookkeeping across cycles.
+#[derive(Debug, Clone, Default)]
+pub struct AcquisitionCycle {
+    samples: u32,
+    skipped: u32,
+    faults_per_part: [u32; 2],
+}
+
+impl AcquisitionCycle {
+    pub const fn new() -> Self {
+        Self {
+            samples: 0,
+            skipped: 0,
+            faults_per_part: [0; 2],
+        }
+    }
+
+    /// Time stamp of sample `n` (the timer's n-th period since streaming
+    /// started); the timer, not the code's progress, fixes the instant.
+    pub fn sample_time_us(n: u32) -> u64 {
+        u64::from(n) * SAMPLE_PERIOD_US
+    }
+
+    /// Runs one cycle: `readings` is `None` when the parts are away for
+    /// recovery (the sample is skipped). Queues the raw frame and one event
+    /// frame per faulty slave.
+    pub fn run<const N: usize>(
+        &mut self,
+        readings: Option<[PartReading; 2]>,
+        queue: &mut FrameQueue<N>,
+    ) -> CycleReport {
+        let n = self.samples;
+        self.samples = self.samples.wrapping_add(1);
+        let time_us = Self::sample_time_us(n);
+        let mut report = CycleReport {
+            sample: RawSample {
+                time_us,
+                sample_counter: n,
+                parts: Default::default(),
+            },
+            ..CycleReport::default()
+        };
+        let Some(readings) = readings else {
+            self.skipped = self.skipped.saturating_add(1);
+            queue.push(&Payload::Raw(report.sample));
+            return report;
+        };
+        report.sample.parts = readings.map(|r| r.raw);
+        queue.push(&Payload::Raw(report.sample));
+        for (index, reading) in readings.iter().enumerate() {
+            for error in [reading.gyro_error, reading.accel_error]
+                .into_iter()
+                .flatten()
+            {
+                report.faults += 1;
+                let count = self.count_fault(index);
+                queue.push(&fault_event(time_us, index, &error, count));
+            }
+            if let Some(flag) = report.recovery_needed.get_mut(index) {
+                *flag = reading.needs_recovery();
+            }
+        }
+        report
+    }
+
+    fn count_fault(&mut self, part: usize) -> u32 {
+        match self.faults_per_part.get_mut(part) {
+            Some(count) => {
+                *count = count.saturating_add(1);
+                *count
+            }
+            None => 0,
+        }
+    }
+
+    /// Cycles run so far (the next sample's counter).
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Cycles whose parts were away for recovery.
+    pub fn skipped(&self) -> u32 {
+        self.skipped
+    }
+
+    /// Sensor faults of each part so far.
+    pub fn faults_per_part(&self) -> [u32; 2] {
+        self.faults_per_part
+    }
+}
+
+/// The event frame of one sensor fault: the driver's error code and the
+/// part's running fault count.
+pub fn fault_event(time_us: u64, part: usize, error: &Error, count: u32) -> Payload {
+    Payload::Event(Event {
+        time_us,
+        kind: EventKind::SensorFault,
+        part: part as u8,
+        code: error.code(),
+        value: count,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::scc1300::Slave;
+    use mwd_core::protocol::frame::raw_flags;
+    use mwd_core::protocol::{Decoder, Frame};
+    use std::vec::Vec;
+
+    fn good() -> PartReading {
+        let mut r = PartReading::default();
+        r.raw.flags = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
+        r
+    }
+
+    fn frames(queue: &mut FrameQueue<1024>) -> Vec<Frame> {
+        let mut decoder = Decoder::new();
+        let mut out = Vec::new();
+        while let Some(b) = queue.pop() {
+            decoder.feed(&[b], |f| out.push(f));
+        }
+        assert_eq!(decoder.stats().corrupt(), 0);
+        out
+    }
+
+    #[test]
+    fn faults_become_events_and_recovery_is_requested_not_run() {
+        let mut cycle = AcquisitionCycle::new();
+        let mut queue = FrameQueue::<1024>::new();
+        let report = cycle.run(Some([good(), good()]), &mut queue);
+        assert!(!report.any_recovery());
+        assert_eq!(report.faults, 0);
+        assert_eq!(report.sample.parts[1], good().raw);
+
+        let mut faulty = good();
+        faulty.gyro_error = Some(Error::NotReady);
+        faulty.accel_error = Some(Error::Saturated(Slave::Accel));
+        let report = cycle.run(Some([good(), faulty]), &mut queue);
+        assert_eq!(report.recovery_needed, [false, true]);
+        assert_eq!(report.faults, 2);
+
+        let report = cycle.run(None, &mut queue);
+        assert!(!report.any_recovery());
+        assert_eq!((cycle.samples(), cycle.skipped()), (3, 1));
+        assert_eq!(cycle.faults_per_part(), [0, 2]);
+
+        let got = frames(&mut queue);
+        let kinds: Vec<_> = got.iter().map(|f| f.payload.kind() as u8).collect();
+        let (raw, event) = (
+            mwd_core::protocol::FrameKind::RawSample as u8,
+            mwd_core::protocol::FrameKind::Event as u8,
+        );
+        assert_eq!(kinds, [raw, raw, event, event, raw]);
+        let Payload::Event(e) = got[3].payload else {
+            panic!("event expected")
+        };
+        assert_eq!((e.kind, e.part), (EventKind::SensorFault, 1));
+        assert_eq!(
+            (e.code, e.value),
+            (Error::Saturated(Slave::Accel).code(), 2)
+        );
+        assert_eq!(e.time_us, SAMPLE_PERIOD_US);
+        let Payload::Raw(skipped) = got[4].payload else {
+            panic!("raw expected")
+        };
+        assert_eq!(skipped.sample_counter, 2);
+        assert_eq!(skipped.time_us, 2 * SAMPLE_PERIOD_US);
+        assert!(skipped.parts.iter().all(|p| p.flags == 0));
+    }
+}

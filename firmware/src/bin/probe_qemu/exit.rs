@@ -1,0 +1,87 @@
+//! Leaving QEMU: semihosting prints to the host's stdout and ends the
+//! emulator with an exit status the end-to-end test checks. Faults end the
+//! run with failure instead of hanging it.
+
+use cortex_m_rt::{exception, ExceptionFrame};
+use cortex_m_semihosting::{debug, hprintln};
+
+use crate::Summary;
+
+/// SysTick counts per instruction under `-icount shift=0`: one instruction
+/// is 1 ns of virtual time, one 25 MHz count 40 ns.
+const INSTRUCTIONS_PER_TICK: u32 = 40;
+
+pub fn finish(summary: &Summary) -> ! {
+    hprintln!(
+        "probe-qemu: samples={} skipped={} frames_queued={} frames_dropped={} \
+         cycle_ticks_worst={} cycle_ticks_mean={} \
+         cycle_instructions_worst={} cycle_instructions_mean={} stack_high_water_bytes={} \
+         nav_samples_dropped={} cycle_overruns={} overrun_instructions_longest={}",
+        summary.samples,
+        summary.skipped,
+        summary.queued,
+        summary.dropped,
+        summary.worst_ticks,
+        summary.mean_ticks,
+        summary.worst_ticks * INSTRUCTIONS_PER_TICK,
+        summary.mean_ticks * INSTRUCTIONS_PER_TICK,
+        summary.stack_bytes,
+        summary.nav_dropped,
+        summary.overruns,
+        summary.longest_overrun_ticks * u64::from(INSTRUCTIONS_PER_TICK),
+    );
+    debug::exit(debug::EXIT_SUCCESS);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+pub fn fail(why: &str) -> ! {
+    hprintln!("probe-qemu: FAILED: {}", why);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("probe-qemu: panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+// cortex-m-rt requires these handlers to be `unsafe fn`; neither does
+// anything unsafe.
+#[allow(unsafe_code)]
+#[exception]
+unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
+    hprintln!("probe-qemu: hard fault at pc {:#010x}", frame.pc());
+    debug::exit(debug::EXIT_FAILURE);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// The watchdog's first timeout (wired to the NMI on mps2-an386): the main
+/// loop stalled. In QEMU the run ends with failure rather than waiting for
+/// the watchdog's reset, so a test sees the stall at once.
+#[allow(unsafe_code)]
+#[exception]
+unsafe fn NonMaskableInt() {
+    fail("watchdog: the main loop stalled");
+}
+
+/// Every interrupt without its own handler lands here: dispatch the UART's,
+/// and treat any other as a fault (nothing else is enabled).
+#[allow(unsafe_code)]
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    if irqn == crate::registers::UART0_TX_IRQ {
+        crate::on_uart_tx();
+    } else {
+        fail("unexpected interrupt");
+    }
+}

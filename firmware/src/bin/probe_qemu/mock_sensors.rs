@@ -1,0 +1,164 @@
+//! The QEMU board's sensors: two hil-mock SCC1300 parts behind the real
+//! driver, on four "chip selects" that call into the simulated parts.
+//!
+//! The parts read the board's time (whole 20 Hz timer periods), so their
+//! 800 ms start-up and any timed fault follow the same clock as the
+//! samples, and a run repeats exactly.
+
+use core::cell::{OnceCell, RefCell};
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use critical_section::Mutex;
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
+use firmware::scc1300::Part;
+use hil_mock::{
+    AccelSpi, Chance, Generator, GyroSpi, MockBusError, MountedSource, Scc1300, TimeSource, Window,
+};
+use mwd_core::sensor_units::PART_MOUNTINGS;
+
+/// The acquisition timer's period.
+pub const PERIOD_NS: u64 = 50_000_000;
+
+/// Timer periods since boot, counted by the SysTick interrupt.
+pub static TICKS: AtomicU32 = AtomicU32::new(0);
+
+/// The board's clock as the simulated parts see it.
+pub struct BoardClock;
+
+impl TimeSource for BoardClock {
+    fn now_ns(&self) -> u64 {
+        u64::from(TICKS.load(Ordering::Relaxed)) * PERIOD_NS
+    }
+}
+
+/// Waits by sleeping until enough timer periods have passed: rounded up to
+/// whole periods, so every wait of the driver is at least what it asked.
+pub struct TickDelay;
+
+impl DelayNs for TickDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        let periods = u64::from(ns).div_ceil(PERIOD_NS) as u32;
+        let target = TICKS.load(Ordering::Relaxed).wrapping_add(periods);
+        // Wrapping comparison: correct across the counter's overflow.
+        while (TICKS.load(Ordering::Relaxed).wrapping_sub(target) as i32) < 0 {
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+type MockPart = Scc1300<BoardClock, MountedSource<Generator>>;
+
+/// The two simulated parts; set once at boot, then used from whichever
+/// context (timer interrupt or main loop) holds the driver.
+static PARTS: Mutex<[OnceCell<RefCell<MockPart>>; 2]> =
+    Mutex::new([OnceCell::new(), OnceCell::new()]);
+
+/// A probe at rest: no rotation, the tool horizontal, temperature creeping.
+fn static_probe() -> Generator {
+    Generator {
+        roll_rate_rad_s: 0.0,
+        wobble_rad_s: 0.0,
+        ..Generator::default()
+    }
+}
+
+/// Which slave of a part a [`MockBus`] selects.
+#[derive(Clone, Copy)]
+enum Slave {
+    Gyro,
+    Accel,
+}
+
+/// One chip select of one simulated part.
+pub struct MockBus {
+    part: usize,
+    slave: Slave,
+}
+
+impl ErrorType for MockBus {
+    type Error = MockBusError;
+}
+
+impl SpiDevice for MockBus {
+    fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), MockBusError> {
+        critical_section::with(|cs| {
+            let parts = PARTS.borrow(cs);
+            let part = parts
+                .get(self.part)
+                .and_then(OnceCell::get)
+                .ok_or(MockBusError)?;
+            match self.slave {
+                Slave::Gyro => GyroSpi::new(part).transaction(operations),
+                Slave::Accel => AccelSpi::new(part).transaction(operations),
+            }
+        })
+    }
+}
+
+/// The probe's two parts, as the driver sees them.
+pub type Sensors = [Part<MockBus, MockBus>; 2];
+
+/// Powers the simulated parts up (now) and returns their drivers.
+pub fn power_up() -> Sensors {
+    critical_section::with(|cs| {
+        for (index, cell) in PARTS.borrow(cs).iter().enumerate() {
+            let source = MountedSource {
+                body: static_probe(),
+                mounting: PART_MOUNTINGS[index],
+            };
+            // Already set only if called twice; keep the first parts then.
+            let _ = cell.set(RefCell::new(Scc1300::new(
+                BoardClock,
+                source,
+                1 + index as u32,
+            )));
+        }
+    });
+    [0, 1].map(|part| {
+        Part::new(
+            MockBus {
+                part,
+                slave: Slave::Gyro,
+            },
+            MockBus {
+                part,
+                slave: Slave::Accel,
+            },
+        )
+    })
+}
+
+/// The fault run (feature `qemu-fault-demo`): faults injected into the
+/// simulated parts at fixed samples, so the end-to-end test sees each one
+/// come back as event frames while the stream goes on. Times are samples
+/// since streaming started (20 per second).
+pub fn inject_scheduled_faults(sample: u32) {
+    if !cfg!(feature = "qemu-fault-demo") {
+        return;
+    }
+    let now_ns = BoardClock.now_ns();
+    critical_section::with(|cs| {
+        let parts = PARTS.borrow(cs);
+        let with_part = |index: usize, f: &mut dyn FnMut(&mut MockPart)| {
+            if let Some(part) = parts.get(index).and_then(OnceCell::get) {
+                f(&mut part.borrow_mut());
+            }
+        };
+        match sample {
+            // 10 s: two corrupted gyro answers on part 0 (parity errors).
+            200 => with_part(0, &mut |p| p.faults.gyro.miso_parity = Chance::next(2)),
+            // 20 s: part 1's gyro loses S_OK for 100 ms (not ready, then
+            // the driver's supervision).
+            400 => with_part(1, &mut |p| {
+                p.faults.s_ok_drop = Some(Window {
+                    start_ns: now_ns,
+                    end_ns: now_ns + 100_000_000,
+                })
+            }),
+            // 30 s: part 0 power-cycles (both slaves restart: recovery).
+            600 => with_part(0, &mut |p| p.faults.reset_at_ns = Some(now_ns)),
+            _ => {}
+        }
+    });
+}

@@ -1,0 +1,183 @@
+//! One SCC1300 part (gyro + accelerometer): start-up, one 20 Hz sample
+//! that never blocks and never fails as a whole (each slave's error is
+//! kept and flagged), and the recovery that follows a flagged sample.
+
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::SpiDevice;
+use mwd_core::protocol::frame::{raw_flags, RawPart};
+use mwd_core::sensor_units;
+
+use super::accel::Accel;
+use super::datasheet::{gyro_reg, POWER_UP_WAIT_MS};
+use super::error::{Error, Slave};
+use super::gyro::{is_saturated, Gyro, Recovery};
+
+/// One sample of a part: counts and flags ready for the raw-sample frame,
+/// plus the error of each slave, if any. Counts of a slave with an error
+/// are 0 unless the error left them meaningful (saturation keeps the
+/// clipped gyro count).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PartReading {
+    pub raw: RawPart,
+    pub gyro_error: Option<Error>,
+    pub accel_error: Option<Error>,
+}
+
+impl PartReading {
+    /// Rate about the part's X axis in rad/s, if valid.
+    pub fn rate_rad_s(&self) -> Option<f32> {
+        (self.gyro_error.is_none()).then(|| sensor_units::gyro_count_to_rad_s(self.raw.gyro_rate))
+    }
+
+    /// Specific force along the part's X, Y, Z in m/s^2, if valid.
+    pub fn accel_m_s2(&self) -> Option<[f32; 3]> {
+        (self.accel_error.is_none()).then(|| self.raw.accel.map(sensor_units::accel_count_to_m_s2))
+    }
+
+    /// True when [`Part::recover`] has something to do.
+    pub fn needs_recovery(&self) -> bool {
+        self.gyro_error.is_some_and(|e| e.needs_recovery())
+            || self.accel_error.is_some_and(|e| e.needs_recovery())
+    }
+}
+
+/// What a recovery did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RecoveryReport {
+    pub gyro: Option<Recovery>,
+    pub accel_restarted: bool,
+}
+
+/// A part: its two slaves, each on its own chip select.
+pub struct Part<G, A> {
+    pub gyro: Gyro<G>,
+    pub accel: Accel<A>,
+}
+
+impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
+    pub fn new(gyro_spi: G, accel_spi: A) -> Self {
+        Self {
+            gyro: Gyro::new(gyro_spi),
+            accel: Accel::new(accel_spi),
+        }
+    }
+
+    /// Power-up sequence [TN92 steps 1-3]: wait 800 ms, start the gyro,
+    /// start the accelerometer. With two parts powered together, call this
+    /// for the first and [`Part::start_powered`] for the second.
+    pub fn start(&mut self, delay: &mut impl DelayNs) -> Result<(), Error> {
+        delay.delay_ms(POWER_UP_WAIT_MS);
+        self.start_powered(delay)
+    }
+
+    /// Steps 2-3 only: the 800 ms have already passed.
+    pub fn start_powered(&mut self, delay: &mut impl DelayNs) -> Result<(), Error> {
+        self.gyro.start()?;
+        self.accel.start(delay)
+    }
+
+    /// Reads both slaves once: gyro rate and temperature, accelerometer
+    /// axes and temperature. Never blocks on a delay.
+    pub fn sample(&mut self) -> PartReading {
+        let mut reading = PartReading::default();
+        let raw = &mut reading.raw;
+        match self.read_gyro(raw) {
+            Ok(()) => raw.flags |= raw_flags::GYRO_VALID,
+            Err(e) => {
+                raw.flags |= e.raw_flag();
+                reading.gyro_error = Some(e);
+            }
+        }
+        match self.accel.read_counts() {
+            Ok(counts) => {
+                raw.accel = counts.xyz;
+                raw.accel_temp = counts.temp;
+                raw.flags |= raw_flags::ACCEL_VALID;
+            }
+            Err(e) => {
+                raw.flags |= e.raw_flag();
+                reading.accel_error = Some(e);
+            }
+        }
+        reading
+    }
+
+    fn read_gyro(&mut self, raw: &mut RawPart) -> Result<(), Error> {
+        let rate = self.gyro.read_register(gyro_reg::RATE_X)?;
+        if !rate.s_ok {
+            return Err(Error::NotReady);
+        }
+        raw.flags |= raw_flags::GYRO_S_OK;
+        raw.gyro_rate = sensor_units::word_to_count(rate.data);
+        raw.gyro_temp = self.gyro.read_temperature_count()?;
+        if is_saturated(raw.gyro_rate) {
+            return Err(Error::Saturated(Slave::Gyro));
+        }
+        Ok(())
+    }
+
+    /// After a sample that [`PartReading::needs_recovery`]: gyro S_OK lost
+    /// -> TN92 supervision (60 ms, or a soft reset and 800 ms); accelerometer
+    /// PORST -> its start-up again (10 ms). Blocking: run it outside the
+    /// acquisition interrupt, and mark the samples it costs as skipped.
+    pub fn recover(
+        &mut self,
+        delay: &mut impl DelayNs,
+        reading: &PartReading,
+    ) -> Result<RecoveryReport, Error> {
+        let mut report = RecoveryReport::default();
+        if reading.gyro_error.is_some_and(|e| e.needs_recovery()) {
+            report.gyro = Some(self.gyro.supervise(delay)?);
+        }
+        if reading.accel_error.is_some_and(|e| e.needs_recovery()) {
+            self.accel.start(delay)?;
+            report.accel_restarted = true;
+        }
+        Ok(report)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use embedded_hal::spi::{self, ErrorKind, ErrorType, Operation};
+
+    /// A bus whose peripheral always fails.
+    struct BrokenBus;
+
+    #[derive(Debug)]
+    struct Fault;
+
+    impl spi::Error for Fault {
+        fn kind(&self) -> ErrorKind {
+            ErrorKind::ModeFault
+        }
+    }
+
+    impl ErrorType for BrokenBus {
+        type Error = Fault;
+    }
+
+    impl SpiDevice for BrokenBus {
+        fn transaction(&mut self, _: &mut [Operation<'_, u8>]) -> Result<(), Fault> {
+            Err(Fault)
+        }
+    }
+
+    #[test]
+    fn bus_errors_are_flagged_per_slave() {
+        let mut part = Part::new(BrokenBus, BrokenBus);
+        let r = part.sample();
+        assert_eq!(
+            r.gyro_error,
+            Some(Error::Bus(Slave::Gyro, ErrorKind::ModeFault))
+        );
+        assert_eq!(
+            r.accel_error,
+            Some(Error::Bus(Slave::Accel, ErrorKind::ModeFault))
+        );
+        assert_eq!(r.raw.flags, raw_flags::NO_RESPONSE);
+        assert_eq!(r.rate_rad_s(), None);
+        assert!(!r.needs_recovery());
+    }
+}

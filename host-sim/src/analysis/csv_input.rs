@@ -1,0 +1,202 @@
+//! Numeric column files (CSV, semicolon, tab or whitespace separated) as
+//! the analysis commands read them: an optional header line, `#` comments,
+//! every data field a finite number. Errors name the file, the line and
+//! the field, so a bad export is found without a debugger.
+
+use super::units::InputUnit;
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// A table of finite numbers, one `Vec` per column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Columns {
+    /// Column names from the header, or `col1`, `col2`, ... without one.
+    pub names: Vec<String>,
+    /// `data[c][r]`: column `c`, data row `r`.
+    pub data: Vec<Vec<f64>>,
+}
+
+impl Columns {
+    /// Number of data rows.
+    pub fn rows(&self) -> usize {
+        self.data.first().map_or(0, Vec::len)
+    }
+
+    /// Index of a column by its header name (case-insensitive).
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n.eq_ignore_ascii_case(name))
+    }
+
+    /// The column called `name`, or an error listing the names there are.
+    pub fn column(&self, name: &str) -> Result<&[f64]> {
+        match self.index_of(name) {
+            Some(i) => Ok(&self.data[i]),
+            None => bail!(
+                "no column named `{name}` (columns: {})",
+                self.names.join(", ")
+            ),
+        }
+    }
+}
+
+/// The columns an analysis command works on, with their units: `columns`
+/// (comma-separated header names) or every column but time and the
+/// simulator's truth (`true_*`) columns;
+/// `units` one unit for all, one per selected column, or `auto` (from the
+/// column names' suffixes, `raw` where there is none).
+pub fn select_columns(
+    table: &Columns,
+    columns: Option<&str>,
+    units: &str,
+) -> Result<Vec<(usize, InputUnit)>> {
+    let selected: Vec<usize> = match columns {
+        Some(list) => list
+            .split(',')
+            .map(|n| {
+                table.index_of(n.trim()).ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "no column `{}` (columns: {})",
+                        n.trim(),
+                        table.names.join(", ")
+                    )
+                })
+            })
+            .collect::<Result<_>>()?,
+        None => (0..table.names.len())
+            .filter(|&i| {
+                let name = table.names[i].to_ascii_lowercase();
+                !(matches!(name.as_str(), "time" | "time_s" | "t") || name.starts_with("true_"))
+            })
+            .collect(),
+    };
+    if selected.is_empty() {
+        bail!("no data columns selected");
+    }
+    if units.trim().eq_ignore_ascii_case("auto") {
+        return Ok(selected
+            .into_iter()
+            .map(|i| {
+                (
+                    i,
+                    InputUnit::from_column_name(&table.names[i]).unwrap_or(InputUnit::Raw),
+                )
+            })
+            .collect());
+    }
+    let parsed: Vec<InputUnit> = units
+        .split(',')
+        .map(InputUnit::parse)
+        .collect::<Result<_>>()?;
+    match parsed.len() {
+        1 => Ok(selected.into_iter().map(|i| (i, parsed[0])).collect()),
+        n if n == selected.len() => Ok(selected.into_iter().zip(parsed).collect()),
+        n => bail!("{n} units given for {} columns", selected.len()),
+    }
+}
+
+/// Reads a numeric column file from disk.
+pub fn read_columns(path: &Path) -> Result<Columns> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    parse_columns(&text).with_context(|| format!("in {}", path.display()))
+}
+
+fn split_fields(line: &str) -> Vec<&str> {
+    if line.contains(',') {
+        line.split(',').map(str::trim).collect()
+    } else if line.contains(';') {
+        line.split(';').map(str::trim).collect()
+    } else {
+        line.split_whitespace().collect()
+    }
+}
+
+/// Parses the text of a numeric column file. The first non-comment line is
+/// a header when any of its fields is not a number.
+pub fn parse_columns(text: &str) -> Result<Columns> {
+    let mut names: Option<Vec<String>> = None;
+    let mut data: Vec<Vec<f64>> = Vec::new();
+    for (index, raw) in text.lines().enumerate() {
+        let line_no = index + 1;
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let fields = split_fields(line);
+        let first_content_line = names.is_none() && data.is_empty();
+        if first_content_line && fields.iter().any(|f| f.parse::<f64>().is_err()) {
+            names = Some(fields.iter().map(|f| f.to_string()).collect());
+            data = vec![Vec::new(); fields.len()];
+            continue;
+        }
+        if data.is_empty() {
+            data = vec![Vec::new(); fields.len()];
+        }
+        if fields.len() != data.len() {
+            bail!(
+                "line {line_no}: {} fields where {} were expected",
+                fields.len(),
+                data.len()
+            );
+        }
+        for (col, field) in fields.iter().enumerate() {
+            let value: f64 = field.parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "line {line_no}, column {}: `{field}` is not a number",
+                    col + 1
+                )
+            })?;
+            if !value.is_finite() {
+                bail!(
+                    "line {line_no}, column {}: `{field}` is not finite",
+                    col + 1
+                );
+            }
+            data[col].push(value);
+        }
+    }
+    if data.first().is_none_or(Vec::is_empty) {
+        bail!("no data rows");
+    }
+    let names = names.unwrap_or_else(|| (1..=data.len()).map(|i| format!("col{i}")).collect());
+    Ok(Columns { names, data })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_comments_and_separators() {
+        let c = parse_columns("# run 3\ngx, gz\n1.0, 2\n\n3e-3, -4\n").unwrap();
+        assert_eq!(c.names, vec!["gx", "gz"]);
+        assert_eq!(c.data, vec![vec![1.0, 3e-3], vec![2.0, -4.0]]);
+        assert_eq!(c.column("GZ").unwrap(), &[2.0, -4.0]);
+        let w = parse_columns("1 2\n3\t4\n").unwrap();
+        assert_eq!(w.names, vec!["col1", "col2"]);
+        assert_eq!(w.rows(), 2);
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let e = parse_columns("a,b\n1,2\n3,x\n").unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("`x`"), "{e}");
+        let e = parse_columns("1,2\n3\n").unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+        let e = parse_columns("1,NaN\n").unwrap_err().to_string();
+        assert!(e.contains("not finite"), "{e}");
+        assert!(parse_columns("a,b\n").is_err());
+        assert!(parse_columns("x\n1\n").unwrap().column("y").is_err());
+    }
+
+    #[test]
+    fn selection_and_units() {
+        let c = parse_columns("time_s,gyro_x_rad_s,ax,true_roll_rad\n0,1,2,3\n").unwrap();
+        let auto = select_columns(&c, None, "auto").unwrap();
+        assert_eq!(auto, vec![(1, InputUnit::RadPerS), (2, InputUnit::Raw)]);
+        let two = select_columns(&c, Some("ax,time_s"), "g,raw").unwrap();
+        assert_eq!(two, vec![(2, InputUnit::G), (0, InputUnit::Raw)]);
+        assert!(select_columns(&c, None, "g,g,g").is_err());
+        assert!(select_columns(&c, Some("nope"), "auto").is_err());
+    }
+}

@@ -1,0 +1,26 @@
+//! Sensor-noise analysis and calibration (issue 4): what the paper's team
+//! did in MATLAB to characterise the SCC1300 (MGWD paper section 3.2),
+//! done in the host tool.
+//!
+//! - [`allan`], [`allan_fit`]: Allan deviation with confidence intervals and
+//!   the noise coefficients (random walk, bias instability, rate random walk).
+//! - [`arfit`]: autocorrelation and AR(p) fitting (Yule-Walker, Burg,
+//!   covariance method), order selection, the model file the filter loads.
+//! - [`calibration`]: six-position calibration of accelerometer triads and
+//!   gyro biases (paper Table 3), by least squares or total least squares.
+//! - [`tls`]: total least squares and Moore-Penrose reconstruction (TLS
+//!   paper eq. 14-23); [`paper_tls`] reproduces that paper's experiment.
+//! - [`csv_input`], [`plot`], [`stats`]: file input, SVG plots, chi-square.
+
+pub mod allan;
+pub mod allan_fit;
+pub mod ar_file;
+pub mod arfit;
+pub mod calibration;
+pub mod calibration_file;
+pub mod csv_input;
+pub mod paper_tls;
+pub mod plot;
+pub mod stats;
+pub mod tls;
+pub mod units;

@@ -1,0 +1,378 @@
+//! Captures of the probe's UART stream (`.bin`: exactly the bytes the probe
+//! sends, see `docs/protocol.md`): writing simulated samples as raw-sample
+//! frames, reading and decoding a capture with its loss statistics, and
+//! exporting the frames as CSV.
+
+use std::fmt;
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Write};
+use std::path::Path;
+
+use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample};
+use mwd_core::protocol::{Decoder, DecoderStats, Frame, FrameEncoder, MAX_WIRE_LEN};
+use mwd_core::sensor_units::{
+    self, ACCEL_TEMPERATURE, GYRO_TEMPERATURE, PART_COUNT, PART_MOUNTINGS,
+};
+
+/// One simulated sample in SI units, body frame (x right, y forward, z up).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SiSample {
+    /// Sample counter (20 Hz samples since start).
+    pub index: u32,
+    /// Sample instant, seconds since start.
+    pub time_s: f64,
+    /// What the two gyros measure: the body x rate (part 1) and the body z
+    /// rate (part 2), rad/s, errors included.
+    pub gyro_body_xz_rad_s: [f64; 2],
+    /// Specific force each part's accelerometer measures, expressed in body
+    /// axes, m/s^2 (errors included; one triad per part).
+    pub accel_body_m_s2: [[f64; 3]; PART_COUNT],
+    /// Temperature of both parts, degC.
+    pub temperature_degc: f64,
+}
+
+/// Turns a simulated sample into the raw-sample frame the probe would send:
+/// body -> part axes through `PART_MOUNTINGS`, SI -> 14-bit counts
+/// (rounded, saturated), flags "valid, S_OK" (and saturation when a count
+/// hits a 14-bit limit).
+pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
+    let [x, z] = sample.gyro_body_xz_rad_s;
+    // The tool-axis (y) rate is not sensed by either gyro.
+    let body_rate = [x as f32, 0.0, z as f32];
+    let temp = sample.temperature_degc as f32;
+    let mut parts = [RawPart::default(); PART_COUNT];
+    for ((part, mounting), accel) in parts
+        .iter_mut()
+        .zip(PART_MOUNTINGS.iter())
+        .zip(sample.accel_body_m_s2.iter())
+    {
+        let rate = mounting.gyro_rate_from_body(body_rate);
+        let sensor = mounting.body_to_sensor(accel.map(|a| a as f32));
+        part.gyro_rate = sensor_units::rad_s_to_gyro_count(rate);
+        part.gyro_temp = GYRO_TEMPERATURE.degc_to_count(temp);
+        part.accel = sensor.map(sensor_units::m_s2_to_accel_count);
+        part.accel_temp = ACCEL_TEMPERATURE.degc_to_count(temp);
+        part.flags = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
+        if matches!(
+            part.gyro_rate,
+            sensor_units::COUNT_MIN | sensor_units::COUNT_MAX
+        ) {
+            part.flags |= raw_flags::GYRO_SATURATED;
+        }
+    }
+    RawSample {
+        time_us: (sample.time_s * 1e6).round().max(0.0) as u64,
+        sample_counter: sample.index,
+        parts,
+    }
+}
+
+/// Writes frames to a capture exactly as the probe sends them (one sequence
+/// counter across all kinds, starting at 0).
+pub struct CaptureWriter<W: Write> {
+    out: W,
+    encoder: FrameEncoder,
+    bytes: u64,
+}
+
+impl<W: Write> CaptureWriter<W> {
+    pub fn new(out: W) -> Self {
+        Self {
+            out,
+            encoder: FrameEncoder::new(),
+            bytes: 0,
+        }
+    }
+
+    /// Encodes and writes one frame.
+    pub fn write(&mut self, payload: &Payload) -> io::Result<()> {
+        let mut buf = [0u8; MAX_WIRE_LEN];
+        let n = self
+            .encoder
+            .encode(payload, &mut buf)
+            .map_err(|_| io::Error::other("frame larger than MAX_WIRE_LEN"))?;
+        self.out.write_all(&buf[..n])?;
+        self.bytes += n as u64;
+        Ok(())
+    }
+
+    /// Writes a simulated sample as a raw-sample frame.
+    pub fn write_si_sample(&mut self, sample: &SiSample) -> io::Result<()> {
+        self.write(&Payload::Raw(raw_sample_from_si(sample)))
+    }
+
+    /// Bytes written so far.
+    pub fn bytes_written(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Flushes and returns the writer.
+    pub fn finish(mut self) -> io::Result<W> {
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+/// Creates a `.bin` capture file.
+pub fn create_capture(path: &Path) -> io::Result<CaptureWriter<BufWriter<File>>> {
+    Ok(CaptureWriter::new(BufWriter::new(File::create(path)?)))
+}
+
+/// A decoded capture: the good frames in order and what was lost.
+#[derive(Debug, Clone, Default)]
+pub struct Capture {
+    pub frames: Vec<Frame>,
+    pub stats: DecoderStats,
+}
+
+/// Decodes a whole capture held in memory.
+pub fn decode_bytes(bytes: &[u8]) -> Capture {
+    let mut decoder = Decoder::new();
+    let mut frames = Vec::new();
+    decoder.feed(bytes, |f| frames.push(f));
+    decoder.finish();
+    Capture {
+        frames,
+        stats: *decoder.stats(),
+    }
+}
+
+/// Reads and decodes a capture from any reader, streaming.
+pub fn decode_reader(mut reader: impl Read) -> io::Result<Capture> {
+    let mut decoder = Decoder::new();
+    let mut frames = Vec::new();
+    let mut buf = [0u8; 64 * 1024];
+    loop {
+        let n = reader.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        decoder.feed(&buf[..n], |f| frames.push(f));
+    }
+    decoder.finish();
+    Ok(Capture {
+        frames,
+        stats: *decoder.stats(),
+    })
+}
+
+/// Reads and decodes a `.bin` capture file.
+pub fn read_capture(path: &Path) -> io::Result<Capture> {
+    decode_reader(File::open(path)?)
+}
+
+impl fmt::Display for Capture {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = &self.stats;
+        let [raw, nav, event] = s.frames;
+        writeln!(f, "bytes            {}", s.bytes)?;
+        writeln!(
+            f,
+            "frames           {} good: raw sample {raw}, navigation {nav}, event {event}, unknown kind {}",
+            s.good_frames(),
+            s.unknown_kind
+        )?;
+        writeln!(
+            f,
+            "sequence gaps    {} frames lost, {} restarts",
+            s.lost, s.sequence_restarts
+        )?;
+        writeln!(
+            f,
+            "corrupt          {} CRC failures, {} malformed ({} other version)",
+            s.crc_errors, s.malformed, s.unsupported_version
+        )?;
+        write!(f, "garbage          {} bytes", s.garbage_bytes)?;
+        let times = self.frames.iter().filter_map(|fr| match fr.payload {
+            Payload::Raw(r) => Some(r.time_us),
+            _ => None,
+        });
+        if let (Some(first), Some(last)) = (times.clone().min(), times.max()) {
+            write!(
+                f,
+                "\nraw samples span {:.3} s .. {:.3} s",
+                first as f64 * 1e-6,
+                last as f64 * 1e-6
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Columns of the CSV export: every frame is one row; the columns of the
+/// other kinds stay empty. Raw counts come with their SI values (part axes).
+pub const CSV_HEADER: &str = "seq,kind,time_us,sample_counter,\
+p1_gyro_count,p1_gyro_temp_count,p1_ax_count,p1_ay_count,p1_az_count,p1_accel_temp_count,p1_flags,\
+p2_gyro_count,p2_gyro_temp_count,p2_ax_count,p2_ay_count,p2_az_count,p2_accel_temp_count,p2_flags,\
+p1_rate_rad_s,p1_ax_m_s2,p1_ay_m_s2,p1_az_m_s2,p1_gyro_temp_degc,\
+p2_rate_rad_s,p2_ax_m_s2,p2_ay_m_s2,p2_az_m_s2,p2_gyro_temp_degc,\
+nav_mode,nav_flags,roll_rad,pitch_rad,azimuth_rad,vn_m_s,ve_m_s,vd_m_s,lat_rad,lon_rad,height_m,\
+sd_roll_rad,sd_pitch_rad,sd_azimuth_rad,sd_vn_m_s,sd_ve_m_s,sd_vd_m_s,sd_pn_m,sd_pe_m,sd_pd_m,\
+event,event_part,event_code,event_value";
+
+const RAW_COLS: usize = 24;
+const NAV_COLS: usize = 20;
+const EVENT_COLS: usize = 4;
+
+fn empties(n: usize) -> String {
+    ",".repeat(n)
+}
+
+fn join<T: fmt::Display>(values: impl IntoIterator<Item = T>) -> String {
+    values
+        .into_iter()
+        .map(|v| format!(",{v}"))
+        .collect::<String>()
+}
+
+/// Writes all frames as CSV (see [`CSV_HEADER`]).
+pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
+    writeln!(out, "{CSV_HEADER}")?;
+    for frame in frames {
+        let (kind, body) = match &frame.payload {
+            Payload::Raw(r) => ("raw", raw_csv(r)),
+            Payload::Nav(n) => {
+                let mut cells = format!(",{},{}", n.time_us, n.sample_counter);
+                cells += &empties(RAW_COLS);
+                cells += &join([n.mode as u32, n.flags as u32]);
+                cells += &join(n.attitude.iter().chain(&n.velocity_ned));
+                cells += &join([n.latitude, n.longitude]);
+                cells += &join(
+                    std::iter::once(&n.height)
+                        .chain(&n.attitude_std)
+                        .chain(&n.velocity_std)
+                        .chain(&n.position_std_ned),
+                );
+                cells += &empties(EVENT_COLS);
+                ("nav", cells)
+            }
+            Payload::Event(e) => {
+                let mut cells = format!(",{},", e.time_us);
+                cells += &empties(RAW_COLS + NAV_COLS);
+                cells += &join([
+                    e.kind.to_byte() as u32,
+                    e.part as u32,
+                    e.code as u32,
+                    e.value,
+                ]);
+                ("event", cells)
+            }
+        };
+        writeln!(out, "{},{kind}{body}", frame.seq)?;
+    }
+    out.flush()
+}
+
+fn raw_csv(r: &RawSample) -> String {
+    let mut cells = format!(",{},{}", r.time_us, r.sample_counter);
+    for p in &r.parts {
+        cells += &join(
+            [p.gyro_rate, p.gyro_temp]
+                .iter()
+                .chain(&p.accel)
+                .chain(&[p.accel_temp]),
+        );
+        cells += &format!(",{}", p.flags);
+    }
+    for p in &r.parts {
+        let acc = p.accel.map(sensor_units::accel_count_to_m_s2);
+        cells += &join(
+            std::iter::once(sensor_units::gyro_count_to_rad_s(p.gyro_rate))
+                .chain(acc)
+                .chain([GYRO_TEMPERATURE.count_to_degc(p.gyro_temp)]),
+        );
+    }
+    cells + &empties(NAV_COLS + EVENT_COLS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mwd_core::protocol::example;
+    use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s};
+
+    fn sample(i: u32) -> SiSample {
+        let g = 9.806_65;
+        SiSample {
+            index: i,
+            time_s: f64::from(i) * 0.05,
+            gyro_body_xz_rad_s: [1e-3 * f64::from(i), -0.2],
+            accel_body_m_s2: [[0.1, 0.2, g], [0.3, -0.2, g + 0.01]],
+            temperature_degc: 30.0,
+        }
+    }
+
+    #[test]
+    fn si_sample_becomes_counts_through_the_mounting() {
+        let s = sample(7);
+        let raw = raw_sample_from_si(&s);
+        assert_eq!(raw.time_us, 350_000);
+        assert_eq!(raw.sample_counter, 7);
+        let lsb_rate = f64::from(gyro_count_to_rad_s(1));
+        let lsb_acc = f64::from(accel_count_to_m_s2(1));
+        let [p1, p2] = raw.parts;
+        // Part 1 senses body x; part 2 body z.
+        assert!((f64::from(gyro_count_to_rad_s(p1.gyro_rate)) - 7e-3).abs() <= lsb_rate / 2.0);
+        assert!((f64::from(gyro_count_to_rad_s(p2.gyro_rate)) + 0.2).abs() <= lsb_rate / 2.0);
+        // Part 2: X = body z, Y = body y, Z = -body x.
+        let expect2 = [s.accel_body_m_s2[1][2], -0.2, -0.3];
+        for (c, e) in p2.accel.iter().zip(expect2) {
+            assert!((f64::from(accel_count_to_m_s2(*c)) - e).abs() <= lsb_acc / 2.0);
+        }
+        assert_eq!(p1.accel[2], 650);
+        assert_eq!(p1.flags & raw_flags::GYRO_SATURATED, 0);
+        assert!((f64::from(GYRO_TEMPERATURE.count_to_degc(p1.gyro_temp)) - 30.0).abs() < 0.02);
+    }
+
+    #[test]
+    fn written_captures_decode_back() {
+        let mut w = CaptureWriter::new(Vec::new());
+        w.write(&example::boot_event()).unwrap();
+        for i in 0..100 {
+            w.write_si_sample(&sample(i)).unwrap();
+        }
+        w.write(&example::nav_solution()).unwrap();
+        let n = w.bytes_written();
+        let bytes = w.finish().unwrap();
+        assert_eq!(bytes.len() as u64, n);
+        assert_eq!(n, 27 + 100 * 51 + 106);
+        let cap = decode_reader(&bytes[..]).unwrap();
+        assert_eq!(cap.stats.frames, [100, 1, 1]);
+        assert_eq!(cap.stats.lost, 0);
+        assert_eq!(
+            cap.frames[5].payload,
+            Payload::Raw(raw_sample_from_si(&sample(4)))
+        );
+        let text = cap.to_string();
+        assert!(
+            text.contains("raw sample 100, navigation 1, event 1"),
+            "{text}"
+        );
+        assert!(text.contains("0 frames lost"), "{text}");
+    }
+
+    #[test]
+    fn csv_has_one_row_per_frame_and_fixed_columns() {
+        let frames = decode_bytes(&{
+            let mut w = CaptureWriter::new(Vec::new());
+            w.write(&example::raw_sample()).unwrap();
+            w.write(&example::nav_solution()).unwrap();
+            w.write(&example::boot_event()).unwrap();
+            w.finish().unwrap()
+        })
+        .frames;
+        let mut out = Vec::new();
+        write_csv(&frames, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4);
+        let columns = CSV_HEADER.split(',').count();
+        for line in &lines {
+            assert_eq!(line.split(',').count(), columns, "{line}");
+        }
+        assert!(lines[1].starts_with("0,raw,61700000,1234,18,-1625,0,-3,650,"));
+        assert!(lines[2].starts_with("1,nav,61700000,1234,"));
+        assert!(lines[3].starts_with("2,event,0,,"));
+        assert!(lines[3].ends_with(",1,255,1,0"));
+    }
+}

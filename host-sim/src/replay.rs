@@ -1,0 +1,178 @@
+//! Replay of a probe capture on the host: the raw-sample frames go through
+//! the probe's own navigation code (`firmware::app::Navigator`, the same
+//! source the firmware runs), and where the capture also holds the probe's
+//! navigation frames, each replayed solution is compared with the probe's
+//! bit for bit (as encoded frames, so NaN fields compare too).
+
+use std::collections::HashMap;
+use std::io::{self, Write};
+
+use firmware::app::Navigator;
+use mwd_core::earth::Position;
+use mwd_core::protocol::frame::MAX_BODY_LEN;
+use mwd_core::protocol::{encode_body, Frame, NavSolution, Payload};
+
+/// One replayed solution and, if the capture had one, whether the probe's
+/// own solution for the same sample was identical.
+#[derive(Debug, Clone, Copy)]
+pub struct ReplayRow {
+    pub solution: NavSolution,
+    pub matches_probe: Option<bool>,
+}
+
+/// What a replay did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ReplaySummary {
+    pub raw_frames: u64,
+    pub probe_solutions: u64,
+    /// Replayed solutions identical to the probe's / different from it.
+    pub matched: u64,
+    pub mismatched: u64,
+    /// Raw frames with a part's data not valid (skipped or faulty samples).
+    pub degraded: u64,
+}
+
+/// Replays every raw frame of `frames` through the navigation, starting at
+/// `position` (the probe's configured site).
+pub fn replay(frames: &[Frame], position: Position) -> (Vec<ReplayRow>, ReplaySummary) {
+    let probe: HashMap<u32, NavSolution> = frames
+        .iter()
+        .filter_map(|f| match f.payload {
+            Payload::Nav(n) => Some((n.sample_counter, n)),
+            _ => None,
+        })
+        .collect();
+    let mut summary = ReplaySummary {
+        probe_solutions: probe.len() as u64,
+        ..ReplaySummary::default()
+    };
+    let mut navigator = Navigator::new(position);
+    let mut rows = Vec::new();
+    for frame in frames {
+        let Payload::Raw(raw) = frame.payload else {
+            continue;
+        };
+        summary.raw_frames += 1;
+        let solution = navigator.step(&raw);
+        if firmware::app::navigation::body_sample(&raw).is_none() {
+            summary.degraded += 1;
+        }
+        let matches_probe = probe
+            .get(&raw.sample_counter)
+            .map(|on_board| encoded(on_board) == encoded(&solution));
+        match matches_probe {
+            Some(true) => summary.matched += 1,
+            Some(false) => summary.mismatched += 1,
+            None => {}
+        }
+        rows.push(ReplayRow {
+            solution,
+            matches_probe,
+        });
+    }
+    (rows, summary)
+}
+
+fn encoded(nav: &NavSolution) -> Vec<u8> {
+    let mut body = [0u8; MAX_BODY_LEN];
+    let len = encode_body(0, &Payload::Nav(*nav), &mut body).unwrap_or(0);
+    body[..len].to_vec()
+}
+
+/// CSV columns of [`write_csv`]: SI inside, degrees at this edge.
+pub const CSV_HEADER: &str = "sample,time_s,mode,flags,roll_deg,pitch_deg,heading_deg,\
+vn_m_s,ve_m_s,vd_m_s,lat_deg,lon_deg,height_m,roll_std_deg,pitch_std_deg,heading_std_deg,\
+matches_probe";
+
+/// Writes the replayed solutions as CSV, one row per raw frame.
+pub fn write_csv(rows: &[ReplayRow], mut out: impl Write) -> io::Result<()> {
+    writeln!(out, "{CSV_HEADER}")?;
+    for row in rows {
+        let s = &row.solution;
+        let deg = |a: f32| f64::from(a).to_degrees();
+        let [roll, pitch, heading] = s.attitude.map(deg);
+        let [roll_std, pitch_std, heading_std] = s.attitude_std.map(deg);
+        let [vn, ve, vd] = s.velocity_ned;
+        let matches = match row.matches_probe {
+            Some(true) => "yes",
+            Some(false) => "no",
+            None => "",
+        };
+        writeln!(
+            out,
+            "{},{:.6},{},{},{roll:.6},{pitch:.6},{heading:.6},{vn},{ve},{vd},{:.9},{:.9},{},\
+             {roll_std:.6},{pitch_std:.6},{heading_std:.6},{matches}",
+            s.sample_counter,
+            s.time_us as f64 * 1e-6,
+            s.mode,
+            s.flags,
+            s.latitude.to_degrees(),
+            s.longitude.to_degrees(),
+            s.height,
+        )?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mwd_core::protocol::frame::raw_flags;
+    use mwd_core::protocol::{RawPart, RawSample};
+    use mwd_core::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+
+    fn raw(n: u32) -> Frame {
+        let parts = PART_MOUNTINGS.map(|m| RawPart {
+            accel: m
+                .body_to_sensor([0.0, 0.0, STANDARD_GRAVITY_M_S2])
+                .map(m_s2_to_accel_count),
+            flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
+            ..RawPart::default()
+        });
+        Frame {
+            seq: n as u16,
+            payload: Payload::Raw(RawSample {
+                time_us: u64::from(n) * 50_000,
+                sample_counter: n,
+                parts,
+            }),
+        }
+    }
+
+    #[test]
+    fn replay_matches_the_same_code_and_catches_a_changed_solution() {
+        let site = Position::paper_site();
+        let raws: Vec<Frame> = (0..150).map(raw).collect();
+        // The "probe's" solutions: the same navigation run once already.
+        let (first, _) = replay(&raws, site);
+        let mut capture = Vec::new();
+        for (frame, row) in raws.iter().zip(&first) {
+            capture.push(*frame);
+            let mut nav = row.solution;
+            if nav.sample_counter == 120 {
+                nav.attitude[2] += 1e-6;
+            }
+            capture.push(Frame {
+                seq: 0,
+                payload: Payload::Nav(nav),
+            });
+        }
+        let (rows, summary) = replay(&capture, site);
+        assert_eq!(rows.len(), 150);
+        assert_eq!(
+            summary,
+            ReplaySummary {
+                raw_frames: 150,
+                probe_solutions: 150,
+                matched: 149,
+                mismatched: 1,
+                degraded: 0,
+            }
+        );
+        let mut csv = Vec::new();
+        write_csv(&rows, &mut csv).unwrap();
+        let text = String::from_utf8(csv).unwrap();
+        assert_eq!(text.lines().count(), 151);
+        assert!(text.lines().nth(121).unwrap().ends_with(",no"));
+    }
+}

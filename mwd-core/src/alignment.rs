@@ -1,0 +1,634 @@
+//! Coarse alignment of a tool at rest (paper section 3.2.3): levelling from
+//! averaged accelerometers, then heading from the earth rate the gyros see,
+//! adapted to the probe's gyros (body x and z only).
+//!
+//! Physics the results respect (see `shared/DESIGN.md`): with gyros across
+//! the tool axis, the heading signal is mainly the cross-axis earth rate
+//! Omega cos(lat) sin(heading), plus a pitch-dependent share of the
+//! along-axis component. Heading is well determined for a tool heading north
+//! or south (where the two candidates psi and 180 deg - psi explain the data
+//! alike unless the tool is pitched: the north/south ambiguity, resolved from
+//! a prior) and badly determined heading east or west. Gyro bias is
+//! comparable with the earth rate, so a single position's heading is
+//! bias-limited; toolface indexing (segments at different roll) reverses
+//! the cross-axis gyros and lets the estimator separate bias from earth rate.
+//!
+//! Two methods:
+//! * [`gyrocompass`]: eq. 27-29 generalised. Levelling per segment
+//!   (eq. 27-28), then the heading that best explains the gyro means of all
+//!   segments (eq. 29's tan psi = -omega_x / omega_y is its closed form for a
+//!   level tool with a forward gyro), with gyro biases common to all segments
+//!   estimated under their prior. The product's default.
+//! * [`analytical`]: eq. 30, the TRIAD of gravity, earth rate and their cross
+//!   product, with the unmeasured tool-axis rate reconstructed from the
+//!   earth-rate magnitude (two signs: the north/south ambiguity).
+//!
+//! Every heading carries its 1-sigma uncertainty from the sensor error
+//! budget ([`ImuNoise`]), propagated through the estimator by central
+//! differences, and flags for ill-conditioning and ambiguity.
+use crate::attitude::level;
+use crate::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler};
+use crate::earth::{earth_rate_n, EARTH_RATE};
+use crate::sensor_noise::ImuNoise;
+use core::f64::consts::{PI, TAU};
+use nalgebra::{Matrix3, Vector3};
+
+/// Most segments one alignment takes (toolface positions).
+pub const MAX_SEGMENTS: usize = 8;
+/// The probe's gyros: body x and z.
+pub const PROBE_GYROS: [bool; 3] = [true, false, true];
+/// A full three-gyro IMU (for comparison with the paper's formulas).
+pub const ALL_GYROS: [bool; 3] = [true, true, true];
+/// Heading is ill-conditioned when the earth-rate signal changes with
+/// heading by less than this fraction of the horizontal earth rate
+/// Omega cos(lat): gyro errors are then magnified more than about three
+/// times (for a horizontal tool: within about 17 deg of east or west).
+pub const ILL_CONDITIONED_SENSITIVITY: f64 = 0.3;
+/// Beyond this 1-sigma (rad) the linearised uncertainty no longer describes
+/// the error and the heading is reported as undetermined.
+pub const MAX_DETERMINED_SIGMA: f64 = 20.0 * PI / 180.0;
+/// A second heading candidate whose misfit exceeds the best one's by less
+/// than this (chi-square, 1 degree of freedom, 99 %) explains the data as
+/// well: the heading is ambiguous.
+pub const AMBIGUITY_CHI2: f64 = 6.63;
+/// Coverage factor of the printed bounds: 2 sigma, about 95 %.
+pub const COVERAGE_FACTOR: f64 = 2.0;
+
+const GRID_POINTS: usize = 72;
+const REFINE_ITERATIONS: usize = 60;
+
+/// Means of one static segment (one toolface position).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StaticSegment {
+    /// Mean specific force f_ib^b (m/s^2).
+    pub specific_force: Vector3<f64>,
+    /// Mean angular rate omega_ib^b (rad/s); axes without a gyro are ignored.
+    pub rate: Vector3<f64>,
+    /// Number of samples averaged.
+    pub samples: usize,
+}
+
+/// What the alignment needs to know besides the data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlignmentConfig {
+    /// Latitude of the site (rad).
+    pub latitude: f64,
+    /// Sample interval (s).
+    pub sample_interval: f64,
+    /// Which body axes have a gyro.
+    pub gyro_axes: [bool; 3],
+    /// The sensors' error budget.
+    pub noise: ImuNoise,
+    /// A heading known roughly (e.g. the parent well's survey), used only to
+    /// choose between ambiguous candidates.
+    pub heading_prior: Option<f64>,
+}
+
+/// A value with its 1-sigma uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Uncertain {
+    pub value: f64,
+    pub sigma: f64,
+}
+
+/// Roll and pitch of one segment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelEstimate {
+    pub roll: Uncertain,
+    pub pitch: Uncertain,
+    /// False when the tool axis is near vertical and roll is undefined.
+    pub roll_valid: bool,
+}
+
+/// A heading estimate and how far to trust it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeadingEstimate {
+    /// Heading (rad, in [-pi, pi)) and its 1-sigma.
+    pub heading: Uncertain,
+    /// The other candidate when the data cannot tell them apart.
+    pub alternative: Option<f64>,
+    /// True when `alternative` explains the data as well (and no prior, or a
+    /// prior, chose between them).
+    pub ambiguous: bool,
+    /// True when the geometry makes heading insensitive to the earth rate.
+    pub ill_conditioned: bool,
+    /// False when sigma exceeds [`MAX_DETERMINED_SIGMA`]: the value is then
+    /// no better than a guess.
+    pub determined: bool,
+    /// Estimated gyro biases (rad/s, body x y z; 0 for absent gyros).
+    pub gyro_bias: Vector3<f64>,
+}
+
+impl HeadingEstimate {
+    /// The half-width of the printed bound (rad): [`COVERAGE_FACTOR`] sigma,
+    /// or pi when the heading is undetermined.
+    pub fn bound(&self) -> f64 {
+        if self.determined {
+            (COVERAGE_FACTOR * self.heading.sigma).min(PI)
+        } else {
+            PI
+        }
+    }
+}
+
+/// Why an alignment could not be computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AlignmentError {
+    /// No segment, or more than [`MAX_SEGMENTS`].
+    SegmentCount,
+    /// A mean is NaN or infinite, or a segment has no samples.
+    InvalidData,
+    /// The specific force is far from gravity: the tool is not at rest.
+    NotStatic,
+    /// No gyro axis is configured.
+    NoGyro,
+    /// The misfit does not change with heading: the gyros see no horizontal
+    /// earth rate (at a pole, or with a single gyro along the vertical).
+    NoHeadingInformation,
+}
+
+/// Levelling (eq. 27-28) of one segment with its uncertainty.
+pub fn level_segment(
+    segment: &StaticSegment,
+    config: &AlignmentConfig,
+) -> Result<LevelEstimate, AlignmentError> {
+    check_segment(segment)?;
+    let lev = level(&segment.specific_force);
+    let mut var = [0.0; 2];
+    for axis in 0..3 {
+        let noise = &config.noise.accel[axis];
+        let sigma = noise.mean_sigma(segment.samples, config.sample_interval);
+        let total = sigma * sigma + noise.residual_bias * noise.residual_bias;
+        let h = step_size(sigma, noise.residual_bias, 1e-6);
+        let mut plus = segment.specific_force;
+        let mut minus = plus;
+        plus[axis] += h;
+        minus[axis] -= h;
+        let (lp, lm) = (level(&plus), level(&minus));
+        let d_roll = wrap_pi(lp.roll - lm.roll) / (2.0 * h);
+        let d_pitch = (lp.pitch - lm.pitch) / (2.0 * h);
+        var[0] += d_roll * d_roll * total;
+        var[1] += d_pitch * d_pitch * total;
+    }
+    Ok(LevelEstimate {
+        roll: Uncertain {
+            value: lev.roll,
+            sigma: libm::sqrt(var[0]),
+        },
+        pitch: Uncertain {
+            value: lev.pitch,
+            sigma: libm::sqrt(var[1]),
+        },
+        roll_valid: lev.roll_valid,
+    })
+}
+
+/// Heading by generalised gyrocompassing (eq. 27-29) over one or more static
+/// segments that share heading and pitch (toolface indexing).
+pub fn gyrocompass(
+    segments: &[StaticSegment],
+    config: &AlignmentConfig,
+) -> Result<HeadingEstimate, AlignmentError> {
+    check_all(segments, config)?;
+    let model = Misfit::new(segments, config);
+    let [first, second] = model.local_minima();
+    let (best, other) = match (first, second) {
+        (Some(a), Some(b)) if b.1 - a.1 < AMBIGUITY_CHI2 => {
+            // Ambiguous: a prior chooses, otherwise the lower misfit.
+            let choose_b = config
+                .heading_prior
+                .is_some_and(|p| wrap_pi(b.0 - p).abs() < wrap_pi(a.0 - p).abs());
+            if choose_b {
+                (b, Some(a))
+            } else {
+                (a, Some(b))
+            }
+        }
+        (Some(a), _) => (a, None),
+        (None, _) => return Err(AlignmentError::NoHeadingInformation),
+    };
+    let heading = best.0;
+    // Propagated through the estimator; near east/west the estimate sticks
+    // where the measured rate exceeds what any heading explains and the
+    // propagated derivative collapses, so the Cramer-Rao bound from the
+    // expected information is the floor.
+    let propagated = heading_sigma(segments, config, |perturbed| {
+        Misfit::new(perturbed, config).refine(heading)
+    });
+    let sigma = propagated.max(model.cramer_rao_sigma(heading));
+    Ok(HeadingEstimate {
+        heading: Uncertain {
+            value: wrap_pi(heading),
+            sigma,
+        },
+        alternative: other.map(|o| wrap_pi(o.0)),
+        ambiguous: other.is_some(),
+        ill_conditioned: ill_conditioned(&model, heading, config),
+        determined: sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA,
+        gyro_bias: model.biases(heading),
+    })
+}
+
+/// Analytical alignment (eq. 30) of one segment: the TRIAD of gravity, earth
+/// rate and their cross product. Without a tool-axis gyro the missing rate
+/// is +-sqrt(Omega^2 - omega_x^2 - omega_z^2); both signs are candidates,
+/// and the one nearer the prior (else the positive one) is returned, with
+/// the other as the alternative.
+pub fn analytical(
+    segment: &StaticSegment,
+    config: &AlignmentConfig,
+) -> Result<HeadingEstimate, AlignmentError> {
+    check_all(core::slice::from_ref(segment), config)?;
+    let solve = |seg: &StaticSegment, sign: f64| triad_heading(seg, config, sign);
+    let plus = solve(segment, 1.0);
+    let (chosen_sign, alternative) = if config.gyro_axes[1] {
+        (1.0, None)
+    } else {
+        let minus = solve(segment, -1.0);
+        let prefer_minus = config
+            .heading_prior
+            .is_some_and(|p| wrap_pi(minus - p).abs() < wrap_pi(plus - p).abs());
+        if prefer_minus {
+            (-1.0, Some(plus))
+        } else {
+            (1.0, Some(minus))
+        }
+    };
+    let heading = solve(segment, chosen_sign);
+    let sigma = if heading.is_finite() {
+        heading_sigma(core::slice::from_ref(segment), config, |p| {
+            p.first()
+                .map(|s| solve(s, chosen_sign))
+                .filter(|h| h.is_finite())
+        })
+    } else {
+        f64::INFINITY
+    };
+    let model = Misfit::new(core::slice::from_ref(segment), config);
+    Ok(HeadingEstimate {
+        heading: Uncertain {
+            value: if heading.is_finite() { heading } else { 0.0 },
+            sigma,
+        },
+        alternative: alternative.filter(|a| a.is_finite()),
+        ambiguous: alternative.is_some_and(|a| wrap_pi(a - heading).abs() > sigma),
+        ill_conditioned: ill_conditioned(&model, heading, config),
+        determined: sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA,
+        gyro_bias: Vector3::zeros(),
+    })
+}
+
+fn triad_heading(segment: &StaticSegment, config: &AlignmentConfig, sign: f64) -> f64 {
+    let mut w_b = segment.rate;
+    for axis in 0..3 {
+        if !config.gyro_axes[axis] {
+            w_b[axis] = 0.0;
+        }
+    }
+    if !config.gyro_axes[1] {
+        let rest = EARTH_RATE * EARTH_RATE - w_b.x * w_b.x - w_b.z * w_b.z;
+        if rest < 0.0 {
+            // The measured cross-axis rates exceed the whole earth rate:
+            // noise or bias dominates and the magnitude constraint has no
+            // solution. No heading (the caller reports it undetermined).
+            return f64::NAN;
+        }
+        w_b.y = sign * libm::sqrt(rest);
+    }
+    let g_b = -segment.specific_force;
+    let g_n = Vector3::new(0.0, 0.0, g_b.norm());
+    let w_n = earth_rate_n(config.latitude);
+    // Orthonormal triads built from (g, g x w) in both frames: eq. 30's
+    // rows [g; w; g x w] carry the same information, and orthonormalising
+    // them keeps the result a rotation.
+    let triad = |g: Vector3<f64>, w: Vector3<f64>| {
+        let t1 = g.normalize();
+        let t2 = g.cross(&w).normalize();
+        Matrix3::from_columns(&[t1, t2, t1.cross(&t2)])
+    };
+    let c_bn = triad(g_n, w_n) * triad(g_b, w_b).transpose();
+    euler_from_dcm(&c_bn).heading
+}
+
+/// Ill-conditioned at the estimate, or at the prior (the well plan's
+/// azimuth, say): with noise the estimate of a tool heading east may land
+/// well away from east, but the geometry is still the weak one.
+fn ill_conditioned(model: &Misfit, heading: f64, config: &AlignmentConfig) -> bool {
+    let weak = |h: f64| model.sensitivity(h) < ILL_CONDITIONED_SENSITIVITY;
+    weak(heading) || config.heading_prior.is_some_and(weak)
+}
+
+fn check_segment(segment: &StaticSegment) -> Result<(), AlignmentError> {
+    let finite = segment.specific_force.iter().all(|v| v.is_finite())
+        && segment.rate.iter().all(|v| v.is_finite());
+    if !finite || segment.samples == 0 {
+        return Err(AlignmentError::InvalidData);
+    }
+    // At rest the specific force is gravity (about 9.8 m/s^2 anywhere on
+    // earth); 20 % off means the tool moved or a sensor failed.
+    let f = segment.specific_force.norm();
+    if !(7.8..=11.8).contains(&f) {
+        return Err(AlignmentError::NotStatic);
+    }
+    Ok(())
+}
+
+fn check_all(segments: &[StaticSegment], config: &AlignmentConfig) -> Result<(), AlignmentError> {
+    if segments.is_empty() || segments.len() > MAX_SEGMENTS {
+        return Err(AlignmentError::SegmentCount);
+    }
+    if !config.gyro_axes.iter().any(|&a| a) {
+        return Err(AlignmentError::NoGyro);
+    }
+    segments.iter().try_for_each(check_segment)
+}
+
+/// Finite-difference step for an input of standard deviations `a` and `b`.
+fn step_size(a: f64, b: f64, floor: f64) -> f64 {
+    let s = libm::sqrt(a * a + b * b);
+    if s.is_finite() && s > 0.0 {
+        (1e-3 * s).max(floor * 1e-6)
+    } else {
+        floor
+    }
+}
+
+/// 1-sigma of a heading function of the segments' means, by central
+/// differences: independent noise of each segment's means plus the residual
+/// biases, which are common to all segments.
+fn heading_sigma<F>(segments: &[StaticSegment], config: &AlignmentConfig, estimate: F) -> f64
+where
+    F: Fn(&[StaticSegment]) -> Option<f64>,
+{
+    let mut work = [StaticSegment {
+        specific_force: Vector3::zeros(),
+        rate: Vector3::zeros(),
+        samples: 1,
+    }; MAX_SEGMENTS];
+    let n = segments.len().min(MAX_SEGMENTS);
+    work[..n].copy_from_slice(&segments[..n]);
+    let dt = config.sample_interval;
+    let mut variance = 0.0;
+    // Inputs: 0..3 accelerometer axes, 3..6 rate axes.
+    for input in 0..6 {
+        let (axis, is_gyro) = (input % 3, input >= 3);
+        if is_gyro && !config.gyro_axes[axis] {
+            continue;
+        }
+        let noise = if is_gyro {
+            &config.noise.gyro[axis]
+        } else {
+            &config.noise.accel[axis]
+        };
+        let floor = if is_gyro { 1e-9 } else { 1e-6 };
+        let mut common_derivative = 0.0;
+        for i in 0..n {
+            let sigma = noise.mean_sigma(work[i].samples, dt);
+            if !sigma.is_finite() {
+                return f64::INFINITY;
+            }
+            let h = step_size(sigma, noise.residual_bias, floor);
+            let original = work[i];
+            let mut shifted = |delta: f64| {
+                let target = if is_gyro {
+                    &mut work[i].rate
+                } else {
+                    &mut work[i].specific_force
+                };
+                target[axis] += delta;
+                let value = estimate(&work[..n]);
+                work[i] = original;
+                value
+            };
+            let (Some(up), Some(down)) = (shifted(h), shifted(-h)) else {
+                return f64::INFINITY;
+            };
+            let derivative = wrap_pi(up - down) / (2.0 * h);
+            variance += derivative * derivative * sigma * sigma;
+            common_derivative += derivative;
+        }
+        variance +=
+            common_derivative * common_derivative * noise.residual_bias * noise.residual_bias;
+    }
+    libm::sqrt(variance)
+}
+
+/// The weighted misfit of a heading to the gyro means of all segments, with
+/// the gyro biases (common to all segments, prior N(0, residual_bias^2))
+/// solved for in closed form. As a function of heading it is a quadratic
+/// form in (cos, sin), so it has at most two local minima.
+struct Misfit<'a> {
+    segments: &'a [StaticSegment],
+    config: &'a AlignmentConfig,
+    /// C_b^n of each segment at heading 0 (levelled by its accelerometers).
+    levelled: [Matrix3<f64>; MAX_SEGMENTS],
+    /// Weight (1/variance) of each segment's gyro means, per axis.
+    weights: [[f64; 3]; MAX_SEGMENTS],
+}
+
+impl<'a> Misfit<'a> {
+    fn new(segments: &'a [StaticSegment], config: &'a AlignmentConfig) -> Self {
+        let mut levelled = [Matrix3::identity(); MAX_SEGMENTS];
+        let mut weights = [[0.0; 3]; MAX_SEGMENTS];
+        for (i, seg) in segments.iter().take(MAX_SEGMENTS).enumerate() {
+            let lev = level(&seg.specific_force);
+            levelled[i] = dcm_from_euler(&Euler::new(lev.roll, lev.pitch, 0.0));
+            for (weight, noise) in weights[i].iter_mut().zip(&config.noise.gyro) {
+                let s = noise.mean_sigma(seg.samples, config.sample_interval);
+                // A noise-free axis still gets a finite weight so the
+                // misfit stays well defined.
+                *weight = 1.0 / (s * s).max(1e-30);
+            }
+        }
+        Self {
+            segments,
+            config,
+            levelled,
+            weights,
+        }
+    }
+
+    fn count(&self) -> usize {
+        self.segments.len().min(MAX_SEGMENTS)
+    }
+
+    /// Predicted gyro means of segment i at a heading.
+    fn predicted(&self, i: usize, heading: f64) -> Vector3<f64> {
+        let (s, c) = (libm::sin(heading), libm::cos(heading));
+        let rz = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        (rz * self.levelled[i]).transpose() * earth_rate_n(self.config.latitude)
+    }
+
+    /// Bias estimate of one axis at a heading, and the misfit it leaves.
+    fn axis_fit(&self, axis: usize, heading: f64) -> (f64, f64) {
+        let prior = self.config.noise.gyro[axis].residual_bias;
+        let prior_weight = if prior > 0.0 {
+            1.0 / (prior * prior)
+        } else {
+            f64::INFINITY
+        };
+        let (mut num, mut den) = (0.0, prior_weight);
+        for i in 0..self.count() {
+            let r = self.segments[i].rate[axis] - self.predicted(i, heading)[axis];
+            num += self.weights[i][axis] * r;
+            den += self.weights[i][axis];
+        }
+        let bias = if den.is_finite() { num / den } else { 0.0 };
+        let mut cost = if prior > 0.0 {
+            bias * bias * prior_weight
+        } else {
+            0.0
+        };
+        for i in 0..self.count() {
+            let r = self.segments[i].rate[axis] - self.predicted(i, heading)[axis] - bias;
+            cost += self.weights[i][axis] * r * r;
+        }
+        (bias, cost)
+    }
+
+    fn cost(&self, heading: f64) -> f64 {
+        (0..3)
+            .filter(|&a| self.config.gyro_axes[a])
+            .map(|a| self.axis_fit(a, heading).1)
+            .sum()
+    }
+
+    fn biases(&self, heading: f64) -> Vector3<f64> {
+        let mut b = Vector3::zeros();
+        for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
+            b[axis] = self.axis_fit(axis, heading).0;
+        }
+        b
+    }
+
+    /// The (at most two) local minima as (heading, misfit), best first.
+    fn local_minima(&self) -> [Option<(f64, f64)>; 2] {
+        let step = TAU / GRID_POINTS as f64;
+        let grid = |j: usize| self.cost(j as f64 * step);
+        let mut found: [Option<(f64, f64)>; 2] = [None, None];
+        for j in 0..GRID_POINTS {
+            let here = grid(j);
+            let before = grid((j + GRID_POINTS - 1) % GRID_POINTS);
+            let after = grid((j + 1) % GRID_POINTS);
+            if !(here.is_finite() && here <= before && here < after) {
+                continue;
+            }
+            let Some(h) = self.refine(j as f64 * step) else {
+                continue;
+            };
+            let candidate = (h, self.cost(h));
+            let duplicate = found
+                .iter()
+                .flatten()
+                .any(|f| wrap_pi(f.0 - h).abs() < step);
+            if duplicate {
+                continue;
+            }
+            match found {
+                [None, _] => found[0] = Some(candidate),
+                [Some(a), None] if candidate.1 < a.1 => found = [Some(candidate), Some(a)],
+                [Some(_), None] => found[1] = Some(candidate),
+                [Some(a), Some(b)] => {
+                    // More than two would contradict the quadratic form; keep
+                    // the best two.
+                    if candidate.1 < a.1 {
+                        found = [Some(candidate), Some(a)];
+                    } else if candidate.1 < b.1 {
+                        found[1] = Some(candidate);
+                    }
+                }
+            }
+        }
+        found
+    }
+
+    /// Golden-section search for the minimum within one grid step of
+    /// `start`.
+    fn refine(&self, start: f64) -> Option<f64> {
+        let span = TAU / GRID_POINTS as f64;
+        let ratio = 0.618_033_988_749_894_8;
+        let (mut a, mut b) = (start - span, start + span);
+        let mut x1 = b - ratio * (b - a);
+        let mut x2 = a + ratio * (b - a);
+        let (mut f1, mut f2) = (self.cost(x1), self.cost(x2));
+        for _ in 0..REFINE_ITERATIONS {
+            if f1 < f2 {
+                b = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = b - ratio * (b - a);
+                f1 = self.cost(x1);
+            } else {
+                a = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = a + ratio * (b - a);
+                f2 = self.cost(x2);
+            }
+        }
+        let h = 0.5 * (a + b);
+        h.is_finite().then_some(h)
+    }
+
+    /// The Cramer-Rao bound of the heading: 1/sqrt of the expected
+    /// information of the gyro means with the biases profiled out (per
+    /// axis: sum w d^2 - (sum w d)^2 / (sum w + w_bias), d the derivative
+    /// of the predicted rate with heading).
+    fn cramer_rao_sigma(&self, heading: f64) -> f64 {
+        let h = 1e-6;
+        let mut information = 0.0;
+        for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
+            let prior = self.config.noise.gyro[axis].residual_bias;
+            let prior_weight = if prior > 0.0 {
+                1.0 / (prior * prior)
+            } else {
+                f64::INFINITY
+            };
+            let (mut wdd, mut wd, mut w) = (0.0, 0.0, 0.0);
+            for i in 0..self.count() {
+                let d = (self.predicted(i, heading + h)[axis]
+                    - self.predicted(i, heading - h)[axis])
+                    / (2.0 * h);
+                let wi = self.weights[i][axis];
+                wdd += wi * d * d;
+                wd += wi * d;
+                w += wi;
+            }
+            let profiled = if prior_weight.is_finite() {
+                wd * wd / (w + prior_weight)
+            } else {
+                0.0
+            };
+            information += (wdd - profiled).max(0.0);
+        }
+        if information > 0.0 {
+            1.0 / libm::sqrt(information)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// How strongly the gyro signal changes with heading, as a fraction of
+    /// the horizontal earth rate (per segment, root-mean-square over
+    /// segments).
+    fn sensitivity(&self, heading: f64) -> f64 {
+        let horizontal = EARTH_RATE * libm::cos(self.config.latitude);
+        // Within 0.06 deg of a pole there is no horizontal earth rate to
+        // speak of (and the ratio below would divide rounding noise).
+        if self.count() == 0 || horizontal <= 1e-3 * EARTH_RATE {
+            return 0.0;
+        }
+        let h = 1e-6;
+        let mut sum = 0.0;
+        for i in 0..self.count() {
+            let d = (self.predicted(i, heading + h) - self.predicted(i, heading - h)) / (2.0 * h);
+            for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
+                sum += d[axis] * d[axis];
+            }
+        }
+        libm::sqrt(sum / self.count() as f64) / horizontal
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,157 @@
+use super::*;
+use crate::kalman::{dense::DenseTransition, Transition};
+use nalgebra::{SVector, Vector3};
+
+fn static_point() -> LinearizationPoint {
+    let position = Position::paper_site();
+    let c_bn = nalgebra::Rotation3::from_euler_angles(0.01, -0.02, 2.6).into_inner();
+    LinearizationPoint {
+        c_bn,
+        velocity_n: Vector3::zeros(),
+        position,
+        specific_force_n: -crate::earth::gravity_n(&position),
+    }
+}
+
+#[test]
+fn frame_rates_agree_with_the_earth_module() {
+    // F11 = -[(omega_ie + omega_en) x] must use the earth module's rates.
+    let mut lp = static_point();
+    lp.velocity_n = Vector3::new(3.0, -2.0, 0.5);
+    let f: nalgebra::SMatrix<f64, 9, 9> = navigation_error_dynamics(&lp);
+    let w = crate::earth::earth_rate_n(lp.position.lat)
+        + crate::earth::transport_rate_n(&lp.position, &lp.velocity_n);
+    let expected = -crate::conventions::skew(&w);
+    assert!((f.fixed_view::<3, 3>(ATT, ATT) - expected).amax() < 1e-20);
+}
+
+#[test]
+fn indices_make_33_states() {
+    assert_eq!(STATES, 33);
+    assert_eq!(newest_ar_state(ACCEL_AR, 0), 12);
+    assert_eq!(newest_ar_state(GYRO_AR, 2), 32);
+}
+
+#[test]
+fn static_error_dynamics_are_the_textbook_psi_model() {
+    let lp = static_point();
+    let f = navigation_error_dynamics::<f64>(&lp);
+    let w = crate::earth::earth_rate_n(lp.position.lat);
+    let g = crate::earth::normal_gravity(lp.position.lat, lp.position.height);
+    // phi' = -w_ie x phi: phiE' = -wD phiN + wN phiD.
+    assert_eq!(f[(ATT + 1, ATT)], -w.z);
+    assert_eq!(f[(ATT + 1, ATT + 2)], w.x);
+    assert_eq!(f[(ATT, ATT + 1)], w.z);
+    // dv' = f^n x phi with f^n = (0, 0, -g): dvN' = g phiE, dvE' = -g phiN.
+    assert!((f[(VEL, ATT + 1)] - g).abs() < 1e-12);
+    assert!((f[(VEL + 1, ATT)] + g).abs() < 1e-12);
+    // dp' = dv, and a positive down-position error raises gravity's error:
+    // the vertical channel's instability, about 2 g / R.
+    assert_eq!(f[(POS + 2, VEL + 2)], 1.0);
+    let vertical = f[(VEL + 2, POS + 2)];
+    assert!((vertical - 3.08e-6).abs() < 0.05e-6, "{vertical}");
+}
+
+/// The error model must predict how a perturbed solution diverges from the
+/// true one: compare F against a numerical derivative of the NED kinematics
+/// for the velocity-to-attitude and velocity-to-position couplings.
+#[test]
+fn transport_rate_terms_match_a_finite_difference() {
+    let mut lp = static_point();
+    lp.velocity_n = Vector3::new(3.0, -2.0, 0.5);
+    let f = navigation_error_dynamics::<f64>(&lp);
+    let wen = |v: &Vector3<f64>, p: &Position| crate::earth::transport_rate_n(p, v);
+    let h = 1e-3;
+    for k in 0..3 {
+        let mut dv = Vector3::zeros();
+        dv[k] = h;
+        let d = (wen(&(lp.velocity_n + dv), &lp.position) - wen(&lp.velocity_n, &lp.position)) / h;
+        for i in 0..3 {
+            assert!((f[(ATT + i, VEL + k)] - d[i]).abs() < 1e-12, "{i} {k}");
+        }
+    }
+}
+
+#[test]
+fn structured_transition_equals_its_dense_form() {
+    let mut lp = static_point();
+    lp.velocity_n = Vector3::new(0.3, 0.1, -0.05);
+    for coupling in [
+        Coupling::SensorErrorsDriveNavigation,
+        Coupling::BlockDiagonalAsPublished,
+    ] {
+        let model = AugmentedModel {
+            coupling,
+            ..AugmentedModel::paper()
+        };
+        let phi = model.transition::<f64>(&lp);
+        let dense = DenseTransition(phi.to_dense());
+        let mut m = nalgebra::SMatrix::<f64, STATES, STATES>::from_fn(|i, j| {
+            libm::sin((i * 37 + j * 11) as f64)
+        });
+        let mut m2 = m;
+        phi.apply_to_matrix(&mut m);
+        dense.apply_to_matrix(&mut m2);
+        assert!((m - m2).amax() < 1e-14);
+        let mut x = SVector::<f64, STATES>::from_fn(|i, _| libm::cos(i as f64));
+        let mut x2 = x;
+        phi.apply_to_vector(&mut x);
+        dense.apply_to_vector(&mut x2);
+        assert!((x - x2).amax() < 1e-14);
+    }
+}
+
+#[test]
+fn coupling_puts_sensor_errors_into_velocity_and_attitude() {
+    let lp = static_point();
+    let phi = AugmentedModel::paper().transition::<f64>(&lp).to_dense();
+    // A body-x accelerometer error moves the velocity error along C_b^n's
+    // first column; a body-x rate error turns phi along minus that column.
+    for i in 0..3 {
+        assert!(
+            (phi[(VEL + i, newest_ar_state(ACCEL_AR, 0))] - lp.c_bn[(i, 0)] * 0.05).abs() < 1e-15
+        );
+        assert!(
+            (phi[(ATT + i, newest_ar_state(GYRO_AR, 0))] + lp.c_bn[(i, 0)] * 0.05).abs() < 1e-15
+        );
+    }
+    let published = AugmentedModel {
+        coupling: Coupling::BlockDiagonalAsPublished,
+        ..AugmentedModel::paper()
+    };
+    let phi = published.transition::<f64>(&lp).to_dense();
+    assert!(phi.fixed_view::<9, 24>(0, 9).amax() == 0.0);
+}
+
+#[test]
+fn initial_covariance_holds_the_stationary_ar_blocks() {
+    let model = AugmentedModel::paper();
+    let p = model.initial_covariance::<f64>(&[1e-4; NAV_STATES]);
+    let s = model.gyro[2].stationary_state_covariance().unwrap();
+    let b = GYRO_AR + 2 * AR_ORDER;
+    assert_eq!(p.fixed_view::<4, 4>(b, b).into_owned(), s);
+    let q = model.process_noise::<f64>(&ProcessNoise {
+        nav_per_step: [0.0; NAV_STATES],
+    });
+    assert_eq!(
+        q[newest_ar_state(ACCEL_AR, 1)],
+        model.accel[1].noise_variance
+    );
+    assert_eq!(q[ACCEL_AR], 0.0);
+}
+
+#[test]
+fn cached_zero_position_offset_matches_the_earth_module() {
+    use crate::measurement::ZeroPosition;
+    let reference = Position::paper_site();
+    let moved = reference.displaced(&Vector3::new(12.0, -7.5, 3.25));
+    let terms = EarthTerms::at(&reference);
+    let fast = ZeroPosition::<f64>::with_earth_terms(&moved, &terms, 1.0);
+    let slow = ZeroPosition::<f64>::new(&moved, &reference, 1.0);
+    for i in 0..3 {
+        assert!((fast.position_error_ned_m[i] - slow.position_error_ned_m[i]).abs() < 1e-9);
+    }
+    let near = reference.displaced(&Vector3::new(5.0, -4.0, 2.0));
+    let far = reference.displaced(&Vector3::new(50.0, 0.0, 0.0));
+    assert!(terms.is_near(&near) && !terms.is_near(&far));
+}

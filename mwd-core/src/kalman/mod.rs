@@ -1,0 +1,220 @@
+//! Error-state Kalman filter, fixed size, no heap, generic over the scalar
+//! (f32 on the probe, f64 on the host; paper section 2.4).
+//!
+//! - Time update (eq. 17-18) through a [`Transition`], which applies the
+//!   discrete transition Phi (eq. 15) to a matrix from the left. The
+//!   structured 33-state transition of `error_model` does that in a fraction
+//!   of the dense cost; [`dense::DenseTransition`] is the textbook reference.
+//! - Measurement update (eq. 19-21) one scalar at a time with a sparse
+//!   measurement row, the Joseph covariance (eq. 21) expanded to
+//!   P - k c^T - c k^T + s k k^T, computed on the upper triangle and
+//!   mirrored so P stays exactly symmetric.
+//! - Every scalar is checked before it touches the filter: non-finite data
+//!   or a non-positive innovation variance is rejected, and an optional
+//!   chi-square gate on the normalised innovation squared rejects outliers.
+
+pub mod dense;
+mod scalar;
+
+use crate::measurement::{Measurement, ScalarMeasurement};
+use nalgebra::{RealField, SMatrix, SVector};
+
+/// The filter's scalar: f32 or f64.
+pub trait FilterScalar: RealField + Copy {
+    fn of(x: f64) -> Self;
+    fn as_f64(self) -> f64;
+}
+
+impl FilterScalar for f32 {
+    fn of(x: f64) -> Self {
+        x as f32
+    }
+    fn as_f64(self) -> f64 {
+        self as f64
+    }
+}
+
+impl FilterScalar for f64 {
+    fn of(x: f64) -> Self {
+        x
+    }
+    fn as_f64(self) -> f64 {
+        self
+    }
+}
+
+/// A discrete state transition Phi that can be applied from the left.
+pub trait Transition<T: FilterScalar, const N: usize> {
+    /// `m <- Phi m`.
+    fn apply_to_matrix(&self, m: &mut SMatrix<T, N, N>);
+    /// `x <- Phi x`.
+    fn apply_to_vector(&self, x: &mut SVector<T, N>);
+}
+
+/// What happened to one scalar measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScalarOutcome<T> {
+    /// Used: innovation `z - h x` and its variance `h P h^T + r`.
+    Accepted { innovation: T, variance: T },
+    /// The normalised innovation squared exceeded the gate; not used.
+    Gated { innovation: T, variance: T },
+    /// Measurement value, row or variance not finite; not used.
+    NonFinite,
+    /// Innovation variance not positive (or not finite after the product);
+    /// not used.
+    Degenerate,
+}
+
+impl<T> ScalarOutcome<T> {
+    pub fn is_accepted(&self) -> bool {
+        matches!(self, ScalarOutcome::Accepted { .. })
+    }
+}
+
+/// Counts of the outcomes of a (vector) measurement's scalars.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct UpdateReport {
+    pub accepted: u8,
+    pub gated: u8,
+    pub non_finite: u8,
+    pub degenerate: u8,
+}
+
+impl UpdateReport {
+    pub fn all_accepted(&self) -> bool {
+        self.gated == 0 && self.non_finite == 0 && self.degenerate == 0
+    }
+
+    fn count<T>(&mut self, outcome: &ScalarOutcome<T>) {
+        let slot = match outcome {
+            ScalarOutcome::Accepted { .. } => &mut self.accepted,
+            ScalarOutcome::Gated { .. } => &mut self.gated,
+            ScalarOutcome::NonFinite => &mut self.non_finite,
+            ScalarOutcome::Degenerate => &mut self.degenerate,
+        };
+        *slot = slot.saturating_add(1);
+    }
+}
+
+/// State estimate and covariance of an error-state filter with `N` states.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KalmanFilter<T: FilterScalar, const N: usize> {
+    /// Error-state estimate (computed - true).
+    pub x: SVector<T, N>,
+    /// Its covariance.
+    pub p: SMatrix<T, N, N>,
+    /// Chi-square threshold on `innovation^2 / variance` (1 degree of
+    /// freedom), e.g. 9 for 3 sigma; `None` disables gating.
+    pub gate: Option<T>,
+}
+
+impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
+    /// A filter with zero state and the given initial covariance.
+    pub fn new(p0: SMatrix<T, N, N>) -> Self {
+        Self {
+            x: SVector::zeros(),
+            p: p0,
+            gate: None,
+        }
+    }
+
+    /// A filter with zero state and diagonal initial covariance.
+    pub fn from_diagonal(p0_diag: &SVector<T, N>) -> Self {
+        Self::new(SMatrix::from_diagonal(p0_diag))
+    }
+
+    /// Time update, eq. 17-18: `x <- Phi x`, `P <- Phi P Phi^T + Q` with a
+    /// diagonal discrete process noise `q_diag` (Gamma Q Gamma^T of eq. 18
+    /// for noise that enters single states).
+    pub fn predict<F: Transition<T, N>>(&mut self, phi: &F, q_diag: &SVector<T, N>) {
+        phi.apply_to_vector(&mut self.x);
+        self.propagate_covariance(phi, q_diag);
+    }
+
+    /// The covariance half of [`predict`](Self::predict), for runs that
+    /// only study P (e.g. long static covariance checks).
+    pub fn propagate_covariance<F: Transition<T, N>>(&mut self, phi: &F, q_diag: &SVector<T, N>) {
+        // Phi P Phi^T = Phi (Phi P)^T because P is symmetric: one transpose
+        // and two structured left products (cheaper on the M4F than the
+        // column-wise right product).
+        phi.apply_to_matrix(&mut self.p);
+        self.p.transpose_mut();
+        phi.apply_to_matrix(&mut self.p);
+        for i in 0..N {
+            self.p[(i, i)] += q_diag[i];
+        }
+        symmetrize(&mut self.p);
+    }
+
+    /// One scalar measurement (eq. 19-21 with a 1 x N row). Leaves the
+    /// filter untouched unless the outcome is `Accepted`.
+    pub fn update_scalar(&mut self, m: &ScalarMeasurement<T>) -> ScalarOutcome<T> {
+        let outcome = scalar::joseph_update(&mut self.x, &mut self.p, m, self.gate);
+        if outcome.is_accepted() {
+            mirror_upper(&mut self.p);
+        }
+        outcome
+    }
+
+    /// All scalars of a measurement, one after another (equivalent to the
+    /// vector update for uncorrelated measurement noise).
+    pub fn update<M: Measurement<T>>(&mut self, m: &M) -> UpdateReport {
+        let mut report = UpdateReport::default();
+        for k in 0..m.len() {
+            let outcome = match m.scalar(k) {
+                Some(s) => scalar::joseph_update(&mut self.x, &mut self.p, &s, self.gate),
+                None => ScalarOutcome::NonFinite,
+            };
+            report.count(&outcome);
+        }
+        // The scalar updates kept the upper triangle; restore the rest once.
+        if report.accepted > 0 {
+            mirror_upper(&mut self.p);
+        }
+        report
+    }
+
+    /// Closed-loop reset: after the estimate has been fed back into the
+    /// navigation solution, the error estimate is zero.
+    pub fn reset_state(&mut self) {
+        self.x = SVector::zeros();
+    }
+
+    /// Trace of P.
+    pub fn trace(&self) -> T {
+        self.p.trace()
+    }
+
+    /// Standard deviation of state `i` (0 for a negative variance).
+    pub fn std_dev(&self, i: usize) -> T {
+        let v = self.p[(i, i)];
+        if v > T::zero() {
+            v.sqrt()
+        } else {
+            T::zero()
+        }
+    }
+}
+
+/// Makes `p` exactly symmetric by averaging mirrored entries.
+pub fn symmetrize<T: FilterScalar, const N: usize>(p: &mut SMatrix<T, N, N>) {
+    let half = T::of(0.5);
+    let data = p.as_mut_slice();
+    for j in 1..N {
+        for i in 0..j {
+            let v = (data[j * N + i] + data[i * N + j]) * half;
+            data[j * N + i] = v;
+            data[i * N + j] = v;
+        }
+    }
+}
+
+/// Copies the upper triangle of `p` onto its lower triangle.
+fn mirror_upper<T: FilterScalar, const N: usize>(p: &mut SMatrix<T, N, N>) {
+    let data = p.as_mut_slice();
+    for j in 1..N {
+        for i in 0..j {
+            data[i * N + j] = data[j * N + i];
+        }
+    }
+}

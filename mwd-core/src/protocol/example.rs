@@ -1,0 +1,70 @@
+//! The worked examples of `docs/protocol.md`: fixed frames whose bytes the
+//! document prints and a test compares, so the document cannot go stale
+//! (`cargo run -p mwd-core --example protocol_example` prints them).
+
+use super::frame::{
+    nav_flags, nav_mode, raw_flags, Event, EventKind, NavSolution, Payload, RawPart, RawSample,
+    NO_PART,
+};
+
+/// Sequence number of the worked raw-sample example.
+pub const EXAMPLE_SEQ: u16 = 0x0102;
+
+const GOOD: u16 = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
+
+/// Tool horizontal, at rest, 25 degC: part 1 senses 1 deg/s about body x
+/// (18 counts) and gravity on its Z (+650 counts = 1 g); part 2 (X along
+/// body z) senses gravity on its X. Sample 1234 at t = 61.7 s.
+pub fn raw_sample() -> Payload {
+    let temp = -1625; // 25 degC with the (unverified) gyro formula
+    Payload::Raw(RawSample {
+        time_us: 61_700_000,
+        sample_counter: 1234,
+        parts: [
+            RawPart {
+                gyro_rate: 18,
+                gyro_temp: temp,
+                accel: [0, -3, 650],
+                accel_temp: temp,
+                flags: GOOD,
+            },
+            RawPart {
+                gyro_rate: -2,
+                gyro_temp: temp,
+                accel: [650, 1, 0],
+                accel_temp: temp,
+                flags: GOOD,
+            },
+        ],
+    })
+}
+
+/// A navigation solution at the paper's start position (45.77755 N,
+/// 126.687898 E, 124 m), fine alignment, ZUPT applied.
+pub fn nav_solution() -> Payload {
+    Payload::Nav(NavSolution {
+        time_us: 61_700_000,
+        sample_counter: 1234,
+        mode: nav_mode::FINE_ALIGNMENT,
+        flags: nav_flags::ZUPT_APPLIED,
+        attitude: [-0.014_069, 0.009_374, -2.634_808],
+        velocity_ned: [0.001, -0.002, 0.0],
+        latitude: 45.777_55_f64.to_radians(),
+        longitude: 126.687_898_f64.to_radians(),
+        height: 124.0,
+        attitude_std: [0.000_607, 0.000_182, 0.1],
+        velocity_std: [0.0277, 0.0292, 0.027],
+        position_std_ned: [0.05, 0.05, 0.05],
+    })
+}
+
+/// The boot event: firmware version 1, reset cause 0.
+pub fn boot_event() -> Payload {
+    Payload::Event(Event {
+        time_us: 0,
+        kind: EventKind::Boot,
+        part: NO_PART,
+        code: 1,
+        value: 0,
+    })
+}

@@ -1,0 +1,249 @@
+//! Frame kinds and their fixed little-endian layouts (the byte tables are in
+//! `docs/protocol.md`). A frame body, before COBS, is:
+//!
+//! ```text
+//! version u8 | kind u8 | seq u16 | payload (fixed length per kind) | crc32c u32
+//! ```
+//! The CRC covers everything before it.
+
+pub use super::codec::{decode_body, encode_body, FrameError};
+
+/// Version byte of this layout; a decoder rejects other versions.
+pub const PROTOCOL_VERSION: u8 = 1;
+/// version + kind + sequence number.
+pub const HEADER_LEN: usize = 4;
+/// The CRC-32C trailer.
+pub const CRC_LEN: usize = 4;
+
+/// Kind byte of each frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum FrameKind {
+    RawSample = 1,
+    NavSolution = 2,
+    Event = 3,
+}
+
+impl FrameKind {
+    pub const ALL: [FrameKind; 3] = [Self::RawSample, Self::NavSolution, Self::Event];
+
+    pub fn from_byte(byte: u8) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| *k as u8 == byte)
+    }
+
+    /// Payload length in bytes (fixed per kind).
+    pub const fn payload_len(self) -> usize {
+        match self {
+            Self::RawSample => RAW_PAYLOAD_LEN,
+            Self::NavSolution => NAV_PAYLOAD_LEN,
+            Self::Event => EVENT_PAYLOAD_LEN,
+        }
+    }
+
+    /// Body length (header + payload + CRC) before COBS.
+    pub const fn body_len(self) -> usize {
+        HEADER_LEN + self.payload_len() + CRC_LEN
+    }
+
+    /// Index 0..3 for per-kind counters.
+    pub const fn index(self) -> usize {
+        self as usize - 1
+    }
+}
+
+/// Bits of [`RawPart::flags`], set by the firmware from the driver's results.
+pub mod raw_flags {
+    /// Gyro rate and temperature were read without error in this sample.
+    pub const GYRO_VALID: u16 = 1 << 0;
+    /// Accelerations and temperature were read without error.
+    pub const ACCEL_VALID: u16 = 1 << 1;
+    /// The gyro's S_OK status bit was set.
+    pub const GYRO_S_OK: u16 = 1 << 2;
+    /// The gyro rate sits at a 14-bit limit (beyond range).
+    pub const GYRO_SATURATED: u16 = 1 << 3;
+    /// The accelerometer reported SAT.
+    pub const ACCEL_SATURATED: u16 = 1 << 4;
+    /// A parity error was seen on either slave of this part.
+    pub const PARITY_ERROR: u16 = 1 << 5;
+    /// The accelerometer reported ST (self-test / checksum failure).
+    pub const SELF_TEST_FAILED: u16 = 1 << 6;
+    /// The part reset (accelerometer PORST or gyro loop-failure restart).
+    pub const RESET_SEEN: u16 = 1 << 7;
+    /// A slave did not answer (dead chip select, bus error).
+    pub const NO_RESPONSE: u16 = 1 << 8;
+    /// The accelerometer reported FRME (it received a bad frame).
+    pub const ACCEL_FRAME_ERROR: u16 = 1 << 9;
+}
+
+/// One SCC1300's raw outputs: 14-bit counts as the part delivers them (the
+/// accelerometer in the part's own axes; `sensor_units` converts to SI and to
+/// the body frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RawPart {
+    pub gyro_rate: i16,
+    pub gyro_temp: i16,
+    pub accel: [i16; 3],
+    pub accel_temp: i16,
+    /// [`raw_flags`] bits.
+    pub flags: u16,
+}
+
+/// Raw sample frame: both parts at one sample instant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RawSample {
+    /// Sample instant, microseconds since boot.
+    pub time_us: u64,
+    /// Counts 20 Hz samples since boot (wraps after 6.8 years).
+    pub sample_counter: u32,
+    pub parts: [RawPart; 2],
+}
+
+/// Navigation filter modes ([`NavSolution::mode`]).
+pub mod nav_mode {
+    pub const INITIALISING: u8 = 0;
+    pub const COARSE_ALIGNMENT: u8 = 1;
+    pub const FINE_ALIGNMENT: u8 = 2;
+    pub const NAVIGATING: u8 = 3;
+}
+
+/// Bits of [`NavSolution::flags`]; the rest are reserved (sent as 0).
+pub mod nav_flags {
+    /// A zero-velocity update was applied in this cycle.
+    pub const ZUPT_APPLIED: u16 = 1 << 0;
+    /// The tool axis is near vertical: the tool-axis rate from accelerometer
+    /// roll is invalid (DESIGN.md, "Sensors and their geometry").
+    pub const TOOL_AXIS_RATE_INVALID: u16 = 1 << 1;
+    /// Some sensor input of this cycle was flagged invalid.
+    pub const SENSOR_DEGRADED: u16 = 1 << 2;
+    /// The covariance was re-initialised (e.g. after a numerical guard).
+    pub const COVARIANCE_RESET: u16 = 1 << 3;
+}
+
+/// Navigation solution frame. Angles in rad, velocity in m/s (NED), position
+/// as geodetic latitude/longitude in rad (f64: f32 would quantise latitude
+/// to ~0.4 m, too coarse for the 1 m requirement and for bit-exact replay)
+/// and height in m (f32: 1 mm resolution at 10 km).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct NavSolution {
+    pub time_us: u64,
+    /// The raw sample this solution used last.
+    pub sample_counter: u32,
+    /// One of [`nav_mode`].
+    pub mode: u8,
+    /// [`nav_flags`] bits.
+    pub flags: u16,
+    /// Roll, pitch, azimuth (rad), in the navigation core's convention.
+    pub attitude: [f32; 3],
+    pub velocity_ned: [f32; 3],
+    pub latitude: f64,
+    pub longitude: f64,
+    pub height: f32,
+    /// One-sigma of roll, pitch, azimuth (rad).
+    pub attitude_std: [f32; 3],
+    /// One-sigma of the NED velocity (m/s).
+    pub velocity_std: [f32; 3],
+    /// One-sigma of the position error, north/east/down (m).
+    pub position_std_ned: [f32; 3],
+}
+
+/// What an event frame reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventKind {
+    /// The probe booted; `code` = firmware version, `value` = reset cause.
+    Boot,
+    /// A sensor fault; `part`, `code` = driver error code, `value` = count.
+    SensorFault,
+    /// A part was reset and restarted; `part`, `code` = reason.
+    SensorReset,
+    /// Sampling resynchronised; `value` = samples skipped.
+    Resync,
+    /// A code this decoder does not know (kept for forward compatibility).
+    Other(u8),
+}
+
+impl EventKind {
+    pub fn to_byte(self) -> u8 {
+        match self {
+            Self::Boot => 1,
+            Self::SensorFault => 2,
+            Self::SensorReset => 3,
+            Self::Resync => 4,
+            Self::Other(b) => b,
+        }
+    }
+
+    pub fn from_byte(byte: u8) -> Self {
+        match byte {
+            1 => Self::Boot,
+            2 => Self::SensorFault,
+            3 => Self::SensorReset,
+            4 => Self::Resync,
+            b => Self::Other(b),
+        }
+    }
+}
+
+/// `Event::part` when the event concerns no particular part.
+pub const NO_PART: u8 = 0xFF;
+
+/// Status/event frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Event {
+    pub time_us: u64,
+    pub kind: EventKind,
+    /// 0 or 1, or [`NO_PART`].
+    pub part: u8,
+    pub code: u16,
+    pub value: u32,
+}
+
+/// The payload of one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Payload {
+    Raw(RawSample),
+    Nav(NavSolution),
+    Event(Event),
+}
+
+impl Payload {
+    pub fn kind(&self) -> FrameKind {
+        match self {
+            Self::Raw(_) => FrameKind::RawSample,
+            Self::Nav(_) => FrameKind::NavSolution,
+            Self::Event(_) => FrameKind::Event,
+        }
+    }
+}
+
+/// A decoded frame: its sequence number and payload.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub seq: u16,
+    pub payload: Payload,
+}
+
+const RAW_PART_LEN: usize = 14;
+/// time_us 8 + sample_counter 4 + two parts.
+pub const RAW_PAYLOAD_LEN: usize = 12 + 2 * RAW_PART_LEN;
+/// time 8 + counter 4 + mode 1 + flags 2 + 6 f32 + 2 f64 + 10 f32.
+pub const NAV_PAYLOAD_LEN: usize = 15 + 24 + 16 + 40;
+/// time 8 + kind 1 + part 1 + code 2 + value 4.
+pub const EVENT_PAYLOAD_LEN: usize = 16;
+/// The longest body of any kind.
+pub const MAX_BODY_LEN: usize = HEADER_LEN + NAV_PAYLOAD_LEN + CRC_LEN;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_and_lengths() {
+        for kind in FrameKind::ALL {
+            assert_eq!(FrameKind::from_byte(kind as u8), Some(kind));
+            assert_eq!(kind.body_len(), HEADER_LEN + kind.payload_len() + CRC_LEN);
+        }
+        assert_eq!(FrameKind::from_byte(0), None);
+        assert_eq!(MAX_BODY_LEN, FrameKind::NavSolution.body_len());
+        assert_eq!(EventKind::from_byte(4), EventKind::Resync);
+    }
+}

@@ -1,0 +1,261 @@
+//! The structured filter against the dense textbook form (eq. 17-21), and
+//! the rejection paths of the measurement update.
+
+use mwd_core::ar::ArModel;
+use mwd_core::earth::{gravity_n, Position};
+use mwd_core::error_model::{
+    AugmentedModel, Coupling, LinearizationPoint, ProcessNoise, POS, STATES, VEL,
+};
+use mwd_core::kalman::{dense, KalmanFilter, ScalarOutcome, Transition};
+use mwd_core::measurement::{
+    Measurement, ScalarMeasurement, SparseRow, ZeroPosition, ZeroVelocity,
+};
+use nalgebra::{Rotation3, SMatrix, SVector, Vector3};
+use proptest::prelude::*;
+
+/// A stationary AR(4) from reflection coefficients in (-1, 1), by the
+/// step-up (Levinson) recursion: every such model is stationary.
+fn ar_from_reflections(k: [f64; 4], variance: f64) -> ArModel<4> {
+    let mut a = [0.0; 4];
+    for m in 0..4 {
+        let prev = a;
+        for i in 0..m {
+            a[i] = prev[i] + k[m] * prev[m - 1 - i];
+        }
+        a[m] = k[m];
+    }
+    ArModel::new(a, variance)
+}
+
+prop_compose! {
+    fn arb_model()(
+        ks in prop::array::uniform6(prop::array::uniform4(-0.9f64..0.9)),
+        vars in prop::array::uniform6(1e-8f64..1e-2),
+        coupled in any::<bool>(),
+    ) -> AugmentedModel {
+        let mut m = AugmentedModel::paper();
+        for axis in 0..3 {
+            m.accel[axis] = ar_from_reflections(ks[axis], vars[axis]);
+            m.gyro[axis] = ar_from_reflections(ks[axis + 3], vars[axis + 3]);
+        }
+        m.coupling = if coupled { Coupling::SensorErrorsDriveNavigation } else { Coupling::BlockDiagonalAsPublished };
+        m
+    }
+}
+
+prop_compose! {
+    fn arb_point()(
+        euler in prop::array::uniform3(-3.0f64..3.0),
+        v in prop::array::uniform3(-5.0f64..5.0),
+        lat in -1.2f64..1.2,
+        height in -3000.0f64..3000.0,
+    ) -> LinearizationPoint {
+        let position = Position::new(lat, 0.3, height);
+        let c_bn = Rotation3::from_euler_angles(euler[0], euler[1], euler[2]).into_inner();
+        LinearizationPoint {
+            c_bn,
+            velocity_n: Vector3::from(v),
+            position,
+            specific_force_n: -gravity_n(&position) + Vector3::new(0.1, -0.2, 0.05),
+        }
+    }
+}
+
+prop_compose! {
+    /// A random covariance: L L^T + 1e-6 I with entries of mixed size.
+    fn arb_covariance()(l in prop::collection::vec(-0.3f64..0.3, STATES * STATES)) -> SMatrix<f64, STATES, STATES> {
+        let l = SMatrix::<f64, STATES, STATES>::from_column_slice(&l);
+        l * l.transpose() + SMatrix::identity() * 1e-6
+    }
+}
+
+fn rel_diff(a: &SMatrix<f64, STATES, STATES>, b: &SMatrix<f64, STATES, STATES>) -> f64 {
+    (a - b).amax() / b.amax().max(1e-300)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn fast_and_dense_filters_agree(
+        model in arb_model(),
+        lp in arb_point(),
+        p0 in arb_covariance(),
+        x0 in prop::array::uniform9(-0.1f64..0.1),
+        zv in prop::array::uniform3(-0.05f64..0.05),
+        zp in prop::array::uniform3(-0.5f64..0.5),
+        rv in 1e-4f64..1.0,
+        rp in 1e-4f64..1.0,
+        q in prop::array::uniform9(0.0f64..1e-3),
+    ) {
+        let phi = model.transition::<f64>(&lp);
+        let q_diag = model.process_noise::<f64>(&ProcessNoise { nav_per_step: q });
+        let mut fast = KalmanFilter::<f64, STATES>::new(p0);
+        fast.x.fixed_rows_mut::<9>(0).copy_from_slice(&x0);
+
+        let mut x = fast.x;
+        let mut p = p0;
+
+        // Two cycles, each a time update then ZUPT and zero-position update.
+        for _ in 0..2 {
+            fast.predict(&phi, &q_diag);
+            let report_v = fast.update(&ZeroVelocity { velocity_n: zv, variance: rv });
+            let report_p = fast.update(&ZeroPosition { position_error_ned_m: zp, variance: rp });
+            prop_assert!(report_v.all_accepted() && report_p.all_accepted());
+
+            dense::predict(&mut x, &mut p, &phi.to_dense(), &SMatrix::from_diagonal(&q_diag));
+            let mut h = SMatrix::<f64, 6, STATES>::zeros();
+            for i in 0..3 {
+                h[(i, VEL + i)] = 1.0;
+                h[(3 + i, POS + i)] = 1.0;
+            }
+            let z = SVector::<f64, 6>::from_column_slice(&[zv[0], zv[1], zv[2], zp[0], zp[1], zp[2]]);
+            let r = SMatrix::<f64, 6, 6>::from_diagonal(&SVector::from_column_slice(&[rv, rv, rv, rp, rp, rp]));
+            prop_assert!(dense::update(&mut x, &mut p, &z, &h, &r));
+        }
+        let dp = rel_diff(&fast.p, &p);
+        let dx = (fast.x - x).amax() / x.amax().max(1e-12);
+        prop_assert!(dp < 1e-9, "P differs by {dp:e}");
+        prop_assert!(dx < 1e-9, "x differs by {dx:e}");
+    }
+
+    #[test]
+    fn structured_transition_matches_dense_on_random_inputs(
+        model in arb_model(), lp in arb_point(), p0 in arb_covariance(),
+    ) {
+        let phi = model.transition::<f64>(&lp);
+        let mut m = p0;
+        phi.apply_to_matrix(&mut m);
+        let reference = phi.to_dense() * p0;
+        prop_assert!(rel_diff(&m, &reference) < 1e-14);
+    }
+
+    #[test]
+    fn general_sparse_row_matches_dense_update(
+        p0 in arb_covariance(),
+        coefs in prop::array::uniform4(-2.0f64..2.0),
+        z in -1.0f64..1.0,
+        r in 1e-3f64..1.0,
+    ) {
+        // A row like a heading or constraint measurement: several states.
+        let idx = [0usize, 2, 4, 30];
+        let mut row = SparseRow::empty();
+        let mut h = SMatrix::<f64, 1, STATES>::zeros();
+        for (i, c) in idx.iter().zip(coefs) {
+            prop_assert!(row.push(*i, c));
+            h[(0, *i)] = c;
+        }
+        let mut f = KalmanFilter::<f64, STATES>::new(p0);
+        let outcome = f.update_scalar(&ScalarMeasurement { z, h: row, r });
+        prop_assert!(outcome.is_accepted());
+        let mut x = SVector::zeros();
+        let mut p = p0;
+        prop_assert!(dense::update(&mut x, &mut p, &SVector::<f64, 1>::new(z), &h, &SMatrix::<f64, 1, 1>::new(r)));
+        prop_assert!(rel_diff(&f.p, &p) < 1e-9);
+        prop_assert!((f.x - x).amax() <= 1e-9 * x.amax().max(1e-12));
+    }
+}
+
+fn filter() -> KalmanFilter<f32, STATES> {
+    let model = AugmentedModel::paper();
+    KalmanFilter::new(model.initial_covariance::<f32>(&[1e-4; 9]))
+}
+
+#[test]
+fn nan_and_infinite_measurements_leave_the_filter_untouched() {
+    let mut f = filter();
+    f.x[VEL] = 0.01;
+    let before = f.clone();
+    let bad = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
+    for v in bad {
+        let report = f.update(&ZeroVelocity {
+            velocity_n: [0.0, v, 0.0],
+            variance: 0.01,
+        });
+        assert_eq!(report.non_finite, 1);
+        assert_eq!(report.accepted, 2);
+        let only_bad = ScalarMeasurement {
+            z: v,
+            h: SparseRow::select(VEL),
+            r: 0.01,
+        };
+        let mut g = before.clone();
+        assert_eq!(g.update_scalar(&only_bad), ScalarOutcome::NonFinite);
+        assert_eq!(g, before);
+        let bad_variance = ScalarMeasurement {
+            z: 0.0,
+            h: SparseRow::select(VEL),
+            r: v,
+        };
+        assert_eq!(g.update_scalar(&bad_variance), ScalarOutcome::NonFinite);
+        let mut bad_row = SparseRow::empty();
+        bad_row.push(VEL, v);
+        let bad_row = ScalarMeasurement {
+            z: 0.0,
+            h: bad_row,
+            r: 0.01,
+        };
+        assert_eq!(g.update_scalar(&bad_row), ScalarOutcome::NonFinite);
+        assert_eq!(g, before);
+    }
+}
+
+#[test]
+fn degenerate_and_out_of_range_rows_are_rejected() {
+    let mut f = filter();
+    let before = f.clone();
+    // A state with zero variance measured with zero noise: S = 0.
+    f.p[(POS, POS)] = 0.0;
+    let before_zero = f.clone();
+    let m = ScalarMeasurement {
+        z: 1.0,
+        h: SparseRow::select(POS),
+        r: 0.0,
+    };
+    assert_eq!(f.update_scalar(&m), ScalarOutcome::Degenerate);
+    assert_eq!(f, before_zero);
+    // Index beyond the state.
+    let mut g = before.clone();
+    let mut row = SparseRow::empty();
+    assert!(row.push(STATES, 1.0));
+    assert_eq!(
+        g.update_scalar(&ScalarMeasurement {
+            z: 0.0,
+            h: row,
+            r: 1.0
+        }),
+        ScalarOutcome::NonFinite
+    );
+    assert_eq!(g, before);
+    assert!(ZeroVelocity {
+        velocity_n: [0.0f32; 3],
+        variance: 1.0
+    }
+    .scalar(3)
+    .is_none());
+}
+
+#[test]
+fn chi_square_gate_rejects_outliers_and_passes_ordinary_data() {
+    let mut f = filter();
+    f.gate = Some(9.0);
+    let before = f.clone();
+    let s = f.p[(VEL, VEL)] + 0.01;
+    let outlier = ScalarMeasurement {
+        z: 4.0 * s.sqrt(),
+        h: SparseRow::select(VEL),
+        r: 0.01,
+    };
+    assert!(matches!(
+        f.update_scalar(&outlier),
+        ScalarOutcome::Gated { .. }
+    ));
+    assert_eq!(f, before);
+    let ordinary = ScalarMeasurement {
+        z: 2.0 * s.sqrt(),
+        h: SparseRow::select(VEL),
+        r: 0.01,
+    };
+    assert!(f.update_scalar(&ordinary).is_accepted());
+    assert!(f.p[(VEL, VEL)] < before.p[(VEL, VEL)]);
+}

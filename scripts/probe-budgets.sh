@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Budget figures of the QEMU probe (docs/budgets.md): flash and static RAM
+# (arm-none-eabi-size), and from one simulated static minute under
+# `-icount shift=0,sleep=off` the stack high-water mark (stack painting),
+# instructions per 20 Hz cycle (SysTick counts, 40 instructions each) and
+# the UART bytes per second.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+target=thumbv7em-none-eabihf
+target_dir="${CARGO_TARGET_DIR:-target}/qemu-probe"
+CARGO_TARGET_DIR="$target_dir" cargo build -q -p firmware --release --target "$target" \
+  --features board-qemu --bin probe-qemu
+elf="$target_dir/$target/release/probe-qemu"
+
+echo "== sections (arm-none-eabi-size -A $elf)"
+arm-none-eabi-size -A "$elf" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
+arm-none-eabi-size -A "$elf" | awk '
+  $1 ~ /^\.(vector_table|text|rodata|data)$/ { flash += $2 }
+  $1 ~ /^\.(data|bss|uninit)$/ { ram += $2 }
+  END { printf "flash %d B (%.1f KiB), static RAM %d B (%.1f KiB)\n", flash, flash/1024, ram, ram/1024 }'
+
+serial="$(mktemp)"
+trap 'rm -f "$serial"' EXIT
+echo "== one simulated minute in QEMU"
+qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic \
+  -semihosting-config enable=on,target=native -serial "file:$serial" \
+  -icount shift=0,sleep=off -kernel "$elf" | grep -o 'probe-qemu: .*' | tr ' ' '\n'
+bytes=$(stat -c %s "$serial")
+echo "uart_bytes=$bytes uart_bytes_per_s=$((bytes / 60)) (of 11520 at 115200 baud 8N1)"

@@ -1,0 +1,395 @@
+//! The probe's firmware in QEMU, end to end (issue 6): the `probe-qemu`
+//! binary is cross-built, runs on the emulated mps2-an386 board for a
+//! simulated minute with the two SCC1300 parts simulated by hil-mock behind
+//! the real driver, and its UART bytes (QEMU `-serial file:`) are decoded
+//! with the host's protocol decoder; the host then replays the raw frames
+//! through the probe's own navigation code and must get the probe's
+//! navigation frames bit for bit.
+//!
+//! Time is QEMU's virtual clock under `-icount shift=0,sleep=off`: one
+//! instruction is one nanosecond and idle time is skipped, so the run is
+//! deterministic and the simulated minute takes about a second. Nothing
+//! here measures wall-clock time; a timeout only guards against a hung
+//! emulator.
+//!
+//! qemu-system-arm must be installed (`scripts/test-all.sh` installs it):
+//! without it this test fails, it does not skip.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use firmware::app::Navigator;
+use mwd_core::earth::Position;
+use mwd_core::protocol::frame::{nav_mode, raw_flags, MAX_BODY_LEN};
+use mwd_core::protocol::{
+    encode_body, Decoder, DecoderStats, Event, EventKind, Frame, NavSolution, Payload, RawSample,
+};
+use mwd_core::sensor_units::{accel_count_to_m_s2, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+
+const TARGET: &str = "thumbv7em-none-eabihf";
+/// The firmware's default run length (`PROBE_QEMU_RUN_SECONDS`).
+const RUN_SECONDS: u64 = 60;
+const RATE_HZ: u64 = 20;
+/// Still samples of the coarse alignment (firmware::app::navigation).
+const ALIGNMENT_SAMPLES: usize = 100;
+/// Far above the ~1 s the run takes; only a hang reaches it.
+const QEMU_TIMEOUT: Duration = Duration::from_secs(300);
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ sits in the workspace")
+        .to_path_buf()
+}
+
+/// The cross-build gets its own directory inside the workspace's target
+/// directory: a separate lock from the `cargo test` that runs this, and
+/// no thrashing between host and target builds.
+fn firmware_target_dir() -> PathBuf {
+    // A relative CARGO_TARGET_DIR is relative to the workspace root, not
+    // to this test's working directory (tests/).
+    let base = std::env::var_os("CARGO_TARGET_DIR")
+        .map(|dir| workspace_root().join(dir))
+        .unwrap_or_else(|| workspace_root().join("target"));
+    base.join("qemu-probe")
+}
+
+/// Builds of different features share one target directory (only the
+/// firmware crate differs) and so one output path: build and copy the
+/// binary out one test at a time.
+static BUILD: Mutex<()> = Mutex::new(());
+
+fn build_firmware(features: &str, name: &str) -> PathBuf {
+    let _one_at_a_time = BUILD.lock().unwrap_or_else(|e| e.into_inner());
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let target_dir = firmware_target_dir();
+    let status = Command::new(cargo)
+        .current_dir(workspace_root())
+        .args(["build", "-p", "firmware", "--release", "--target", TARGET])
+        .args(["--features", features, "--bin", "probe-qemu"])
+        .env("CARGO_TARGET_DIR", &target_dir)
+        .status()
+        .expect("run cargo to cross-build the firmware");
+    assert!(
+        status.success(),
+        "cross-build of probe-qemu failed (is the {TARGET} target installed? \
+         `rustup target add {TARGET}`)"
+    );
+    let built = target_dir.join(TARGET).join("release").join("probe-qemu");
+    let elf = target_dir.join(format!("probe-qemu-{name}.elf"));
+    std::fs::copy(&built, &elf).expect("copy the firmware binary");
+    elf
+}
+
+fn require_qemu() {
+    let found = Command::new("qemu-system-arm")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    assert!(
+        found,
+        "qemu-system-arm is not installed: this end-to-end test needs it \
+         (Debian: `apt-get install -y qemu-system-arm`, as scripts/test-all.sh does)"
+    );
+}
+
+/// What one QEMU run left: the probe's semihosting output and its UART.
+struct Run {
+    stdout: String,
+    uart: Vec<u8>,
+}
+
+fn run_in_qemu(elf: &Path, name: &str) -> Run {
+    let (run, status) = run_in_qemu_to_exit(elf, name);
+    assert!(
+        status.success(),
+        "probe-qemu failed: {status}\n{}",
+        run.stdout
+    );
+    run
+}
+
+/// Runs the probe until QEMU exits; returns what it left and its status.
+fn run_in_qemu_to_exit(elf: &Path, name: &str) -> (Run, std::process::ExitStatus) {
+    let serial = std::env::temp_dir().join(format!("probe-qemu-{name}-{}.bin", std::process::id()));
+    let _ = std::fs::remove_file(&serial);
+    let mut child = Command::new("qemu-system-arm")
+        .args(["-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .arg("-serial")
+        .arg(format!("file:{}", serial.display()))
+        .args(["-icount", "shift=0,sleep=off", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start qemu-system-arm");
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for qemu") {
+            break status;
+        }
+        if started.elapsed() > QEMU_TIMEOUT {
+            let _ = child.kill();
+            panic!("QEMU did not exit within {QEMU_TIMEOUT:?}: the probe hung");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let output = child.wait_with_output().expect("qemu output");
+    let mut stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    stdout += &String::from_utf8_lossy(&output.stderr);
+    let uart = std::fs::read(&serial).expect("QEMU's serial capture");
+    let _ = std::fs::remove_file(&serial);
+    (Run { stdout, uart }, status)
+}
+
+fn decode(uart: &[u8]) -> (Vec<Frame>, DecoderStats) {
+    let mut decoder = Decoder::new();
+    let mut frames = Vec::new();
+    decoder.feed(uart, |f| frames.push(f));
+    (frames, *decoder.stats())
+}
+
+fn raw_samples(frames: &[Frame]) -> Vec<RawSample> {
+    frames
+        .iter()
+        .filter_map(|f| match f.payload {
+            Payload::Raw(r) => Some(r),
+            _ => None,
+        })
+        .collect()
+}
+
+/// 20 raw frames in every simulated second, consecutive counters, the
+/// timer's exact 50 ms spacing.
+fn assert_twenty_per_simulated_second(raws: &[RawSample]) {
+    assert_eq!(raws.len() as u64, RUN_SECONDS * RATE_HZ);
+    let mut per_second = [0u64; RUN_SECONDS as usize];
+    for (n, raw) in raws.iter().enumerate() {
+        assert_eq!(raw.sample_counter as usize, n);
+        assert_eq!(raw.time_us, n as u64 * 1_000_000 / RATE_HZ);
+        per_second[(raw.time_us / 1_000_000) as usize] += 1;
+    }
+    assert!(per_second.iter().all(|&n| n == RATE_HZ), "{per_second:?}");
+}
+
+fn assert_clean_link(stats: &DecoderStats, stdout: &str) {
+    assert_eq!(stats.corrupt(), 0, "{stats:?}");
+    assert_eq!(stats.garbage_bytes, 0, "{stats:?}");
+    assert_eq!(stats.lost, 0, "sequence gaps: {stats:?}");
+    assert_eq!(stats.sequence_restarts, 0, "{stats:?}");
+    assert_eq!(summary_value(stdout, "frames_dropped"), 0);
+}
+
+fn nav_bytes(nav: &NavSolution) -> Vec<u8> {
+    let mut body = [0u8; MAX_BODY_LEN];
+    let len = encode_body(0, &Payload::Nav(*nav), &mut body).expect("room for a frame");
+    body[..len].to_vec()
+}
+
+/// The figure `key=` of the probe's summary line.
+fn summary_value(stdout: &str, key: &str) -> u64 {
+    let line = stdout
+        .lines()
+        .find_map(|l| l.split_once("probe-qemu: samples=").map(|(_, rest)| rest))
+        .unwrap_or_else(|| panic!("no summary line in: {stdout}"));
+    let full = format!("samples={line}");
+    full.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {key} in the summary: {full}"))
+}
+
+#[test]
+fn static_minute_streams_twenty_clean_raw_frames_per_simulated_second() {
+    require_qemu();
+    let elf = build_firmware("board-qemu", "static");
+    let run = run_in_qemu(&elf, "static");
+    let (frames, stats) = decode(&run.uart);
+    let raws = raw_samples(&frames);
+
+    // The link: every byte decoded, nothing lost or corrupt.
+    assert_clean_link(&stats, &run.stdout);
+
+    // First the boot event, then raw and navigation frames only: no faults
+    // in this run.
+    let Some(Payload::Event(boot)) = frames.first().map(|f| f.payload) else {
+        panic!("the stream starts with the boot event")
+    };
+    assert_eq!(boot.kind, EventKind::Boot);
+    let navs: Vec<NavSolution> = frames
+        .iter()
+        .filter_map(|f| match f.payload {
+            Payload::Nav(n) => Some(n),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        raws.len() + navs.len() + 1,
+        frames.len(),
+        "unexpected events"
+    );
+    assert_twenty_per_simulated_second(&raws);
+    assert_eq!(summary_value(&run.stdout, "samples"), RUN_SECONDS * RATE_HZ);
+    assert_eq!(summary_value(&run.stdout, "nav_samples_dropped"), 0);
+
+    // One navigation solution per raw sample: 5 s of coarse alignment on
+    // the still probe, then navigation from a level attitude (the mock's
+    // tool lies level; it has no earth rate, so only the levelling is
+    // checked, right after the alignment).
+    assert_eq!(navs.len(), raws.len());
+    for (n, nav) in navs.iter().enumerate() {
+        assert_eq!(nav.sample_counter as usize, n);
+        let aligning = n < ALIGNMENT_SAMPLES - 1;
+        let mode = if aligning {
+            nav_mode::COARSE_ALIGNMENT
+        } else {
+            nav_mode::NAVIGATING
+        };
+        assert_eq!(nav.mode, mode, "solution {n}");
+    }
+    let first = navs[ALIGNMENT_SAMPLES - 1];
+    assert!(
+        first.attitude[0].abs() < 2e-3 && first.attitude[1].abs() < 2e-3,
+        "{first:?}"
+    );
+    assert!(first.attitude_std[0] > 0.0 && first.attitude_std[1] > 0.0);
+
+    // Replay parity: the host runs the probe's navigation code on the
+    // recorded raw frames and gets the probe's solutions bit for bit
+    // (compared as encoded frames, so NaN fields compare too).
+    let mut navigator = Navigator::new(Position::paper_site());
+    for (raw, on_board) in raws.iter().zip(&navs) {
+        let replayed = navigator.step(raw);
+        assert_eq!(
+            nav_bytes(&replayed),
+            nav_bytes(on_board),
+            "sample {}: host {replayed:?} vs probe {on_board:?}",
+            raw.sample_counter
+        );
+    }
+    // The same through the host tool's replay (`host-sim replay`).
+    let (_, summary) = host_sim::replay::replay(&frames, Position::paper_site());
+    assert_eq!(
+        (summary.matched, summary.mismatched),
+        (navs.len() as u64, 0)
+    );
+
+    // The data are the probe at rest: both parts valid, and both
+    // accelerometers, back in body axes, feel gravity's reaction.
+    let lsb = accel_count_to_m_s2(1);
+    for raw in &raws {
+        for (part, mounting) in raw.parts.iter().zip(PART_MOUNTINGS) {
+            let valid = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
+            assert_eq!(part.flags & valid, valid, "sample {}", raw.sample_counter);
+            let body = mounting.sensor_to_body(part.accel.map(accel_count_to_m_s2));
+            let norm = body.iter().map(|a| a * a).sum::<f32>().sqrt();
+            assert!(
+                (norm - STANDARD_GRAVITY_M_S2).abs() <= 2.0 * lsb,
+                "|f| = {norm}"
+            );
+        }
+    }
+}
+
+#[test]
+fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
+    require_qemu();
+    // Faults (firmware/src/bin/probe_qemu/mock_sensors.rs): part 0 gyro
+    // parity errors at 10 s, part 1 gyro S_OK drop at 20 s, part 0
+    // power-cycle at 30 s.
+    let elf = build_firmware("qemu-fault-demo", "faults");
+    let run = run_in_qemu(&elf, "faults");
+    let (frames, stats) = decode(&run.uart);
+    assert_clean_link(&stats, &run.stdout);
+    let raws = raw_samples(&frames);
+    assert_twenty_per_simulated_second(&raws);
+
+    let events: Vec<Event> = frames
+        .iter()
+        .filter_map(|f| match f.payload {
+            Payload::Event(e) => Some(e),
+            _ => None,
+        })
+        .collect();
+    let seen = |kind: EventKind, part: u8, from_s: u64, to_s: u64| {
+        events.iter().any(|e| {
+            e.kind == kind && e.part == part && (from_s..to_s).contains(&(e.time_us / 1_000_000))
+        })
+    };
+    assert!(seen(EventKind::SensorFault, 0, 10, 11), "{events:#?}");
+    assert!(seen(EventKind::SensorFault, 1, 20, 21), "{events:#?}");
+    assert!(seen(EventKind::SensorFault, 0, 30, 31), "{events:#?}");
+    // The recoveries ran, succeeded (code 0) and the stream resynchronised.
+    // A power-cycled part takes its 800 ms start-up again: within 2 s.
+    for (part, at_s) in [(1, 20), (0, 30)] {
+        assert!(
+            seen(EventKind::SensorReset, part, at_s, at_s + 2),
+            "{events:#?}"
+        );
+        assert!(
+            events
+                .iter()
+                .all(|e| e.kind != EventKind::SensorReset || e.code == 0),
+            "{events:#?}"
+        );
+    }
+    // Each resynchronisation says how many samples its recovery cost.
+    let resyncs: u64 = events
+        .iter()
+        .filter(|e| e.kind == EventKind::Resync)
+        .map(|e| u64::from(e.value))
+        .sum();
+    // No fault outside the injected ones.
+    let faults = events.iter().filter(|e| e.kind == EventKind::SensorFault);
+    assert!(faults
+        .clone()
+        .all(|e| [10, 20, 30].contains(&(e.time_us / 1_000_000))));
+
+    // Samples lost to recovery are marked (no valid flag), all within 2 s
+    // of a fault, and the probe streams good data again after.
+    let valid = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
+    let skipped: Vec<_> = raws
+        .iter()
+        .filter(|r| r.parts.iter().any(|p| p.flags & valid != valid))
+        .map(|r| r.time_us / 1_000_000)
+        .collect();
+    assert!(!skipped.is_empty());
+    assert!(
+        skipped.iter().all(|s| [10, 20, 21, 30, 31].contains(s)),
+        "{skipped:?}"
+    );
+    let away = raws.iter().filter(|r| r.parts.iter().all(|p| p.flags == 0));
+    assert_eq!(summary_value(&run.stdout, "skipped"), away.count() as u64);
+    assert_eq!(summary_value(&run.stdout, "skipped"), resyncs);
+    assert_eq!(summary_value(&run.stdout, "nav_samples_dropped"), 0);
+    assert!(raws
+        .iter()
+        .filter(|r| r.time_us >= 32_000_000)
+        .all(|r| r.parts.iter().all(|p| p.flags & valid == valid)));
+}
+
+#[test]
+fn the_watchdog_ends_a_run_whose_main_loop_hangs() {
+    require_qemu();
+    // The main loop stops at 10 s (the acquisition interrupt goes on); the
+    // watchdog (2 s) must catch it and the probe reports it and fails.
+    let elf = build_firmware("qemu-stall-demo", "stall");
+    let (run, status) = run_in_qemu_to_exit(&elf, "stall");
+    assert!(!status.success(), "{}", run.stdout);
+    assert!(
+        run.stdout.contains("watchdog: the main loop stalled"),
+        "{}",
+        run.stdout
+    );
+    // Streaming went on until the watchdog acted, about 12 s in.
+    let (frames, stats) = decode(&run.uart);
+    assert_eq!((stats.corrupt(), stats.lost), (0, 0), "{stats:?}");
+    let raws = raw_samples(&frames);
+    let last_s = raws.last().map_or(0, |r| r.time_us / 1_000_000);
+    assert!((11..=12).contains(&last_s), "last raw frame at {last_s} s");
+}
