@@ -140,3 +140,87 @@ fn simulate_writes_a_binary_capture_that_decodes_cleanly() {
     );
     let _ = std::fs::remove_file(bin);
 }
+
+/// A calibration file (the format `host-sim calibrate` writes) sets the
+/// simulated probe's deterministic errors, and the same file removes them
+/// again in `align`.
+#[test]
+fn a_calibration_file_drives_simulate_and_align() {
+    use host_sim::analysis::calibration_file::{
+        CalibrationFile, GyroEntry, TriadEntry, FORMAT, VERSION,
+    };
+    let deg = std::f64::consts::PI / 180.0;
+    let triad = TriadEntry {
+        columns: [
+            "accel_x_m_s2".into(),
+            "accel_y_m_s2".into(),
+            "accel_z_m_s2".into(),
+        ],
+        bias: [0.05, -0.03, 0.02],
+        correction: [[0.999, 0.001, 0.0], [0.0, 1.001, 0.0], [0.0, 0.0, 1.0]],
+    };
+    let gyro = |column: &str, axis: &str, bias: f64| GyroEntry {
+        column: column.into(),
+        axis: axis.into(),
+        bias,
+        scale: 1.0,
+    };
+    let file = CalibrationFile {
+        format: FORMAT.into(),
+        version: VERSION,
+        method: "tls".into(),
+        latitude_deg: 45.77755,
+        gravity: 9.8,
+        accel: vec![triad],
+        gyro: vec![
+            gyro("gyro_x_rad_s", "x", 0.05 * deg),
+            gyro("gyro_z_rad_s", "z", -0.03 * deg),
+        ],
+    };
+    let cal = temp_path("probe.cal.json");
+    file.save(&cal).expect("save calibration");
+    let csv = temp_path("calibrated.csv");
+    let (c, o) = (cal.to_str().expect("utf-8"), csv.to_str().expect("utf-8"));
+    let (ok, _, err) = host_sim(&[
+        "simulate",
+        "--sensor",
+        "ideal",
+        "--calibration-file",
+        c,
+        "--pitch",
+        "10",
+        "--heading",
+        "20",
+        "--duration",
+        "10",
+        "-o",
+        o,
+    ]);
+    assert!(ok, "{err}");
+    // Without the calibration the 0.05 deg/s gyro bias ruins the heading;
+    // with it the noise-free heading comes back exactly.
+    let (ok, out, err) = host_sim(&[
+        "align",
+        o,
+        "--noise-free",
+        "--calibration-file",
+        c,
+        "--prior-heading",
+        "40",
+    ]);
+    assert!(ok, "{err}");
+    assert!((printed_azimuth(&out) - 20.0).abs() < 1e-3, "{out}");
+    let (ok, out, _) = host_sim(&[
+        "align",
+        o,
+        "--noise-free",
+        "--calibration",
+        "none",
+        "--prior-heading",
+        "40",
+    ]);
+    assert!(!ok || (printed_azimuth(&out) - 20.0).abs() > 1.0, "{out}");
+    for f in [cal, csv] {
+        let _ = std::fs::remove_file(f);
+    }
+}

@@ -461,16 +461,30 @@ impl<'a> Misfit<'a> {
 
     /// Bias estimate of one axis at a heading, and the misfit it leaves.
     fn axis_fit(&self, axis: usize, heading: f64) -> (f64, f64) {
+        self.axis_fit_with(axis, &self.all_predicted(heading))
+    }
+
+    /// Predicted gyro means of every segment at a heading (computed once
+    /// per heading: the misfit of each axis reads them twice).
+    fn all_predicted(&self, heading: f64) -> [Vector3<f64>; MAX_SEGMENTS] {
+        let mut predicted = [Vector3::zeros(); MAX_SEGMENTS];
+        for (i, p) in predicted.iter_mut().enumerate().take(self.count()) {
+            *p = self.predicted(i, heading);
+        }
+        predicted
+    }
+
+    fn axis_fit_with(&self, axis: usize, predicted: &[Vector3<f64>; MAX_SEGMENTS]) -> (f64, f64) {
         let prior = self.config.noise.gyro[axis].residual_bias;
         let prior_weight = if prior > 0.0 {
             1.0 / (prior * prior)
         } else {
             f64::INFINITY
         };
+        let residual = |i: usize| self.segments[i].rate[axis] - predicted[i][axis];
         let (mut num, mut den) = (0.0, prior_weight);
         for i in 0..self.count() {
-            let r = self.segments[i].rate[axis] - self.predicted(i, heading)[axis];
-            num += self.weights[i][axis] * r;
+            num += self.weights[i][axis] * residual(i);
             den += self.weights[i][axis];
         }
         let bias = if den.is_finite() { num / den } else { 0.0 };
@@ -480,16 +494,17 @@ impl<'a> Misfit<'a> {
             0.0
         };
         for i in 0..self.count() {
-            let r = self.segments[i].rate[axis] - self.predicted(i, heading)[axis] - bias;
+            let r = residual(i) - bias;
             cost += self.weights[i][axis] * r * r;
         }
         (bias, cost)
     }
 
     fn cost(&self, heading: f64) -> f64 {
+        let predicted = self.all_predicted(heading);
         (0..3)
             .filter(|&a| self.config.gyro_axes[a])
-            .map(|a| self.axis_fit(a, heading).1)
+            .map(|a| self.axis_fit_with(a, &predicted).1)
             .sum()
     }
 
@@ -504,12 +519,15 @@ impl<'a> Misfit<'a> {
     /// The (at most two) local minima as (heading, misfit), best first.
     fn local_minima(&self) -> [Option<(f64, f64)>; 2] {
         let step = TAU / GRID_POINTS as f64;
-        let grid = |j: usize| self.cost(j as f64 * step);
+        let mut grid = [0.0; GRID_POINTS];
+        for (j, g) in grid.iter_mut().enumerate() {
+            *g = self.cost(j as f64 * step);
+        }
         let mut found: [Option<(f64, f64)>; 2] = [None, None];
         for j in 0..GRID_POINTS {
-            let here = grid(j);
-            let before = grid((j + GRID_POINTS - 1) % GRID_POINTS);
-            let after = grid((j + 1) % GRID_POINTS);
+            let here = grid[j];
+            let before = grid[(j + GRID_POINTS - 1) % GRID_POINTS];
+            let after = grid[(j + 1) % GRID_POINTS];
             if !(here.is_finite() && here <= before && here < after) {
                 continue;
             }

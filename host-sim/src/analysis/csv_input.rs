@@ -94,11 +94,70 @@ pub fn select_columns(
     }
 }
 
-/// Reads a numeric column file from disk.
+/// Reads a numeric column file from disk, or a probe capture (`.bin`, the
+/// UART bytes of `docs/protocol.md`) as SI body-frame columns.
 pub fn read_columns(path: &Path) -> Result<Columns> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bin"))
+    {
+        return capture_columns(path);
+    }
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     parse_columns(&text).with_context(|| format!("in {}", path.display()))
+}
+
+/// The raw-sample frames of a capture, converted to SI in body axes by the
+/// probe's own conversion (`firmware::app::navigation::body_sample`), in
+/// columns named with their units: time_s, gyro_x_rad_s, gyro_z_rad_s,
+/// accel_{x,y,z}_m_s2. Samples with a faulty part are left out (and
+/// counted on standard error), as are CRC failures and other corrupt frames.
+fn capture_columns(path: &Path) -> Result<Columns> {
+    use mwd_core::protocol::Payload;
+    let capture = crate::capture::read_capture(path)
+        .with_context(|| format!("cannot read capture {}", path.display()))?;
+    let mut data = vec![Vec::new(); 6];
+    let mut skipped = 0usize;
+    for frame in &capture.frames {
+        let Payload::Raw(raw) = frame.payload else {
+            continue;
+        };
+        let Some((gx, gz, f)) = firmware::app::navigation::body_sample(&raw) else {
+            skipped += 1;
+            continue;
+        };
+        let row = [raw.time_us as f64 * 1e-6, gx, gz, f.x, f.y, f.z];
+        for (column, value) in data.iter_mut().zip(row) {
+            column.push(value);
+        }
+    }
+    if data[0].is_empty() {
+        bail!(
+            "{}: no valid raw-sample frame ({} frames decoded, {} CRC failures)",
+            path.display(),
+            capture.frames.len(),
+            capture.stats.crc_errors
+        );
+    }
+    if skipped > 0 {
+        eprintln!(
+            "{}: {skipped} raw samples with a faulty part left out",
+            path.display()
+        );
+    }
+    let names = [
+        "time_s",
+        "gyro_x_rad_s",
+        "gyro_z_rad_s",
+        "accel_x_m_s2",
+        "accel_y_m_s2",
+        "accel_z_m_s2",
+    ];
+    Ok(Columns {
+        names: names.iter().map(|n| n.to_string()).collect(),
+        data,
+    })
 }
 
 fn split_fields(line: &str) -> Vec<&str> {

@@ -1,5 +1,6 @@
 //! `host-sim align`: coarse alignment of a recorded or simulated static file.
 use anyhow::{bail, Context, Result};
+use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::coarse;
 use host_sim::samples_csv;
 use host_sim::sim::{DeterministicErrors, SensorModelFile, SAMPLE_INTERVAL};
@@ -37,6 +38,10 @@ pub struct Args {
     /// Sensor calibration applied before aligning.
     #[arg(long, value_enum, default_value_t = CalibrationKind::Paper)]
     pub calibration: CalibrationKind,
+    /// Calibration JSON (as `host-sim calibrate` writes); overrides
+    /// --calibration.
+    #[arg(long)]
+    pub calibration_file: Option<PathBuf>,
     /// Sensor model JSON (as `simulate --print-sensor-model` writes): its
     /// error budget sets the uncertainties (default: the SCC1300's).
     #[arg(long)]
@@ -62,11 +67,17 @@ pub fn run(args: Args) -> Result<()> {
         Some(path) => Some(SensorModelFile::load(path, 0)?),
         None => None,
     };
-    let cal = match (args.calibration, &model) {
-        (CalibrationKind::Paper, _) => DeterministicErrors::paper_table3().calibration(),
-        (CalibrationKind::None, _) => ProbeCalibration::default(),
-        (CalibrationKind::Model, Some(m)) => m.deterministic.calibration(),
-        (CalibrationKind::Model, None) => bail!("--calibration model needs --sensor-model FILE"),
+    let cal = if let Some(path) = &args.calibration_file {
+        CalibrationFile::load(path)?.to_probe()
+    } else {
+        match (args.calibration, &model) {
+            (CalibrationKind::Paper, _) => DeterministicErrors::paper_table3().calibration(),
+            (CalibrationKind::None, _) => ProbeCalibration::default(),
+            (CalibrationKind::Model, Some(m)) => m.deterministic.calibration(),
+            (CalibrationKind::Model, None) => {
+                bail!("--calibration model needs --sensor-model FILE")
+            }
+        }
     };
     let noise = match (&model, args.noise_free) {
         (Some(m), _) => m.noise,

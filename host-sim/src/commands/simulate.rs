@@ -2,6 +2,8 @@
 //! written as a sample CSV.
 use anyhow::{Context, Result};
 use clap::ValueEnum;
+use host_sim::analysis::calibration_file::CalibrationFile;
+use host_sim::sim::DeterministicErrors;
 use host_sim::sim::{
     Motion, SensorModel, SensorModelFile, SensorSimulator, Trajectory, SAMPLE_INTERVAL,
 };
@@ -110,6 +112,10 @@ pub struct Args {
     /// --print-sensor-model for the defaults.
     #[arg(long)]
     pub sensor_model: Option<PathBuf>,
+    /// Calibration JSON (as `host-sim calibrate` writes): the simulated
+    /// probe gets exactly the deterministic errors it describes.
+    #[arg(long)]
+    pub calibration_file: Option<PathBuf>,
     /// Print the default SCC1300 sensor model as JSON and exit.
     #[arg(long)]
     pub print_sensor_model: bool,
@@ -150,6 +156,16 @@ pub fn run(args: Args) -> Result<()> {
         (None, SensorKind::Scc1300) => SensorModel::scc1300(args.seed),
         (None, SensorKind::Ideal) => SensorModel::ideal(),
     };
+    let mut model = model;
+    if let Some(path) = &args.calibration_file {
+        let cal = CalibrationFile::load(path)?.to_probe();
+        model.deterministic = DeterministicErrors::from_calibration(&cal).with_context(|| {
+            format!(
+                "{}: the accelerometer correction is not invertible or a gyro scale is zero",
+                path.display()
+            )
+        })?;
+    }
     let n = (duration / SAMPLE_INTERVAL).round() as usize;
     let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL).take(n);
     let format = args

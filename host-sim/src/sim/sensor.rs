@@ -59,6 +59,28 @@ impl DeterministicErrors {
         }
     }
 
+    /// The errors a calibration describes (the simulated probe then has
+    /// exactly what `host-sim calibrate` found): accelerometer bias and
+    /// K = M^-1 of the first triad, gyro biases and scales. `None` if the
+    /// accelerometer correction is not invertible or a gyro scale is zero.
+    pub fn from_calibration(cal: &ProbeCalibration) -> Option<Self> {
+        let triad = &cal.accel[0];
+        let m = Matrix3::from_fn(|r, c| triad.correction[r][c]);
+        let k = m.try_inverse()?;
+        let [gx, gz] = cal.gyro;
+        let valid =
+            |g: &GyroCalibration| g.scale.is_finite() && g.scale != 0.0 && g.bias.is_finite();
+        if !(valid(&gx) && valid(&gz) && k.iter().all(|v| v.is_finite())) {
+            return None;
+        }
+        Some(Self {
+            accel_bias: Vector3::from(triad.bias),
+            accel_matrix: k,
+            gyro_bias: Vector3::new(gx.bias, 0.0, gz.bias),
+            gyro_scale: Vector3::new(gx.scale - 1.0, 0.0, gz.scale - 1.0),
+        })
+    }
+
     /// The calibration that removes exactly these errors (what a perfect
     /// six-position calibration would find), in the probe's format. Both
     /// accelerometer triads get the body-frame correction.
@@ -312,6 +334,23 @@ impl Iterator for SensorSimulator {
 mod tests {
     use super::*;
     use mwd_core::conventions::Euler;
+
+    #[test]
+    fn calibration_round_trips_to_the_same_errors() {
+        let mut errors = DeterministicErrors::paper_table3();
+        errors.accel_matrix[(0, 1)] = 1e-3;
+        errors.accel_matrix[(2, 2)] = 1.002;
+        errors.gyro_scale = Vector3::new(3e-4, 0.0, -2e-4);
+        let back =
+            DeterministicErrors::from_calibration(&errors.calibration()).expect("invertible");
+        assert!((back.accel_matrix - errors.accel_matrix).abs().max() < 1e-12);
+        assert!((back.accel_bias - errors.accel_bias).norm() < 1e-15);
+        assert!((back.gyro_bias - errors.gyro_bias).norm() < 1e-18);
+        assert!((back.gyro_scale - errors.gyro_scale).norm() < 1e-15);
+        let mut broken = errors.calibration();
+        broken.accel[0].correction = [[0.0; 3]; 3];
+        assert!(DeterministicErrors::from_calibration(&broken).is_none());
+    }
 
     #[test]
     fn ideal_static_outputs_are_earth_rate_and_gravity() {
