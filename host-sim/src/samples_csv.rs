@@ -39,11 +39,20 @@ impl From<&SimSample> for Record {
     }
 }
 
-/// Writes the header and the samples.
+/// Writes the header and the samples; six-position runs get a `position`
+/// column (the code `host-sim calibrate` reads).
 pub fn write<W: Write>(mut out: W, samples: impl IntoIterator<Item = SimSample>) -> Result<()> {
-    writeln!(out, "{},{}", MEASURED.join(","), TRUTH.join(","))?;
+    let mut samples = samples.into_iter().peekable();
+    let with_position = samples.peek().is_some_and(|s| s.position_code.is_some());
+    let position_header = if with_position { ",position" } else { "" };
+    writeln!(
+        out,
+        "{},{}{position_header}",
+        MEASURED.join(","),
+        TRUTH.join(",")
+    )?;
     for s in samples {
-        writeln!(
+        write!(
             out,
             "{:.3},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
             s.time,
@@ -56,6 +65,10 @@ pub fn write<W: Write>(mut out: W, samples: impl IntoIterator<Item = SimSample>)
             s.truth.pitch,
             s.truth.heading
         )?;
+        if with_position {
+            write!(out, ",{}", s.position_code.unwrap_or(0))?;
+        }
+        writeln!(out)?;
     }
     Ok(())
 }

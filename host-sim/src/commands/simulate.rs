@@ -24,6 +24,9 @@ pub enum MotionKind {
     Toolface,
     /// Constant body rate relative to the earth.
     Rotate,
+    /// Six-position calibration tumble (--dwell s per position); the CSV
+    /// gets the `position` column `host-sim calibrate` reads.
+    SixPosition,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -60,7 +63,7 @@ pub struct TrajectoryArgs {
     /// Toolface indexing: turn per step, degrees.
     #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
     pub step: f64,
-    /// Toolface indexing: time at rest at each toolface, seconds.
+    /// Toolface indexing / six-position: time at rest at each position, seconds.
     #[arg(long, default_value_t = 30.0)]
     pub dwell: f64,
     /// Toolface indexing: number of turns.
@@ -84,6 +87,7 @@ impl TrajectoryArgs {
                 dwell: self.dwell,
                 steps: self.steps,
             },
+            MotionKind::SixPosition => Motion::SixPosition { dwell: self.dwell },
             MotionKind::Rotate => {
                 let r = |i: usize| self.body_rate.get(i).copied().unwrap_or(0.0) * DEG;
                 Motion::ConstantRate {

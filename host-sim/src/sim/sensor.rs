@@ -208,6 +208,8 @@ pub struct SimSample {
     pub true_accel: Vector3<f64>,
     /// True attitude at `time`.
     pub truth: mwd_core::conventions::Euler,
+    /// Six-position runs: the calibration position code (1-6).
+    pub position_code: Option<u8>,
 }
 
 /// Interval means of the ideal rate and specific force.
@@ -326,6 +328,7 @@ impl Iterator for SensorSimulator {
             true_rate,
             true_accel,
             truth: self.trajectory.euler(time),
+            position_code: self.trajectory.position_code(time),
         })
     }
 }

@@ -2,6 +2,7 @@
 //! alignment scenarios): static, toolface indexing and constant-rate
 //! rotations. Each gives the attitude and the body's rate relative to the
 //! navigation frame at any time.
+use core::f64::consts::{FRAC_PI_2, PI};
 use mwd_core::conventions::{dcm_from_euler, Euler};
 use mwd_core::earth::Position;
 use nalgebra::{Matrix3, Vector3};
@@ -26,7 +27,23 @@ pub enum Motion {
     },
     /// Constant body rate omega_nb^b (rad/s) relative to the navigation frame.
     ConstantRate { body_rate: Vector3<f64> },
+    /// A six-position calibration tumble: `dwell` seconds with each body
+    /// axis up and then down, in the order of [`SIX_POSITIONS`], at the
+    /// starting heading. The probe jumps between positions (only the dwell
+    /// data matter to the calibration).
+    SixPosition { dwell: f64 },
 }
+
+/// The six positions (code as `host-sim calibrate` reads it, roll, pitch):
+/// 1 +x up, 2 x down, 3 +y up, 4 y down, 5 +z up, 6 z down.
+pub const SIX_POSITIONS: [(u8, f64, f64); 6] = [
+    (1, -FRAC_PI_2, 0.0),
+    (2, FRAC_PI_2, 0.0),
+    (3, 0.0, FRAC_PI_2),
+    (4, 0.0, -FRAC_PI_2),
+    (5, 0.0, 0.0),
+    (6, PI, 0.0),
+];
 
 /// A trajectory: where, the attitude at t = 0, and how it moves.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,8 +73,28 @@ impl Trajectory {
                 dwell,
                 steps,
             } => (*steps as f64) * (step.abs() / turn_rate + dwell) + dwell,
+            Motion::SixPosition { dwell } => 6.0 * dwell,
             _ => 0.0,
         }
+    }
+
+    /// The six-position entry at time t: the last instant of a dwell still
+    /// belongs to it, so each sample interval lies in one position.
+    fn six_position(&self, t: f64) -> Option<(u8, f64, f64)> {
+        let Motion::SixPosition { dwell } = self.motion else {
+            return None;
+        };
+        let valid = dwell > 0.0; // false for NaN too
+        if !valid {
+            return None;
+        }
+        let index = ((t - 1e-9).max(0.0) / dwell).floor() as usize;
+        Some(SIX_POSITIONS[index.min(5)])
+    }
+
+    /// The calibration position code (1-6) at time t, for six-position runs.
+    pub fn position_code(&self, t: f64) -> Option<u8> {
+        self.six_position(t).map(|(code, _, _)| code)
     }
 
     /// Roll added by toolface indexing at time t, and its rate.
@@ -96,6 +133,10 @@ impl Trajectory {
     pub fn attitude(&self, t: f64) -> Matrix3<f64> {
         match &self.motion {
             Motion::Static => dcm_from_euler(&self.start),
+            Motion::SixPosition { .. } => {
+                let (_, roll, pitch) = self.six_position(t).unwrap_or((0, 0.0, 0.0));
+                dcm_from_euler(&Euler::new(roll, pitch, self.start.heading))
+            }
             Motion::ToolfaceSteps { .. } => {
                 let (angle, _) = self.indexing(t);
                 dcm_from_euler(&Euler::new(
@@ -114,7 +155,7 @@ impl Trajectory {
     /// The body's rate relative to the navigation frame, omega_nb^b (rad/s).
     pub fn body_rate(&self, t: f64) -> Vector3<f64> {
         match &self.motion {
-            Motion::Static => Vector3::zeros(),
+            Motion::Static | Motion::SixPosition { .. } => Vector3::zeros(),
             // Roll is the innermost Euler rotation, about the tool axis (y).
             Motion::ToolfaceSteps { .. } => Vector3::new(0.0, self.indexing(t).1, 0.0),
             Motion::ConstantRate { body_rate } => *body_rate,
@@ -153,6 +194,38 @@ mod tests {
                 || (mwd_core::conventions::wrap_pi(end.roll) + core::f64::consts::PI).abs() < 1e-9
         );
         assert!((end.heading - 0.5).abs() < 1e-9 && (end.pitch + 0.2).abs() < 1e-9);
+    }
+
+    #[test]
+    fn six_positions_put_each_axis_up_and_down() {
+        let traj = Trajectory {
+            position: Position::paper_site(),
+            start: Euler::new(0.0, 0.0, 0.4),
+            motion: Motion::SixPosition { dwell: 10.0 },
+        };
+        assert_eq!(traj.scripted_duration(), 60.0);
+        // Body axis that points up (-down) in each dwell, and its code.
+        let up = [
+            (1, 0, 1.0),
+            (2, 0, -1.0),
+            (3, 1, 1.0),
+            (4, 1, -1.0),
+            (5, 2, 1.0),
+            (6, 2, -1.0),
+        ];
+        for (k, (code, axis, sign)) in up.into_iter().enumerate() {
+            for t in [k as f64 * 10.0 + 0.05, (k + 1) as f64 * 10.0] {
+                assert_eq!(traj.position_code(t), Some(code), "t = {t}");
+                let mut b = Vector3::zeros();
+                b[axis] = sign;
+                let n = traj.attitude(t) * b;
+                assert!((n.z + 1.0).abs() < 1e-12, "code {code}: {n:?}");
+            }
+        }
+        assert_eq!(
+            Trajectory::paper_static(Euler::default()).position_code(1.0),
+            None
+        );
     }
 
     #[test]
