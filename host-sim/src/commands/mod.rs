@@ -7,6 +7,7 @@ mod arfit;
 mod calibrate;
 mod decode;
 mod demo;
+mod observability;
 mod paper;
 mod paper_mgwd;
 mod replay;
@@ -38,6 +39,9 @@ pub enum Command {
     Arfit(arfit::Args),
     /// Six-position calibration of accelerometer triads and gyro biases (LS and TLS).
     Calibrate(calibrate::Args),
+    /// What ZUPT and zero-position updates can determine at rest, per state
+    /// (one toolface or toolface indexing).
+    Observability(observability::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
@@ -53,6 +57,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Allan(args) => allan::run(args),
         Command::Arfit(args) => arfit::run(args),
         Command::Calibrate(args) => calibrate::run(args),
+        Command::Observability(args) => observability::run(args),
         Command::Paper(cmd) => paper::run(cmd),
     }
 }
