@@ -55,7 +55,13 @@ pub const AMBIGUITY_CHI2: f64 = 6.63;
 pub const COVERAGE_FACTOR: f64 = 2.0;
 
 const GRID_POINTS: usize = 72;
-const REFINE_ITERATIONS: usize = 60;
+/// Golden-section steps that bring the bracket (one grid step either side)
+/// to about 1e-4 rad, and Newton steps that take it from there to rounding
+/// (the misfit is smooth, and quadratic near its minimum).
+const GOLDEN_ITERATIONS: usize = 16;
+const NEWTON_ITERATIONS: usize = 4;
+/// Finite-difference step of the Newton iterations (rad).
+const NEWTON_STEP: f64 = 1e-5;
 
 /// Means of one static segment (one toolface position).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -190,7 +196,8 @@ pub fn gyrocompass(
     config: &AlignmentConfig,
 ) -> Result<HeadingEstimate, AlignmentError> {
     check_all(segments, config)?;
-    let model = Misfit::new(segments, config);
+    let sigmas = MeanSigmas::new(segments, config);
+    let model = Misfit::new(segments, config, &sigmas);
     let [first, second] = model.local_minima();
     let (best, other) = match (first, second) {
         (Some(a), Some(b)) if b.1 - a.1 < AMBIGUITY_CHI2 => {
@@ -212,8 +219,8 @@ pub fn gyrocompass(
     // where the measured rate exceeds what any heading explains and the
     // propagated derivative collapses, so the Cramer-Rao bound from the
     // expected information is the floor.
-    let propagated = heading_sigma(segments, config, |perturbed| {
-        Misfit::new(perturbed, config).refine(heading)
+    let propagated = heading_sigma(segments, config, &sigmas, |perturbed| {
+        Misfit::new(perturbed, config, &sigmas).refine(heading)
     });
     let sigma = propagated.max(model.cramer_rao_sigma(heading));
     Ok(HeadingEstimate {
@@ -255,8 +262,9 @@ pub fn analytical(
         }
     };
     let heading = solve(segment, chosen_sign);
+    let sigmas = MeanSigmas::new(core::slice::from_ref(segment), config);
     let sigma = if heading.is_finite() {
-        heading_sigma(core::slice::from_ref(segment), config, |p| {
+        heading_sigma(core::slice::from_ref(segment), config, &sigmas, |p| {
             p.first()
                 .map(|s| solve(s, chosen_sign))
                 .filter(|h| h.is_finite())
@@ -264,7 +272,7 @@ pub fn analytical(
     } else {
         f64::INFINITY
     };
-    let model = Misfit::new(core::slice::from_ref(segment), config);
+    let model = Misfit::new(core::slice::from_ref(segment), config, &sigmas);
     Ok(HeadingEstimate {
         heading: Uncertain {
             value: if heading.is_finite() { heading } else { 0.0 },
@@ -353,10 +361,42 @@ fn step_size(a: f64, b: f64, floor: f64) -> f64 {
     }
 }
 
+/// Standard deviations of each segment's means (white, coloured and
+/// Gauss-Markov parts; see `AxisNoise::mean_sigma`), per axis. Computed
+/// once per alignment: the coloured part solves a Lyapunov equation, far
+/// too costly to repeat for every perturbed estimate on the probe.
+#[derive(Clone, Copy, Debug)]
+struct MeanSigmas {
+    accel: [[f64; 3]; MAX_SEGMENTS],
+    gyro: [[f64; 3]; MAX_SEGMENTS],
+}
+
+impl MeanSigmas {
+    fn new(segments: &[StaticSegment], config: &AlignmentConfig) -> Self {
+        let mut table = Self {
+            accel: [[0.0; 3]; MAX_SEGMENTS],
+            gyro: [[0.0; 3]; MAX_SEGMENTS],
+        };
+        let dt = config.sample_interval;
+        for (i, seg) in segments.iter().take(MAX_SEGMENTS).enumerate() {
+            for axis in 0..3 {
+                table.accel[i][axis] = config.noise.accel[axis].mean_sigma(seg.samples, dt);
+                table.gyro[i][axis] = config.noise.gyro[axis].mean_sigma(seg.samples, dt);
+            }
+        }
+        table
+    }
+}
+
 /// 1-sigma of a heading function of the segments' means, by central
 /// differences: independent noise of each segment's means plus the residual
 /// biases, which are common to all segments.
-fn heading_sigma<F>(segments: &[StaticSegment], config: &AlignmentConfig, estimate: F) -> f64
+fn heading_sigma<F>(
+    segments: &[StaticSegment],
+    config: &AlignmentConfig,
+    sigmas: &MeanSigmas,
+    estimate: F,
+) -> f64
 where
     F: Fn(&[StaticSegment]) -> Option<f64>,
 {
@@ -367,7 +407,6 @@ where
     }; MAX_SEGMENTS];
     let n = segments.len().min(MAX_SEGMENTS);
     work[..n].copy_from_slice(&segments[..n]);
-    let dt = config.sample_interval;
     let mut variance = 0.0;
     // Inputs: 0..3 accelerometer axes, 3..6 rate axes.
     for input in 0..6 {
@@ -383,7 +422,11 @@ where
         let floor = if is_gyro { 1e-9 } else { 1e-6 };
         let mut common_derivative = 0.0;
         for i in 0..n {
-            let sigma = noise.mean_sigma(work[i].samples, dt);
+            let sigma = if is_gyro {
+                sigmas.gyro[i][axis]
+            } else {
+                sigmas.accel[i][axis]
+            };
             if !sigma.is_finite() {
                 return f64::INFINITY;
             }
@@ -427,14 +470,17 @@ struct Misfit<'a> {
 }
 
 impl<'a> Misfit<'a> {
-    fn new(segments: &'a [StaticSegment], config: &'a AlignmentConfig) -> Self {
+    fn new(
+        segments: &'a [StaticSegment],
+        config: &'a AlignmentConfig,
+        sigmas: &MeanSigmas,
+    ) -> Self {
         let mut levelled = [Matrix3::identity(); MAX_SEGMENTS];
         let mut weights = [[0.0; 3]; MAX_SEGMENTS];
         for (i, seg) in segments.iter().take(MAX_SEGMENTS).enumerate() {
             let lev = level(&seg.specific_force);
             levelled[i] = dcm_from_euler(&Euler::new(lev.roll, lev.pitch, 0.0));
-            for (weight, noise) in weights[i].iter_mut().zip(&config.noise.gyro) {
-                let s = noise.mean_sigma(seg.samples, config.sample_interval);
+            for (weight, s) in weights[i].iter_mut().zip(sigmas.gyro[i]) {
                 // A noise-free axis still gets a finite weight so the
                 // misfit stays well defined.
                 *weight = 1.0 / (s * s).max(1e-30);
@@ -560,8 +606,8 @@ impl<'a> Misfit<'a> {
         found
     }
 
-    /// Golden-section search for the minimum within one grid step of
-    /// `start`.
+    /// The minimum within one grid step of `start`: golden-section search,
+    /// then Newton steps on finite differences, kept inside the bracket.
     fn refine(&self, start: f64) -> Option<f64> {
         let span = TAU / GRID_POINTS as f64;
         let ratio = 0.618_033_988_749_894_8;
@@ -569,7 +615,7 @@ impl<'a> Misfit<'a> {
         let mut x1 = b - ratio * (b - a);
         let mut x2 = a + ratio * (b - a);
         let (mut f1, mut f2) = (self.cost(x1), self.cost(x2));
-        for _ in 0..REFINE_ITERATIONS {
+        for _ in 0..GOLDEN_ITERATIONS {
             if f1 < f2 {
                 b = x2;
                 x2 = x1;
@@ -584,7 +630,28 @@ impl<'a> Misfit<'a> {
                 f2 = self.cost(x2);
             }
         }
-        let h = 0.5 * (a + b);
+        let mut h = 0.5 * (a + b);
+        for _ in 0..NEWTON_ITERATIONS {
+            let (minus, here, plus) = (
+                self.cost(h - NEWTON_STEP),
+                self.cost(h),
+                self.cost(h + NEWTON_STEP),
+            );
+            let slope = (plus - minus) / (2.0 * NEWTON_STEP);
+            let curvature = (plus - 2.0 * here + minus) / (NEWTON_STEP * NEWTON_STEP);
+            // Only a step towards a minimum, and never out of the bracket.
+            let valid = curvature > 0.0; // false for NaN too
+            if !valid {
+                break;
+            }
+            // max/min rather than clamp: clamp's panic path formats floats,
+            // which costs the probe 15 KiB of flash.
+            let next = (h - slope / curvature).max(start - span).min(start + span);
+            if next == h {
+                break;
+            }
+            h = next;
+        }
         h.is_finite().then_some(h)
     }
 
