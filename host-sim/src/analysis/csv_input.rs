@@ -94,6 +94,37 @@ pub fn select_columns(
     }
 }
 
+/// The input of an analysis command: a record sampled at `rate_hz`, read
+/// from `path` (column file or capture), with the selected columns and
+/// their units (see [`select_columns`]).
+pub struct AnalysisInput {
+    pub table: Columns,
+    pub selected: Vec<usize>,
+    pub units: Vec<InputUnit>,
+}
+
+/// Checks the sample rate, reads the file and selects the columns: the
+/// common start of `allan` and `arfit`.
+pub fn read_analysis_input(
+    path: &Path,
+    rate_hz: f64,
+    columns: Option<&str>,
+    units: &str,
+) -> Result<AnalysisInput> {
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        bail!("--rate must be a positive number of Hz, got {rate_hz}");
+    }
+    let table = read_columns(path)?;
+    let chosen =
+        select_columns(&table, columns, units).with_context(|| format!("{}", path.display()))?;
+    let (selected, units) = chosen.into_iter().unzip();
+    Ok(AnalysisInput {
+        table,
+        selected,
+        units,
+    })
+}
+
 /// Reads a numeric column file from disk, or a probe capture (`.bin`, the
 /// UART bytes of `docs/protocol.md`) as SI body-frame columns.
 pub fn read_columns(path: &Path) -> Result<Columns> {

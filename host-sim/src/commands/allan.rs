@@ -2,12 +2,12 @@
 //! every column of a static record, with confidence intervals, the fitted
 //! noise coefficients and a log-log SVG plot.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use host_sim::analysis::allan::{allan_deviation, averaging_factors, AllanPoint, TauSet};
 use host_sim::analysis::allan_fit::{bias_instability_factor, fit_noise, NoiseCoefficients};
-use host_sim::analysis::csv_input::{read_columns, select_columns};
+use host_sim::analysis::csv_input::{read_analysis_input, AnalysisInput};
 use host_sim::analysis::plot::{loglog_svg, Labels, Series, Style};
-use host_sim::analysis::units::{deviation_unit, report_noise, InputUnit, Quantity, Reported};
+use host_sim::analysis::units::{deviation_unit, report_noise, Quantity, Reported};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -65,13 +65,11 @@ struct Report {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if !(args.rate.is_finite() && args.rate > 0.0) {
-        bail!("--rate must be a positive number of Hz, got {}", args.rate);
-    }
-    let table = read_columns(&args.file)?;
-    let chosen = select_columns(&table, args.columns.as_deref(), &args.units)
-        .with_context(|| format!("{}", args.file.display()))?;
-    let (selected, units): (Vec<usize>, Vec<InputUnit>) = chosen.into_iter().unzip();
+    let AnalysisInput {
+        table,
+        selected,
+        units,
+    } = read_analysis_input(&args.file, args.rate, args.columns.as_deref(), &args.units)?;
     let set = if args.all_taus {
         TauSet::All
     } else {

@@ -3,10 +3,10 @@
 //! selection help, and the model file the filter loads.
 
 use super::allan::print_out;
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use host_sim::analysis::ar_file::{ArModelEntry, ArModelFile, ArQuantity};
 use host_sim::analysis::arfit::{autocorrelation, fit_ar, order_scores, ArFit, ArMethod};
-use host_sim::analysis::csv_input::{read_columns, select_columns};
+use host_sim::analysis::csv_input::{read_analysis_input, AnalysisInput};
 use host_sim::analysis::units::{InputUnit, Quantity};
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -59,13 +59,11 @@ fn quantity_of(unit: InputUnit) -> ArQuantity {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if !(args.rate.is_finite() && args.rate > 0.0) {
-        bail!("--rate must be a positive number of Hz, got {}", args.rate);
-    }
-    let table = read_columns(&args.file)?;
-    let chosen = select_columns(&table, args.columns.as_deref(), &args.units)
-        .with_context(|| format!("{}", args.file.display()))?;
-    let (selected, units): (Vec<usize>, Vec<InputUnit>) = chosen.into_iter().unzip();
+    let AnalysisInput {
+        table,
+        selected,
+        units,
+    } = read_analysis_input(&args.file, args.rate, args.columns.as_deref(), &args.units)?;
     let demean = !args.no_demean;
     let mut out = String::new();
     let mut entries = Vec::new();
