@@ -3,7 +3,8 @@
 # (arm-none-eabi-size), and from one simulated static minute under
 # `-icount shift=0,sleep=off` the stack high-water mark (stack painting),
 # instructions per 20 Hz cycle (SysTick counts, 40 instructions each) and
-# the UART bytes per second.
+# the UART bytes per second; then flash and static RAM of the real board's
+# build (`probe-stm32`, linked with the top-level memory.x).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,3 +29,13 @@ qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic \
   -icount shift=0,sleep=off -kernel "$elf" | grep -o 'probe-qemu: .*' | tr ' ' '\n'
 bytes=$(stat -c %s "$serial")
 echo "uart_bytes=$bytes uart_bytes_per_s=$((bytes / 60)) (of 11520 at 115200 baud 8N1)"
+
+stm32_dir="${CARGO_TARGET_DIR:-target}"
+cargo build -q -p firmware --release --target "$target" --features board-stm32 --bin probe-stm32
+elf="$stm32_dir/$target/release/probe-stm32"
+echo "== real board (arm-none-eabi-size -A $elf)"
+arm-none-eabi-size -A "$elf" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
+arm-none-eabi-size -A "$elf" | awk '
+  $1 ~ /^\.(vector_table|text|rodata|data)$/ { flash += $2 }
+  $1 ~ /^\.(data|bss|uninit)$/ { ram += $2 }
+  END { printf "flash %d B (%.1f KiB) of 128 KiB, static RAM %d B (%.1f KiB) of 32 KiB\n", flash, flash/1024, ram, ram/1024 }'

@@ -35,42 +35,97 @@ pub struct ReplaySummary {
 /// Replays every raw frame of `frames` through the navigation, starting at
 /// `position` (the probe's configured site).
 pub fn replay(frames: &[Frame], position: Position) -> (Vec<ReplayRow>, ReplaySummary) {
-    let probe: HashMap<u32, NavSolution> = frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Nav(n) => Some((n.sample_counter, n)),
-            _ => None,
-        })
-        .collect();
-    let mut summary = ReplaySummary {
-        probe_solutions: probe.len() as u64,
-        ..ReplaySummary::default()
-    };
-    let mut navigator = Navigator::new(position);
-    let mut rows = Vec::new();
+    let mut replayer = Replayer::new(position);
     for frame in frames {
-        let Payload::Raw(raw) = frame.payload else {
-            continue;
-        };
-        summary.raw_frames += 1;
-        let solution = navigator.step(&raw);
-        if firmware::app::navigation::body_sample(&raw).is_none() {
-            summary.degraded += 1;
-        }
-        let matches_probe = probe
-            .get(&raw.sample_counter)
-            .map(|on_board| encoded(on_board) == encoded(&solution));
-        match matches_probe {
-            Some(true) => summary.matched += 1,
-            Some(false) => summary.mismatched += 1,
-            None => {}
-        }
-        rows.push(ReplayRow {
-            solution,
-            matches_probe,
-        });
+        replayer.push(frame);
     }
-    (rows, summary)
+    replayer.finish()
+}
+
+/// The replay one frame at a time, for a live stream: a raw frame is
+/// replayed as soon as it arrives. The probe sends a sample's navigation
+/// frame after its raw frame, but nothing here relies on that order: a
+/// solution waits for its partner on either side.
+pub struct Replayer {
+    navigator: Navigator,
+    rows: Vec<ReplayRow>,
+    /// Rows (index into `rows`) of replayed samples the probe's solution
+    /// has not arrived for yet.
+    awaiting_probe: HashMap<u32, usize>,
+    /// The probe's solutions whose raw frame has not arrived yet.
+    early_probe: HashMap<u32, NavSolution>,
+    summary: ReplaySummary,
+}
+
+impl Replayer {
+    pub fn new(position: Position) -> Self {
+        Self {
+            navigator: Navigator::new(position),
+            rows: Vec::new(),
+            awaiting_probe: HashMap::new(),
+            early_probe: HashMap::new(),
+            summary: ReplaySummary::default(),
+        }
+    }
+
+    /// Takes one decoded frame; returns the replayed solution if it was a
+    /// raw sample.
+    pub fn push(&mut self, frame: &Frame) -> Option<NavSolution> {
+        match frame.payload {
+            Payload::Nav(on_board) => {
+                self.summary.probe_solutions += 1;
+                match self.awaiting_probe.remove(&on_board.sample_counter) {
+                    Some(index) => self.compare(index, &on_board),
+                    None => {
+                        self.early_probe.insert(on_board.sample_counter, on_board);
+                    }
+                }
+                None
+            }
+            Payload::Raw(raw) => {
+                self.summary.raw_frames += 1;
+                let solution = self.navigator.step(&raw);
+                if firmware::app::navigation::body_sample(&raw).is_none() {
+                    self.summary.degraded += 1;
+                }
+                let index = self.rows.len();
+                self.rows.push(ReplayRow {
+                    solution,
+                    matches_probe: None,
+                });
+                match self.early_probe.remove(&raw.sample_counter) {
+                    Some(on_board) => self.compare(index, &on_board),
+                    None => {
+                        self.awaiting_probe.insert(raw.sample_counter, index);
+                    }
+                }
+                Some(solution)
+            }
+            _ => None,
+        }
+    }
+
+    fn compare(&mut self, index: usize, on_board: &NavSolution) {
+        let row = &mut self.rows[index];
+        let same = encoded(on_board) == encoded(&row.solution);
+        row.matches_probe = Some(same);
+        if same {
+            self.summary.matched += 1;
+        } else {
+            self.summary.mismatched += 1;
+        }
+    }
+
+    /// The replay so far.
+    pub fn summary(&self) -> &ReplaySummary {
+        &self.summary
+    }
+
+    /// The replayed rows (one per raw frame, in arrival order) and the
+    /// summary.
+    pub fn finish(self) -> (Vec<ReplayRow>, ReplaySummary) {
+        (self.rows, self.summary)
+    }
 }
 
 fn encoded(nav: &NavSolution) -> Vec<u8> {

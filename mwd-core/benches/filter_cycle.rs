@@ -87,7 +87,10 @@ impl<T: FilterScalar> DenseCycle<T> {
             position: s.position,
             specific_force_n: c_bn * sample.specific_force,
         };
-        let phi = self.model.transition_with::<T>(&self.earth, &lp).to_dense();
+        let phi = self
+            .model
+            .transition_with::<T, STATES>(&self.earth, &lp)
+            .to_dense();
         dense::predict(&mut self.x, &mut self.p, &phi, &self.q);
         let dp = s.position.ned_from(&self.reference);
         let z =

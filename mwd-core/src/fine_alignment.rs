@@ -1,19 +1,20 @@
 //! Quasi-stationary fine alignment (paper section 3.2.3 and 4): from the
 //! coarse alignment, run the strapdown mechanization and the 33-state
-//! filter at the sample rate with zero-velocity and zero-position updates,
+//! filter (or the 39-state one with sensor biases) at the sample rate with zero-velocity and zero-position updates,
 //! feeding the estimated navigation errors back into the mechanization
 //! after every update (closed loop) and zeroing them in the filter.
 //!
 //! Only the navigation errors are fed back: the AR states are the filter's
 //! memory of the coloured sensor noise, not a correction of the solution,
-//! so they stay in the state.
+//! so they stay in the state; so do the bias estimates (the mechanization
+//! takes raw samples: the filter's dynamics carry the bias's effect).
 
 use crate::attitude::quat_from_rotation_vector;
 use crate::conventions::{euler_from_quat, wrap_pi};
-use crate::earth::Position;
+use crate::earth::{gravity_n, normal_gravity, Position};
 use crate::error_model::{
-    AugmentedModel, AugmentedTransition, EarthTerms, LinearizationPoint, ProcessNoise, ATT,
-    NAV_STATES, POS, STATES, VEL,
+    AugmentedModel, AugmentedTransition, EarthTerms, LinearizationPoint, ProcessNoise, ACCEL_BIAS,
+    ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
 };
 use crate::kalman::{FilterScalar, KalmanFilter, UpdateReport};
 use crate::measurement::{ZeroPosition, ZeroVelocity};
@@ -27,6 +28,37 @@ pub enum ArInitialCovariance {
     Stationary,
     /// The same variance on every AR state (the paper's P0 = 0.01 I).
     Diagonal(f64),
+}
+
+/// How the initial tilt error relates to the accelerometer biases
+/// (39-state form; ignored with 33 states).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TiltPrior {
+    /// Tilt errors independent of the biases, variances as configured.
+    Independent,
+    /// The coarse attitude was levelled with these same accelerometers, so
+    /// its tilt error holds the bias: phiN = (C_b^n b)_E / g, phiE =
+    /// -(C_b^n b)_N / g (the rest state of dv' = f^n x phi + C_b^n b,
+    /// derivation section 3b). The configured tilt variances are then the
+    /// levelling noise alone; the bias part and its cross-covariance with
+    /// the bias states are added.
+    LevelledWithSameAccelerometers,
+}
+
+/// Which specific force f^n enters F21 = [f^n x] (eq. 12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpecificForceInModel {
+    /// The sample's C_b^n f^b: the usual choice, and right in motion.
+    MeasuredSample,
+    /// -g^n, what the alignment's own zero-velocity assumption says the
+    /// true specific force is. The sample's sensor noise (0.06 m/s^2 on
+    /// body x, Table 4) in [f^n x] phi is a term (C_b^n df) x phi that the
+    /// true error dynamics do not have (dv' = C~ df + f^n_true x phi with
+    /// the computed C~ in the coupling); with tens of degrees of azimuth
+    /// error it makes the noise's direction look like heading information
+    /// and the azimuth sigma collapse while the error stays large
+    /// (derivation section 6).
+    GravityAtRest,
 }
 
 /// Settings of the fine alignment.
@@ -45,6 +77,10 @@ pub struct FineAlignmentConfig {
     pub gate: Option<f64>,
     /// Multiplies the AR innovation variances in Q (1 for the models' own).
     pub ar_noise_scale: f64,
+    /// Initial tilt-bias correlation (39-state form only).
+    pub tilt_prior: TiltPrior,
+    /// The specific force of the error model's F21.
+    pub specific_force: SpecificForceInModel,
 }
 
 impl FineAlignmentConfig {
@@ -66,6 +102,8 @@ impl FineAlignmentConfig {
             zero_position_variance: Some(0.1),
             gate: None,
             ar_noise_scale: 1.0,
+            tilt_prior: TiltPrior::Independent,
+            specific_force: SpecificForceInModel::MeasuredSample,
         }
     }
 }
@@ -81,13 +119,14 @@ pub struct StepReport {
     pub correction: [f64; NAV_STATES],
 }
 
-/// The fine alignment in progress.
+/// The fine alignment in progress, with `N` = 33 ([`STATES`]) or 39
+/// ([`STATES_WITH_BIASES`]) filter states.
 #[derive(Debug, Clone)]
-pub struct FineAlignment<T: FilterScalar> {
+pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     strapdown: Strapdown,
-    filter: KalmanFilter<T, STATES>,
+    filter: KalmanFilter<T, N>,
     config: FineAlignmentConfig,
-    q: SVector<T, STATES>,
+    q: SVector<T, N>,
     /// Geodetic terms of F, refreshed when the solution has moved.
     earth: EarthTerms,
     /// Radii at the reference position, for the zero-position update.
@@ -96,13 +135,12 @@ pub struct FineAlignment<T: FilterScalar> {
     rejected_samples: u32,
 }
 
-impl<T: FilterScalar> FineAlignment<T> {
+impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Starts from a coarse alignment `initial` (attitude, zero velocity,
     /// known position) and the known position `reference` of the tool.
     pub fn new(initial: NavState, reference: Position, config: FineAlignmentConfig) -> Self {
         let model = &config.model;
-        let mut p0: SMatrix<T, STATES, STATES> =
-            model.initial_covariance(&config.initial_nav_variance);
+        let mut p0: SMatrix<T, N, N> = model.initial_covariance(&config.initial_nav_variance);
         if let ArInitialCovariance::Diagonal(v) = config.initial_ar {
             p0.view_mut(
                 (NAV_STATES, NAV_STATES),
@@ -113,7 +151,11 @@ impl<T: FilterScalar> FineAlignment<T> {
                 p0[(i, i)] = T::of(v);
             }
         }
-        let mut q: SVector<T, STATES> = model.process_noise(&config.process_noise);
+        if N == STATES_WITH_BIASES && config.tilt_prior == TiltPrior::LevelledWithSameAccelerometers
+        {
+            add_levelling_bias_correlation(&mut p0, &initial);
+        }
+        let mut q: SVector<T, N> = model.process_noise(&config.process_noise);
         for i in NAV_STATES..STATES {
             q[i] *= T::of(config.ar_noise_scale);
         }
@@ -157,12 +199,15 @@ impl<T: FilterScalar> FineAlignment<T> {
             c_bn,
             velocity_n: state.velocity,
             position: state.position,
-            specific_force_n: c_bn * sample.specific_force,
+            specific_force_n: match self.config.specific_force {
+                SpecificForceInModel::MeasuredSample => c_bn * sample.specific_force,
+                SpecificForceInModel::GravityAtRest => -gravity_n(&state.position),
+            },
         };
         if !self.earth.is_near(&state.position) {
             self.earth = EarthTerms::at(&state.position);
         }
-        let phi: AugmentedTransition<T> = self.config.model.transition_with(&self.earth, &lp);
+        let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
         self.filter.predict(&phi, &self.q);
 
         let zero_velocity = match self.config.zero_velocity_variance {
@@ -207,7 +252,7 @@ impl<T: FilterScalar> FineAlignment<T> {
         self.strapdown.state()
     }
 
-    pub fn filter(&self) -> &KalmanFilter<T, STATES> {
+    pub fn filter(&self) -> &KalmanFilter<T, N> {
         &self.filter
     }
 
@@ -235,6 +280,37 @@ impl<T: FilterScalar> FineAlignment<T> {
         let j = euler_error_jacobian(&self.state().attitude);
         let p = j * self.attitude_error_covariance() * j.transpose();
         Vector3::new(p[(0, 0)], p[(1, 1)], p[(2, 2)]).map(|v| libm::sqrt(v.max(0.0)))
+    }
+}
+
+/// Adds to `p0` what levelling with biased accelerometers puts into the
+/// tilt: phi_h = M b with M = (1/g) [row E of C_b^n; -row N of C_b^n]
+/// (derivation section 3b), so P(phi_h) += M S M^T and P(phi_h, b) = M S,
+/// S the accelerometer bias block. With the levelling noise N already on
+/// the tilt diagonal this is [I M; 0 I] blockdiag(N, S) [I M; 0 I]^T:
+/// positive semi-definite by construction.
+fn add_levelling_bias_correlation<T: FilterScalar, const N: usize>(
+    p0: &mut SMatrix<T, N, N>,
+    initial: &NavState,
+) {
+    let c_bn = initial.attitude.to_rotation_matrix().into_inner();
+    let g = normal_gravity(initial.position.lat, initial.position.height);
+    let m = Matrix3::from_fn(|i, j| match i {
+        0 => c_bn[(1, j)] / g,
+        1 => -c_bn[(0, j)] / g,
+        _ => 0.0,
+    });
+    let s = p0
+        .fixed_view::<3, 3>(ACCEL_BIAS, ACCEL_BIAS)
+        .map(|v| v.as_f64());
+    let cross = m * s;
+    let tilt = cross * m.transpose();
+    for i in 0..3 {
+        for j in 0..3 {
+            p0[(ATT + i, ATT + j)] += T::of(tilt[(i, j)]);
+            p0[(ATT + i, ACCEL_BIAS + j)] = T::of(cross[(i, j)]);
+            p0[(ACCEL_BIAS + j, ATT + i)] = T::of(cross[(i, j)]);
+        }
     }
 }
 

@@ -14,7 +14,9 @@ use mwd_core::attitude::quat_from_rotation_vector;
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{earth_rate_n, gravity_n, Position};
 use mwd_core::error_model::{AugmentedModel, ProcessNoise, NAV_STATES};
-use mwd_core::fine_alignment::{ArInitialCovariance, FineAlignment, FineAlignmentConfig};
+use mwd_core::fine_alignment::{
+    ArInitialCovariance, FineAlignment, FineAlignmentConfig, SpecificForceInModel, TiltPrior,
+};
 use mwd_core::kalman::FilterScalar;
 use mwd_core::mechanization::{ImuSample, NavState};
 use nalgebra::Vector3;
@@ -108,6 +110,8 @@ fn physical() -> FineAlignmentConfig {
         zero_position_variance: Some(1e-6),
         gate: None,
         ar_noise_scale: 1.0,
+        tilt_prior: TiltPrior::Independent,
+        specific_force: SpecificForceInModel::MeasuredSample,
     }
 }
 

@@ -1,10 +1,12 @@
-//! The structured filter against the dense textbook form (eq. 17-21), and
-//! the rejection paths of the measurement update.
+//! The structured filter against the dense textbook form (eq. 17-21), for
+//! the 33-state model and the 39-state one with sensor biases, and the
+//! rejection paths of the measurement update.
 
 use mwd_core::ar::ArModel;
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{
-    AugmentedModel, Coupling, LinearizationPoint, ProcessNoise, POS, STATES, VEL,
+    AugmentedModel, BiasState, Coupling, LinearizationPoint, ProcessNoise, POS, STATES,
+    STATES_WITH_BIASES, VEL,
 };
 use mwd_core::kalman::{dense, KalmanFilter, ScalarOutcome, Transition};
 use mwd_core::measurement::{
@@ -31,12 +33,17 @@ prop_compose! {
     fn arb_model()(
         ks in prop::array::uniform6(prop::array::uniform4(-0.9f64..0.9)),
         vars in prop::array::uniform6(1e-8f64..1e-2),
+        bias_sigmas in prop::array::uniform6(1e-6f64..1e-1),
+        bias_walks in prop::array::uniform6(0.0f64..1e-6),
         coupled in any::<bool>(),
     ) -> AugmentedModel {
         let mut m = AugmentedModel::paper();
         for axis in 0..3 {
             m.accel[axis] = ar_from_reflections(ks[axis], vars[axis]);
             m.gyro[axis] = ar_from_reflections(ks[axis + 3], vars[axis + 3]);
+            let bias = |k: usize| BiasState { initial_sigma: bias_sigmas[k], variance_per_step: bias_walks[k] };
+            m.biases.accel[axis] = bias(axis);
+            m.biases.gyro[axis] = bias(axis + 3);
         }
         m.coupling = if coupled { Coupling::SensorErrorsDriveNavigation } else { Coupling::BlockDiagonalAsPublished };
         m
@@ -61,16 +68,76 @@ prop_compose! {
     }
 }
 
-prop_compose! {
-    /// A random covariance: L L^T + 1e-6 I with entries of mixed size.
-    fn arb_covariance()(l in prop::collection::vec(-0.3f64..0.3, STATES * STATES)) -> SMatrix<f64, STATES, STATES> {
-        let l = SMatrix::<f64, STATES, STATES>::from_column_slice(&l);
+/// A random covariance: L L^T + 1e-6 I with entries of mixed size.
+fn arb_covariance<const N: usize>() -> impl Strategy<Value = SMatrix<f64, N, N>> {
+    prop::collection::vec(-0.3f64..0.3, N * N).prop_map(|l| {
+        let l = SMatrix::<f64, N, N>::from_column_slice(&l);
         l * l.transpose() + SMatrix::identity() * 1e-6
-    }
+    })
 }
 
-fn rel_diff(a: &SMatrix<f64, STATES, STATES>, b: &SMatrix<f64, STATES, STATES>) -> f64 {
+fn rel_diff<const N: usize>(a: &SMatrix<f64, N, N>, b: &SMatrix<f64, N, N>) -> f64 {
     (a - b).amax() / b.amax().max(1e-300)
+}
+
+/// Inputs of one fast-vs-dense comparison.
+struct Cycle {
+    x0: [f64; 9],
+    zv: [f64; 3],
+    zp: [f64; 3],
+    rv: f64,
+    rp: f64,
+    q: [f64; 9],
+}
+
+/// Two cycles (time update, ZUPT, zero-position update) of the structured
+/// filter and of the dense textbook form from the same start: they must
+/// agree to 1e-9 relative, with `N` = 33 or 39 states.
+fn fast_matches_dense<const N: usize>(
+    model: &AugmentedModel,
+    lp: &LinearizationPoint,
+    p0: SMatrix<f64, N, N>,
+    c: &Cycle,
+) -> Result<(), TestCaseError> {
+    let phi = model.transition::<f64, N>(lp);
+    let q_diag = model.process_noise::<f64, N>(&ProcessNoise { nav_per_step: c.q });
+    let mut fast = KalmanFilter::<f64, N>::new(p0);
+    fast.x.fixed_rows_mut::<9>(0).copy_from_slice(&c.x0);
+    let mut x = fast.x;
+    let mut p = p0;
+    let mut h = SMatrix::<f64, 6, N>::zeros();
+    for i in 0..3 {
+        h[(i, VEL + i)] = 1.0;
+        h[(3 + i, POS + i)] = 1.0;
+    }
+    let (zv, zp, rv, rp) = (c.zv, c.zp, c.rv, c.rp);
+    let z = SVector::<f64, 6>::from_column_slice(&[zv[0], zv[1], zv[2], zp[0], zp[1], zp[2]]);
+    let r =
+        SMatrix::<f64, 6, 6>::from_diagonal(&SVector::from_column_slice(&[rv, rv, rv, rp, rp, rp]));
+    for _ in 0..2 {
+        fast.predict(&phi, &q_diag);
+        let report_v = fast.update(&ZeroVelocity {
+            velocity_n: zv,
+            variance: rv,
+        });
+        let report_p = fast.update(&ZeroPosition {
+            position_error_ned_m: zp,
+            variance: rp,
+        });
+        prop_assert!(report_v.all_accepted() && report_p.all_accepted());
+        dense::predict(
+            &mut x,
+            &mut p,
+            &phi.to_dense(),
+            &SMatrix::from_diagonal(&q_diag),
+        );
+        prop_assert!(dense::update(&mut x, &mut p, &z, &h, &r));
+    }
+    let dp = rel_diff(&fast.p, &p);
+    let dx = (fast.x - x).amax() / x.amax().max(1e-12);
+    prop_assert!(dp < 1e-9, "P differs by {dp:e}");
+    prop_assert!(dx < 1e-9, "x differs by {dx:e}");
+    Ok(())
 }
 
 proptest! {
@@ -80,7 +147,7 @@ proptest! {
     fn fast_and_dense_filters_agree(
         model in arb_model(),
         lp in arb_point(),
-        p0 in arb_covariance(),
+        p0 in arb_covariance::<STATES>(),
         x0 in prop::array::uniform9(-0.1f64..0.1),
         zv in prop::array::uniform3(-0.05f64..0.05),
         zp in prop::array::uniform3(-0.5f64..0.5),
@@ -88,42 +155,29 @@ proptest! {
         rp in 1e-4f64..1.0,
         q in prop::array::uniform9(0.0f64..1e-3),
     ) {
-        let phi = model.transition::<f64>(&lp);
-        let q_diag = model.process_noise::<f64>(&ProcessNoise { nav_per_step: q });
-        let mut fast = KalmanFilter::<f64, STATES>::new(p0);
-        fast.x.fixed_rows_mut::<9>(0).copy_from_slice(&x0);
+        fast_matches_dense(&model, &lp, p0, &Cycle { x0, zv, zp, rv, rp, q })?;
+    }
 
-        let mut x = fast.x;
-        let mut p = p0;
-
-        // Two cycles, each a time update then ZUPT and zero-position update.
-        for _ in 0..2 {
-            fast.predict(&phi, &q_diag);
-            let report_v = fast.update(&ZeroVelocity { velocity_n: zv, variance: rv });
-            let report_p = fast.update(&ZeroPosition { position_error_ned_m: zp, variance: rp });
-            prop_assert!(report_v.all_accepted() && report_p.all_accepted());
-
-            dense::predict(&mut x, &mut p, &phi.to_dense(), &SMatrix::from_diagonal(&q_diag));
-            let mut h = SMatrix::<f64, 6, STATES>::zeros();
-            for i in 0..3 {
-                h[(i, VEL + i)] = 1.0;
-                h[(3 + i, POS + i)] = 1.0;
-            }
-            let z = SVector::<f64, 6>::from_column_slice(&[zv[0], zv[1], zv[2], zp[0], zp[1], zp[2]]);
-            let r = SMatrix::<f64, 6, 6>::from_diagonal(&SVector::from_column_slice(&[rv, rv, rv, rp, rp, rp]));
-            prop_assert!(dense::update(&mut x, &mut p, &z, &h, &r));
-        }
-        let dp = rel_diff(&fast.p, &p);
-        let dx = (fast.x - x).amax() / x.amax().max(1e-12);
-        prop_assert!(dp < 1e-9, "P differs by {dp:e}");
-        prop_assert!(dx < 1e-9, "x differs by {dx:e}");
+    #[test]
+    fn fast_and_dense_filters_agree_with_bias_states(
+        model in arb_model(),
+        lp in arb_point(),
+        p0 in arb_covariance::<STATES_WITH_BIASES>(),
+        x0 in prop::array::uniform9(-0.1f64..0.1),
+        zv in prop::array::uniform3(-0.05f64..0.05),
+        zp in prop::array::uniform3(-0.5f64..0.5),
+        rv in 1e-4f64..1.0,
+        rp in 1e-4f64..1.0,
+        q in prop::array::uniform9(0.0f64..1e-3),
+    ) {
+        fast_matches_dense(&model, &lp, p0, &Cycle { x0, zv, zp, rv, rp, q })?;
     }
 
     #[test]
     fn structured_transition_matches_dense_on_random_inputs(
-        model in arb_model(), lp in arb_point(), p0 in arb_covariance(),
+        model in arb_model(), lp in arb_point(), p0 in arb_covariance::<STATES>(),
     ) {
-        let phi = model.transition::<f64>(&lp);
+        let phi = model.transition::<f64, STATES>(&lp);
         let mut m = p0;
         phi.apply_to_matrix(&mut m);
         let reference = phi.to_dense() * p0;
@@ -131,8 +185,24 @@ proptest! {
     }
 
     #[test]
+    fn structured_39_state_transition_matches_dense_on_random_inputs(
+        model in arb_model(), lp in arb_point(), p0 in arb_covariance::<STATES_WITH_BIASES>(),
+        x0 in prop::collection::vec(-1.0f64..1.0, STATES_WITH_BIASES),
+    ) {
+        let phi = model.transition::<f64, STATES_WITH_BIASES>(&lp);
+        let mut m = p0;
+        phi.apply_to_matrix(&mut m);
+        let reference = phi.to_dense() * p0;
+        prop_assert!(rel_diff(&m, &reference) < 1e-14);
+        let mut x = SVector::<f64, STATES_WITH_BIASES>::from_column_slice(&x0);
+        phi.apply_to_vector(&mut x);
+        let x_ref = phi.to_dense() * SVector::<f64, STATES_WITH_BIASES>::from_column_slice(&x0);
+        prop_assert!((x - x_ref).amax() <= 1e-14 * x_ref.amax().max(1e-300));
+    }
+
+    #[test]
     fn general_sparse_row_matches_dense_update(
-        p0 in arb_covariance(),
+        p0 in arb_covariance::<STATES>(),
         coefs in prop::array::uniform4(-2.0f64..2.0),
         z in -1.0f64..1.0,
         r in 1e-3f64..1.0,
@@ -158,7 +228,7 @@ proptest! {
 
 fn filter() -> KalmanFilter<f32, STATES> {
     let model = AugmentedModel::paper();
-    KalmanFilter::new(model.initial_covariance::<f32>(&[1e-4; 9]))
+    KalmanFilter::new(model.initial_covariance::<f32, STATES>(&[1e-4; 9]))
 }
 
 #[test]

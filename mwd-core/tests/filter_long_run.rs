@@ -39,16 +39,16 @@ fn run<T: FilterScalar>(
         dt,
         ..AugmentedModel::paper()
     };
-    let phi = model.transition::<T>(&lp());
+    let phi = model.transition::<T, STATES>(&lp());
     // Physically scaled: gyro ARW 0.86 deg/sqrt(h), accel VRW 0.05 m/s/sqrt(h).
     let arw = (0.86f64.to_radians() / 60.0).powi(2);
     let vrw = (0.05f64 / 60.0).powi(2);
-    let q = model.process_noise::<T>(&ProcessNoise::from_densities(arw, vrw, 0.0, dt));
+    let q = model.process_noise::<T, STATES>(&ProcessNoise::from_densities(arw, vrw, 0.0, dt));
     let mut nav0 = [0.0; NAV_STATES];
     nav0[..3].copy_from_slice(&[1e-4, 1e-4, 0.1]);
     nav0[3..6].copy_from_slice(&[1e-4; 3]);
     nav0[6..].copy_from_slice(&[1e-2; 3]);
-    let mut f = KalmanFilter::<T, STATES>::new(model.initial_covariance::<T>(&nav0));
+    let mut f = KalmanFilter::<T, STATES>::new(model.initial_covariance::<T, STATES>(&nav0));
     let zero_v = ZeroVelocity {
         velocity_n: [T::zero(); 3],
         variance: T::of(1e-4),

@@ -15,10 +15,9 @@
 //! qemu-system-arm must be installed (`scripts/test-all.sh` installs it):
 //! without it this test fails, it does not skip.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use firmware::app::Navigator;
 use mwd_core::earth::Position;
@@ -27,8 +26,8 @@ use mwd_core::protocol::{
     encode_body, Decoder, DecoderStats, Event, EventKind, Frame, NavSolution, Payload, RawSample,
 };
 use mwd_core::sensor_units::{accel_count_to_m_s2, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+use system_tests::{build_firmware, require_qemu, summary_value, wait_or_kill};
 
-const TARGET: &str = "thumbv7em-none-eabihf";
 /// The firmware's default run length (`PROBE_QEMU_RUN_SECONDS`).
 const RUN_SECONDS: u64 = 60;
 const RATE_HZ: u64 = 20;
@@ -36,65 +35,6 @@ const RATE_HZ: u64 = 20;
 const ALIGNMENT_SAMPLES: usize = 100;
 /// Far above the ~1 s the run takes; only a hang reaches it.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(300);
-
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("tests/ sits in the workspace")
-        .to_path_buf()
-}
-
-/// The cross-build gets its own directory inside the workspace's target
-/// directory: a separate lock from the `cargo test` that runs this, and
-/// no thrashing between host and target builds.
-fn firmware_target_dir() -> PathBuf {
-    // A relative CARGO_TARGET_DIR is relative to the workspace root, not
-    // to this test's working directory (tests/).
-    let base = std::env::var_os("CARGO_TARGET_DIR")
-        .map(|dir| workspace_root().join(dir))
-        .unwrap_or_else(|| workspace_root().join("target"));
-    base.join("qemu-probe")
-}
-
-/// Builds of different features share one target directory (only the
-/// firmware crate differs) and so one output path: build and copy the
-/// binary out one test at a time.
-static BUILD: Mutex<()> = Mutex::new(());
-
-fn build_firmware(features: &str, name: &str) -> PathBuf {
-    let _one_at_a_time = BUILD.lock().unwrap_or_else(|e| e.into_inner());
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let target_dir = firmware_target_dir();
-    let status = Command::new(cargo)
-        .current_dir(workspace_root())
-        .args(["build", "-p", "firmware", "--release", "--target", TARGET])
-        .args(["--features", features, "--bin", "probe-qemu"])
-        .env("CARGO_TARGET_DIR", &target_dir)
-        .status()
-        .expect("run cargo to cross-build the firmware");
-    assert!(
-        status.success(),
-        "cross-build of probe-qemu failed (is the {TARGET} target installed? \
-         `rustup target add {TARGET}`)"
-    );
-    let built = target_dir.join(TARGET).join("release").join("probe-qemu");
-    let elf = target_dir.join(format!("probe-qemu-{name}.elf"));
-    std::fs::copy(&built, &elf).expect("copy the firmware binary");
-    elf
-}
-
-fn require_qemu() {
-    let found = Command::new("qemu-system-arm")
-        .arg("--version")
-        .stdout(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(
-        found,
-        "qemu-system-arm is not installed: this end-to-end test needs it \
-         (Debian: `apt-get install -y qemu-system-arm`, as scripts/test-all.sh does)"
-    );
-}
 
 /// What one QEMU run left: the probe's semihosting output and its UART.
 struct Run {
@@ -128,17 +68,7 @@ fn run_in_qemu_to_exit(elf: &Path, name: &str) -> (Run, std::process::ExitStatus
         .stderr(Stdio::piped())
         .spawn()
         .expect("start qemu-system-arm");
-    let started = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("wait for qemu") {
-            break status;
-        }
-        if started.elapsed() > QEMU_TIMEOUT {
-            let _ = child.kill();
-            panic!("QEMU did not exit within {QEMU_TIMEOUT:?}: the probe hung");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let status = wait_or_kill(&mut child, "QEMU", QEMU_TIMEOUT);
     let output = child.wait_with_output().expect("qemu output");
     let mut stdout = String::from_utf8_lossy(&output.stdout).into_owned();
     stdout += &String::from_utf8_lossy(&output.stderr);
@@ -189,19 +119,6 @@ fn nav_bytes(nav: &NavSolution) -> Vec<u8> {
     let mut body = [0u8; MAX_BODY_LEN];
     let len = encode_body(0, &Payload::Nav(*nav), &mut body).expect("room for a frame");
     body[..len].to_vec()
-}
-
-/// The figure `key=` of the probe's summary line.
-fn summary_value(stdout: &str, key: &str) -> u64 {
-    let line = stdout
-        .lines()
-        .find_map(|l| l.split_once("probe-qemu: samples=").map(|(_, rest)| rest))
-        .unwrap_or_else(|| panic!("no summary line in: {stdout}"));
-    let full = format!("samples={line}");
-    full.split_whitespace()
-        .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("no {key} in the summary: {full}"))
 }
 
 #[test]

@@ -1,19 +1,38 @@
-//! `host-sim replay FILE [--csv OUT]`: runs the probe's navigation on the
-//! raw frames of a capture (for example QEMU's `-serial file:` output) and
-//! checks the replayed solutions against the probe's own navigation frames.
+//! `host-sim replay FILE [--csv OUT]` or `host-sim replay --port PATH
+//! [--baud 115200] [--duration S] [--csv OUT]`: runs the probe's navigation
+//! on the raw frames of a capture (for example QEMU's `-serial file:`
+//! output) or of a live stream from a serial port (a real probe, or QEMU's
+//! `-serial pty`), and checks the replayed solutions against the probe's
+//! own navigation frames. Live mode shows a running status line and, when
+//! the stream ends, prints the same summary as a file replay.
 
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::PathBuf;
+use std::time::Duration;
 
 use anyhow::Context;
-use host_sim::{capture, replay};
+use host_sim::capture::Capture;
+use host_sim::live::{self, LiveOptions};
+use host_sim::replay::{self, ReplayRow, ReplaySummary};
 use mwd_core::earth::Position;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Capture of the probe's UART bytes (`.bin`).
-    pub file: PathBuf,
+    #[arg(required_unless_present = "port", conflicts_with = "port")]
+    pub file: Option<PathBuf>,
+    /// Read a live stream from this serial port instead (e.g. /dev/ttyUSB0,
+    /// or the /dev/pts/N QEMU prints for `-serial pty`).
+    #[arg(long, value_name = "PATH")]
+    pub port: Option<String>,
+    /// Baud rate of the serial port (the probe sends at 115200).
+    #[arg(long, default_value_t = 115_200, requires = "port")]
+    pub baud: u32,
+    /// Stop a live replay after this many seconds (default: until the
+    /// stream ends).
+    #[arg(long, value_name = "SECONDS", requires = "port")]
+    pub duration: Option<f64>,
     /// Write the replayed navigation solutions as CSV here.
     #[arg(long, value_name = "OUT")]
     pub csv: Option<PathBuf>,
@@ -24,14 +43,56 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let cap = capture::read_capture(&args.file)
-        .with_context(|| format!("reading {}", args.file.display()))?;
     let site = match args.site.as_deref() {
         Some([lat, lon, height]) => Position::from_degrees(*lat, *lon, *height),
         _ => Position::paper_site(),
     };
-    let (rows, summary) = replay::replay(&cap.frames, site);
-    println!("capture          {}", args.file.display());
+    let (source, cap, rows, summary) = match (&args.port, &args.file) {
+        (Some(port), _) => {
+            let duration = match args.duration {
+                Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
+                Some(s) => {
+                    anyhow::bail!("--duration must be a positive number of seconds, not {s}")
+                }
+                None => None,
+            };
+            // A short timeout keeps the time limit responsive on a quiet line.
+            let serial = serialport::new(port.as_str(), args.baud)
+                .timeout(Duration::from_millis(100))
+                .open()
+                .with_context(|| format!("opening serial port {port}"))?;
+            // Tools driving this (tests, scripts) wait for this line before
+            // letting the probe run.
+            println!("listening on {port} at {} baud", args.baud);
+            std::io::stdout().flush()?;
+            let options = LiveOptions {
+                duration,
+                ..LiveOptions::default()
+            };
+            let outcome = live::run(serial, site, options, |status| println!("{status}"));
+            println!("end of stream    {}", outcome.end);
+            (port.clone(), outcome.capture, outcome.rows, outcome.summary)
+        }
+        (None, Some(file)) => {
+            let cap = host_sim::capture::read_capture(file)
+                .with_context(|| format!("reading {}", file.display()))?;
+            let (rows, summary) = replay::replay(&cap.frames, site);
+            (file.display().to_string(), cap, rows, summary)
+        }
+        (None, None) => anyhow::bail!("give a capture file or --port"),
+    };
+    report(&source, &cap, &rows, &summary, args.csv.as_ref())
+}
+
+/// The summary both modes end with, and the CSV.
+fn report(
+    source: &str,
+    cap: &Capture,
+    rows: &[ReplayRow],
+    summary: &ReplaySummary,
+    csv: Option<&PathBuf>,
+) -> anyhow::Result<()> {
+    println!("capture          {source}");
     println!("{cap}");
     println!("raw frames       {}", summary.raw_frames);
     println!("degraded samples {}", summary.degraded);
@@ -47,9 +108,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "last attitude    roll {r:.3} pitch {p:.3} heading {h:.2} (+/- {h_std:.2} deg 1-sigma)"
         );
     }
-    if let Some(out) = &args.csv {
+    if let Some(out) = csv {
         let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
-        replay::write_csv(&rows, BufWriter::new(file))
+        replay::write_csv(rows, BufWriter::new(file))
             .with_context(|| format!("writing {}", out.display()))?;
         println!("csv              {} ({} rows)", out.display(), rows.len());
     }

@@ -1,6 +1,7 @@
 //! Error model of the navigation solution (paper section 2.3, eq. 11-12),
 //! restated for NED with position error in metres, and its AR(4)
-//! augmentation to 33 states (eq. 31-45, corrected: errata 1-3, 6).
+//! augmentation to 33 states (eq. 31-45, corrected: errata 1-3, 6), and
+//! optionally 6 sensor-bias states more (39 states; not in the paper).
 //!
 //! The derivation is in `docs/filter-derivation.md`; this code only
 //! evaluates it. Errors are computed - true; the attitude error phi is the
@@ -8,11 +9,14 @@
 //!
 //! State layout (indices below):
 //! `[phiN phiE phiD | dvN dvE dvD | dpN dpE dpD | accel AR x,y,z (4 each,
-//! oldest first) | rate AR x,y,z (4 each, oldest first)]`.
+//! oldest first) | rate AR x,y,z (4 each, oldest first)]` (33), then for
+//! the 39-state form `[accel bias x,y,z | rate bias x,y,z]`.
 
 mod augmented;
+mod bias;
 
 pub use augmented::{AugmentedModel, AugmentedTransition, Coupling, ProcessNoise};
+pub use bias::{BiasState, SensorBiases};
 
 use crate::earth::{normal_gravity, radii, Position, EARTH_RATE};
 use crate::kalman::FilterScalar;
@@ -34,6 +38,17 @@ pub const ACCEL_AR: usize = NAV_STATES;
 pub const GYRO_AR: usize = ACCEL_AR + 3 * AR_ORDER;
 /// Size of the augmented state: 9 + 12 + 12 = 33 (eq. 43).
 pub const STATES: usize = GYRO_AR + 3 * AR_ORDER;
+/// First accelerometer bias state (body x; 39-state form only).
+pub const ACCEL_BIAS: usize = STATES;
+/// First rate bias state (body x; 39-state form only).
+pub const GYRO_BIAS: usize = ACCEL_BIAS + 3;
+/// Size of the state with the six sensor biases: 33 + 3 + 3 = 39.
+pub const STATES_WITH_BIASES: usize = GYRO_BIAS + 3;
+
+/// Whether a state size is one the augmented model defines (33 or 39).
+pub const fn is_model_size(n: usize) -> bool {
+    n == STATES || n == STATES_WITH_BIASES
+}
 
 /// Index of the newest AR state (the current sensor error) of body axis
 /// `axis` in the block starting at `first`.

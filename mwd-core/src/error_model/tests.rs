@@ -30,6 +30,44 @@ fn indices_make_33_states() {
     assert_eq!(STATES, 33);
     assert_eq!(newest_ar_state(ACCEL_AR, 0), 12);
     assert_eq!(newest_ar_state(GYRO_AR, 2), 32);
+    assert_eq!((ACCEL_BIAS, GYRO_BIAS, STATES_WITH_BIASES), (33, 36, 39));
+}
+
+#[test]
+fn bias_states_are_random_constants_driving_velocity_and_attitude() {
+    let lp = static_point();
+    let model = AugmentedModel::paper();
+    let phi = model.transition::<f64, STATES_WITH_BIASES>(&lp).to_dense();
+    // The 33-state part is the 33-state transition itself.
+    let phi33 = model.transition::<f64, STATES>(&lp).to_dense();
+    assert_eq!(phi.fixed_view::<STATES, STATES>(0, 0).into_owned(), phi33);
+    for axis in 0..3 {
+        for i in 0..3 {
+            let g = lp.c_bn[(i, axis)] * model.dt;
+            assert_eq!(phi[(VEL + i, ACCEL_BIAS + axis)], g);
+            assert_eq!(phi[(ATT + i, GYRO_BIAS + axis)], -g);
+        }
+    }
+    // Bias rows: identity, nothing else.
+    let bias_rows = phi.fixed_view::<6, STATES_WITH_BIASES>(ACCEL_BIAS, 0);
+    assert_eq!(
+        bias_rows.columns(ACCEL_BIAS, 6),
+        nalgebra::SMatrix::<f64, 6, 6>::identity()
+    );
+    assert_eq!(bias_rows.columns(0, ACCEL_BIAS).amax(), 0.0);
+    // Statistics from the budget: 1 mg and 2.1 deg/h residual with the
+    // Gauss-Markov instability root-sum-squared; a small random walk.
+    let p = model.initial_covariance::<f64, STATES_WITH_BIASES>(&[1e-4; NAV_STATES]);
+    let budget = crate::sensor_noise::ImuNoise::scc1300();
+    let a = budget.accel[0];
+    let expected = a.residual_bias.powi(2) + a.bias_instability.powi(2);
+    assert!((p[(ACCEL_BIAS, ACCEL_BIAS)] - expected).abs() < 1e-12 * expected);
+    let q = model.process_noise::<f64, STATES_WITH_BIASES>(&ProcessNoise {
+        nav_per_step: [0.0; NAV_STATES],
+    });
+    let g = budget.gyro[2];
+    let walk = q[GYRO_BIAS + 2];
+    assert!(walk > 0.0 && walk < 2.0 * g.bias_instability.powi(2) * model.dt / 100.0);
 }
 
 #[test]
@@ -84,27 +122,32 @@ fn structured_transition_equals_its_dense_form() {
             coupling,
             ..AugmentedModel::paper()
         };
-        let phi = model.transition::<f64>(&lp);
-        let dense = DenseTransition(phi.to_dense());
-        let mut m = nalgebra::SMatrix::<f64, STATES, STATES>::from_fn(|i, j| {
-            libm::sin((i * 37 + j * 11) as f64)
-        });
-        let mut m2 = m;
-        phi.apply_to_matrix(&mut m);
-        dense.apply_to_matrix(&mut m2);
-        assert!((m - m2).amax() < 1e-14);
-        let mut x = SVector::<f64, STATES>::from_fn(|i, _| libm::cos(i as f64));
-        let mut x2 = x;
-        phi.apply_to_vector(&mut x);
-        dense.apply_to_vector(&mut x2);
-        assert!((x - x2).amax() < 1e-14);
+        fast_equals_dense::<STATES>(&model, &lp);
+        fast_equals_dense::<STATES_WITH_BIASES>(&model, &lp);
     }
+}
+
+fn fast_equals_dense<const N: usize>(model: &AugmentedModel, lp: &LinearizationPoint) {
+    let phi = model.transition::<f64, N>(lp);
+    let dense = DenseTransition(phi.to_dense());
+    let mut m = nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| libm::sin((i * 37 + j * 11) as f64));
+    let mut m2 = m;
+    phi.apply_to_matrix(&mut m);
+    dense.apply_to_matrix(&mut m2);
+    assert!((m - m2).amax() < 1e-14);
+    let mut x = SVector::<f64, N>::from_fn(|i, _| libm::cos(i as f64));
+    let mut x2 = x;
+    phi.apply_to_vector(&mut x);
+    dense.apply_to_vector(&mut x2);
+    assert!((x - x2).amax() < 1e-14);
 }
 
 #[test]
 fn coupling_puts_sensor_errors_into_velocity_and_attitude() {
     let lp = static_point();
-    let phi = AugmentedModel::paper().transition::<f64>(&lp).to_dense();
+    let phi = AugmentedModel::paper()
+        .transition::<f64, STATES>(&lp)
+        .to_dense();
     // A body-x accelerometer error moves the velocity error along C_b^n's
     // first column; a body-x rate error turns phi along minus that column.
     for i in 0..3 {
@@ -119,18 +162,18 @@ fn coupling_puts_sensor_errors_into_velocity_and_attitude() {
         coupling: Coupling::BlockDiagonalAsPublished,
         ..AugmentedModel::paper()
     };
-    let phi = published.transition::<f64>(&lp).to_dense();
+    let phi = published.transition::<f64, STATES>(&lp).to_dense();
     assert!(phi.fixed_view::<9, 24>(0, 9).amax() == 0.0);
 }
 
 #[test]
 fn initial_covariance_holds_the_stationary_ar_blocks() {
     let model = AugmentedModel::paper();
-    let p = model.initial_covariance::<f64>(&[1e-4; NAV_STATES]);
+    let p = model.initial_covariance::<f64, STATES>(&[1e-4; NAV_STATES]);
     let s = model.gyro[2].stationary_state_covariance().unwrap();
     let b = GYRO_AR + 2 * AR_ORDER;
     assert_eq!(p.fixed_view::<4, 4>(b, b).into_owned(), s);
-    let q = model.process_noise::<f64>(&ProcessNoise {
+    let q = model.process_noise::<f64, STATES>(&ProcessNoise {
         nav_per_step: [0.0; NAV_STATES],
     });
     assert_eq!(

@@ -1,6 +1,7 @@
 //! One 20 Hz filter cycle (mechanization, time update, ZUPT and
 //! zero-position updates, feedback) counted in SysTick ticks on QEMU's
-//! mps2-an386 with `-icount shift=0`, fast vs dense, f32 vs f64.
+//! mps2-an386 with `-icount shift=0`, fast vs dense, f32 vs f64, 33 states
+//! and (fast f32) 39 states with the sensor biases.
 //!
 //! Under `-icount shift=0` every instruction advances virtual time by 1 ns;
 //! SysTick runs from the 25 MHz board clock, so it ticks every 40
@@ -16,7 +17,8 @@ use cortex_m_semihosting::{debug, hprintln};
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{earth_rate_n, gravity_n, Position};
 use mwd_core::error_model::{
-    AugmentedModel, EarthTerms, LinearizationPoint, ProcessNoise, POS, STATES, VEL,
+    AugmentedModel, EarthTerms, LinearizationPoint, ProcessNoise, POS, STATES, STATES_WITH_BIASES,
+    VEL,
 };
 use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use mwd_core::kalman::{dense, FilterScalar};
@@ -44,9 +46,9 @@ fn setup() -> (NavState, ImuSample) {
     (state, sample)
 }
 
-fn fast<T: FilterScalar>() -> u32 {
+fn fast<T: FilterScalar, const N: usize>() -> u32 {
     let (state, sample) = setup();
-    let mut fa = FineAlignment::<T>::new(
+    let mut fa = FineAlignment::<T, N>::new(
         state,
         state.position,
         FineAlignmentConfig::paper(AugmentedModel::paper()),
@@ -65,7 +67,7 @@ fn dense_cycle<T: FilterScalar>() -> u32 {
     let mut sd = Strapdown::new(state, model.dt);
     let mut x = SVector::<T, STATES>::zeros();
     let mut p = SMatrix::<T, STATES, STATES>::identity() * T::of(0.01);
-    let q = SMatrix::from_diagonal(&model.process_noise::<T>(&ProcessNoise {
+    let q = SMatrix::from_diagonal(&model.process_noise::<T, STATES>(&ProcessNoise {
         nav_per_step: [1e-6; 9],
     }));
     let mut h = SMatrix::<T, 6, STATES>::zeros();
@@ -87,7 +89,7 @@ fn dense_cycle<T: FilterScalar>() -> u32 {
             position: s.position,
             specific_force_n: c_bn * sample.specific_force,
         };
-        let phi = model.transition_with::<T>(&earth, &lp).to_dense();
+        let phi = model.transition_with::<T, STATES>(&earth, &lp).to_dense();
         dense::predict(&mut x, &mut p, &phi, &q);
         let dp = s.position.ned_from(&state.position);
         let z =
@@ -102,7 +104,7 @@ fn dense_cycle<T: FilterScalar>() -> u32 {
 }
 
 /// The fast cycle's parts, to see where the instructions go.
-fn parts<T: FilterScalar>() -> [(&'static str, u32); 4] {
+fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 4] {
     let (state, sample) = setup();
     let model = AugmentedModel::paper();
     let mut sd = Strapdown::new(state, model.dt);
@@ -122,14 +124,14 @@ fn parts<T: FilterScalar>() -> [(&'static str, u32); 4] {
     let earth = EarthTerms::at(&s.position);
     let start = SYST::get_current();
     for _ in 0..CYCLES {
-        core::hint::black_box(model.transition_with::<T>(&earth, core::hint::black_box(&lp)));
+        core::hint::black_box(model.transition_with::<T, N>(&earth, core::hint::black_box(&lp)));
     }
     let build = ticks(start) / CYCLES;
-    let phi = model.transition::<T>(&lp);
-    let q = model.process_noise::<T>(&ProcessNoise {
+    let phi = model.transition::<T, N>(&lp);
+    let q = model.process_noise::<T, N>(&ProcessNoise {
         nav_per_step: [1e-6; 9],
     });
-    let mut f = mwd_core::kalman::KalmanFilter::<T, STATES>::new(SMatrix::identity() * T::of(0.01));
+    let mut f = mwd_core::kalman::KalmanFilter::<T, N>::new(SMatrix::identity() * T::of(0.01));
     let start = SYST::get_current();
     for _ in 0..CYCLES {
         f.predict(core::hint::black_box(&phi), &q);
@@ -188,8 +190,9 @@ fn main() -> ! {
         per_tick
     );
     let rows = [
-        ("fast  f32", fast::<f32>()),
-        ("fast  f64", fast::<f64>()),
+        ("fast  f32", fast::<f32, STATES>()),
+        ("fast  f32, 39 states", fast::<f32, STATES_WITH_BIASES>()),
+        ("fast  f64", fast::<f64, STATES>()),
         ("dense f32", dense_cycle::<f32>()),
         ("dense f64", dense_cycle::<f64>()),
     ];
@@ -204,9 +207,16 @@ fn main() -> ! {
             instr / 80e6 / 0.05 * 100.0
         );
     }
-    for (name, t) in parts::<f32>() {
+    for (name, t) in parts::<f32, STATES>() {
         hprintln!(
             "  f32 part {}: ~{:.0} instructions",
+            name,
+            t as f32 * per_tick
+        );
+    }
+    for (name, t) in parts::<f32, STATES_WITH_BIASES>() {
+        hprintln!(
+            "  f32 39-state part {}: ~{:.0} instructions",
             name,
             t as f32 * per_tick
         );

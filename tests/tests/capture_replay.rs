@@ -1,0 +1,58 @@
+//! The committed capture of the QEMU probe (`tests/data/qemu-static-6s.bin`,
+//! recorded by `scripts/make-test-capture.sh`) decodes cleanly and replays
+//! through the host's copy of the probe's navigation to the probe's own
+//! navigation frames bit for bit, both through the library and through the
+//! `host-sim replay` summary it backs. No QEMU needed.
+
+use host_sim::capture;
+use host_sim::replay::{self, ReplaySummary};
+use mwd_core::earth::Position;
+use mwd_core::protocol::frame::nav_mode;
+use mwd_core::protocol::{EventKind, Payload};
+use system_tests::workspace_root;
+
+const SAMPLES: u64 = 6 * 20;
+/// Still samples of the coarse alignment (firmware::app::navigation).
+const ALIGNMENT_SAMPLES: u32 = 100;
+
+#[test]
+fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {
+    let path = workspace_root().join("tests/data/qemu-static-6s.bin");
+    let cap = capture::read_capture(&path).expect("the committed capture");
+    let stats = cap.stats;
+    assert_eq!(stats.frames, [SAMPLES, SAMPLES, 1], "{stats:?}");
+    assert_eq!(
+        (stats.corrupt(), stats.lost, stats.garbage_bytes),
+        (0, 0, 0),
+        "{stats:?}"
+    );
+    assert!(matches!(
+        cap.frames.first().map(|f| f.payload),
+        Some(Payload::Event(e)) if e.kind == EventKind::Boot
+    ));
+
+    let (rows, summary) = replay::replay(&cap.frames, Position::paper_site());
+    assert_eq!(
+        summary,
+        ReplaySummary {
+            raw_frames: SAMPLES,
+            probe_solutions: SAMPLES,
+            matched: SAMPLES,
+            mismatched: 0,
+            degraded: 0,
+        },
+        "the replay no longer reproduces the recorded probe: if the navigation \
+         changed on purpose, record the capture again (scripts/make-test-capture.sh)"
+    );
+    // The run covers the coarse alignment and the start of navigation.
+    for row in &rows {
+        let n = row.solution.sample_counter;
+        let expected = if n < ALIGNMENT_SAMPLES - 1 {
+            nav_mode::COARSE_ALIGNMENT
+        } else {
+            nav_mode::NAVIGATING
+        };
+        assert_eq!(row.solution.mode, expected, "sample {n}");
+        assert_eq!(row.matches_probe, Some(true), "sample {n}");
+    }
+}
