@@ -55,10 +55,17 @@ impl Position {
 
     /// This position moved by a small north-east-down offset in metres.
     pub fn displaced(&self, ned: &Vector3<f64>) -> Self {
-        let r = radii(self.lat);
+        self.displaced_with_trig(ned, &LatitudeTrig::new(self.lat))
+    }
+
+    /// [`displaced`](Self::displaced) with the sine and cosine of this
+    /// position's latitude already at hand (one square root, no
+    /// trigonometry).
+    pub fn displaced_with_trig(&self, ned: &Vector3<f64>, trig: &LatitudeTrig) -> Self {
+        let r = radii_from_trig(trig);
         Self {
             lat: self.lat + ned.x / (r.meridian + self.height),
-            lon: self.lon + ned.y / ((r.transverse + self.height) * libm::cos(self.lat)),
+            lon: self.lon + ned.y / ((r.transverse + self.height) * trig.cos),
             height: self.height - ned.z,
         }
     }
@@ -75,6 +82,23 @@ impl Position {
     }
 }
 
+/// Sine and cosine of a geodetic latitude. The latitude-dependent terms
+/// below (radii, normal gravity, earth and transport rate) all derive from
+/// them: a caller that needs several terms at one latitude computes this
+/// once (one `libm::sincos`) and passes it to the `*_from_trig` functions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LatitudeTrig {
+    pub sin: f64,
+    pub cos: f64,
+}
+
+impl LatitudeTrig {
+    pub fn new(lat: f64) -> Self {
+        let (sin, cos) = libm::sincos(lat);
+        Self { sin, cos }
+    }
+}
+
 /// Principal radii of curvature of the ellipsoid at a latitude.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Radii {
@@ -85,7 +109,15 @@ pub struct Radii {
 }
 
 pub fn radii(lat: f64) -> Radii {
-    let s = libm::sin(lat);
+    radii_from_sin(libm::sin(lat))
+}
+
+/// [`radii`] from the sine and cosine of the latitude.
+pub fn radii_from_trig(trig: &LatitudeTrig) -> Radii {
+    radii_from_sin(trig.sin)
+}
+
+fn radii_from_sin(s: f64) -> Radii {
     let w2 = 1.0 - ECCENTRICITY_SQUARED * s * s;
     let w = libm::sqrt(w2);
     Radii {
@@ -98,7 +130,16 @@ pub fn radii(lat: f64) -> Radii {
 /// closed formula on the ellipsoid (TR8350.2 eq. 4-1) with the second-order
 /// height correction (eq. 4-3).
 pub fn normal_gravity(lat: f64, height: f64) -> f64 {
-    let s2 = libm::sin(lat) * libm::sin(lat);
+    normal_gravity_from_sin(libm::sin(lat), height)
+}
+
+/// [`normal_gravity`] from the sine and cosine of the latitude.
+pub fn normal_gravity_from_trig(trig: &LatitudeTrig, height: f64) -> f64 {
+    normal_gravity_from_sin(trig.sin, height)
+}
+
+fn normal_gravity_from_sin(s: f64, height: f64) -> f64 {
+    let s2 = s * s;
     let on_ellipsoid =
         GRAVITY_EQUATOR * (1.0 + SOMIGLIANA_K * s2) / libm::sqrt(1.0 - ECCENTRICITY_SQUARED * s2);
     let a = SEMI_MAJOR_AXIS;
@@ -113,25 +154,43 @@ pub fn gravity_n(pos: &Position) -> Vector3<f64> {
     Vector3::new(0.0, 0.0, normal_gravity(pos.lat, pos.height))
 }
 
+/// [`gravity_n`] from the sine and cosine of the position's latitude.
+pub fn gravity_n_from_trig(trig: &LatitudeTrig, height: f64) -> Vector3<f64> {
+    Vector3::new(0.0, 0.0, normal_gravity_from_trig(trig, height))
+}
+
 /// Earth rate in NED, omega_ie^n = Omega (cos L, 0, -sin L).
 pub fn earth_rate_n(lat: f64) -> Vector3<f64> {
-    Vector3::new(
-        EARTH_RATE * libm::cos(lat),
-        0.0,
-        -EARTH_RATE * libm::sin(lat),
-    )
+    earth_rate_n_from_trig(&LatitudeTrig::new(lat))
+}
+
+/// [`earth_rate_n`] from the sine and cosine of the latitude.
+pub fn earth_rate_n_from_trig(trig: &LatitudeTrig) -> Vector3<f64> {
+    Vector3::new(EARTH_RATE * trig.cos, 0.0, -EARTH_RATE * trig.sin)
 }
 
 /// Transport rate omega_en^n: the turning of the NED frame as the probe moves
 /// over the curved earth.
 pub fn transport_rate_n(pos: &Position, vel_n: &Vector3<f64>) -> Vector3<f64> {
-    let r = radii(pos.lat);
-    let rn = r.transverse + pos.height;
-    let rm = r.meridian + pos.height;
+    let trig = LatitudeTrig::new(pos.lat);
+    transport_rate_n_from_trig(&trig, &radii_from_trig(&trig), pos.height, vel_n)
+}
+
+/// [`transport_rate_n`] from the sine and cosine of the latitude and the
+/// radii there (tan L = sin L / cos L).
+pub fn transport_rate_n_from_trig(
+    trig: &LatitudeTrig,
+    radii: &Radii,
+    height: f64,
+    vel_n: &Vector3<f64>,
+) -> Vector3<f64> {
+    let rn = radii.transverse + height;
+    let rm = radii.meridian + height;
+    let east_over_rn = vel_n.y / rn;
     Vector3::new(
-        vel_n.y / rn,
+        east_over_rn,
         -vel_n.x / rm,
-        -vel_n.y * libm::tan(pos.lat) / rn,
+        -east_over_rn * (trig.sin / trig.cos),
     )
 }
 
@@ -176,6 +235,29 @@ mod tests {
         let w = transport_rate_n(&pos, &Vector3::new(10.0, 0.0, 0.0));
         assert!(w.y < 0.0 && w.x == 0.0 && w.z == 0.0);
         assert!((w.y + 10.0 / (radii(pos.lat).meridian + pos.height)).abs() < 1e-18);
+    }
+
+    #[test]
+    fn terms_from_precomputed_trig_match_the_latitude_forms() {
+        let vel = Vector3::new(3.0, -2.0, 0.5);
+        for lat in [-1.3, -0.4, 0.0, 0.798_968, 1.5] {
+            let trig = LatitudeTrig::new(lat);
+            assert_eq!((trig.sin, trig.cos), (libm::sin(lat), libm::cos(lat)));
+            assert_eq!(radii_from_trig(&trig), radii(lat));
+            assert_eq!(
+                normal_gravity_from_trig(&trig, 123.0),
+                normal_gravity(lat, 123.0)
+            );
+            let pos = Position::new(lat, 0.3, 123.0);
+            assert_eq!(gravity_n_from_trig(&trig, 123.0), gravity_n(&pos));
+            assert_eq!(earth_rate_n_from_trig(&trig), earth_rate_n(lat));
+            let w = transport_rate_n_from_trig(&trig, &radii(lat), 123.0, &vel);
+            assert_eq!(w, transport_rate_n(&pos, &vel));
+            // tan L as sin L / cos L: libm's tangent to rounding.
+            let r = radii(lat);
+            let with_tan = -vel.y * libm::tan(lat) / (r.transverse + 123.0);
+            assert!((w.z - with_tan).abs() <= 1e-15 * with_tan.abs().max(1e-300));
+        }
     }
 
     #[test]

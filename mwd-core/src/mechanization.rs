@@ -12,9 +12,11 @@
 use crate::attitude::{
     coning_rotation_vector, quat_from_rotation_vector, ToolAxisRate, ToolAxisRateEstimator,
 };
-use crate::conventions::skew;
-use crate::earth::{earth_rate_n, gravity_n, radii, transport_rate_n, Position};
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use crate::earth::{
+    earth_rate_n_from_trig, gravity_n_from_trig, radii_from_trig, transport_rate_n_from_trig,
+    LatitudeTrig, Position,
+};
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// One sample of the probe's inertial sensors in the body frame, averaged
 /// over the sample interval.
@@ -55,6 +57,9 @@ pub struct Strapdown {
     state: NavState,
     dt: f64,
     previous: Option<(Vector3<f64>, Vector3<f64>)>,
+    /// Sine and cosine of the latitude the last step ended at, and that
+    /// latitude: they spare `apply_correction` its trigonometry.
+    latitude_trig: Option<(f64, LatitudeTrig)>,
 }
 
 impl Strapdown {
@@ -64,6 +69,7 @@ impl Strapdown {
             state,
             dt,
             previous: None,
+            latitude_trig: None,
         }
     }
 
@@ -80,9 +86,17 @@ impl Strapdown {
     pub fn reset(&mut self, state: NavState) {
         self.state = state;
         self.previous = None;
+        self.latitude_trig = None;
     }
 
     /// Advances the solution by one sample interval.
+    ///
+    /// The latitude's sine and cosine are computed once (`libm::sincos`)
+    /// and give the earth rate, the transport rate, gravity and the radii;
+    /// the cosine at the interval's mid-latitude and the sine and cosine at
+    /// the new latitude (kept for [`apply_correction`](Self::apply_correction))
+    /// follow from them by the angle-sum formulas with series in the
+    /// latitude increment, exact to f64 rounding.
     pub fn step(&mut self, sample: &ImuSample) {
         let dt = self.dt;
         let s = &mut self.state;
@@ -93,40 +107,50 @@ impl Strapdown {
         let (prev_dtheta, prev_dv) = self.previous.unwrap_or((dtheta, dv));
         self.previous = Some((dtheta, dv));
 
-        let omega_ie = earth_rate_n(s.position.lat);
-        let omega_en = transport_rate_n(&s.position, &s.velocity);
+        let pos = s.position;
+        let trig = LatitudeTrig::new(pos.lat);
+        let r = radii_from_trig(&trig);
+        let omega_ie = earth_rate_n_from_trig(&trig);
+        let omega_en = transport_rate_n_from_trig(&trig, &r, pos.height, &s.velocity);
         let zeta = (omega_ie + omega_en) * dt; // eq. 5, rates held over the interval
-        let c_bn = s.attitude.to_rotation_matrix().into_inner();
+
+        // Velocity: the specific-force increment with the rotation and
+        // two-sample sculling corrections, resolved at the start of the
+        // interval and rotated by half the frame's turn,
+        // (I - 0.5 [zeta x]) C_b^n dv_body.
+        let dv_body =
+            dv + dtheta.cross(&dv) * 0.5 + (prev_dtheta.cross(&dv) + prev_dv.cross(&dtheta)) / 12.0;
+        let dv_start = s.attitude.transform_vector(&dv_body);
+        let dv_nav = dv_start - zeta.cross(&dv_start) * 0.5;
+        let coriolis = (omega_ie * 2.0 + omega_en).cross(&s.velocity);
+        let velocity =
+            s.velocity + dv_nav + (gravity_n_from_trig(&trig, pos.height) - coriolis) * dt;
 
         // Attitude, eq. 3-7.
         let body_rotation =
             quat_from_rotation_vector(&coning_rotation_vector(&prev_dtheta, &dtheta));
         let nav_rotation = quat_from_rotation_vector(&-zeta);
-        let mut attitude = nav_rotation * s.attitude * body_rotation;
-        attitude.renormalize();
+        let attitude = renormalized(nav_rotation * s.attitude * body_rotation);
 
-        // Velocity: the specific-force increment with the rotation and
-        // two-sample sculling corrections, resolved at the start of the
-        // interval and rotated by half the frame's turn.
-        let dv_body =
-            dv + dtheta.cross(&dv) * 0.5 + (prev_dtheta.cross(&dv) + prev_dv.cross(&dtheta)) / 12.0;
-        let dv_nav = (Matrix3::identity() - skew(&zeta) * 0.5) * c_bn * dv_body;
-        let coriolis = (omega_ie * 2.0 + omega_en).cross(&s.velocity);
-        let velocity = s.velocity + dv_nav + (gravity_n(&s.position) - coriolis) * dt;
-
-        // Position by the trapezoidal rule in f64.
+        // Position by the trapezoidal rule in f64, the longitude with the
+        // cosine of the mid-latitude.
         let mean_v = (s.velocity + velocity) * 0.5;
-        let r = radii(s.position.lat);
-        let lat = s.position.lat + mean_v.x / (r.meridian + s.position.height) * dt;
-        let cos_lat = libm::cos(0.5 * (lat + s.position.lat));
-        let lon = s.position.lon + mean_v.y / ((r.transverse + s.position.height) * cos_lat) * dt;
-        let height = s.position.height - mean_v.z * dt;
+        let lat = pos.lat + mean_v.x / (r.meridian + pos.height) * dt;
+        let half_step = 0.5 * (lat - pos.lat);
+        let cos_mid = match shifted_trig(&trig, half_step) {
+            Some(t) => t.cos,
+            None => libm::cos(pos.lat + half_step),
+        };
+        let lon = pos.lon + mean_v.y / ((r.transverse + pos.height) * cos_mid) * dt;
+        let height = pos.height - mean_v.z * dt;
 
         *s = NavState {
             attitude,
             velocity,
             position: Position::new(lat, lon, height),
         };
+        // For the feedback that usually follows (`apply_correction`).
+        self.latitude_trig = shifted_trig(&trig, lat - pos.lat).map(|t| (lat, t));
     }
 
     /// Closed-loop feedback of estimated errors (error = computed - true):
@@ -139,11 +163,57 @@ impl Strapdown {
         position_error_ned_m: &Vector3<f64>,
     ) {
         let s = &mut self.state;
-        s.attitude = quat_from_rotation_vector(attitude_error_n) * s.attitude;
-        s.attitude.renormalize();
+        s.attitude = renormalized(quat_from_rotation_vector(attitude_error_n) * s.attitude);
         s.velocity -= velocity_error_n;
-        s.position = s.position.displaced(&-position_error_ned_m);
+        // The sine and cosine of the latitude from the last step, if the
+        // latitude has not been changed since.
+        let trig = match self.latitude_trig {
+            Some((lat, trig)) if lat == s.position.lat => trig,
+            _ => LatitudeTrig::new(s.position.lat),
+        };
+        s.position = s
+            .position
+            .displaced_with_trig(&-position_error_ned_m, &trig);
+        self.latitude_trig = None;
     }
+}
+
+/// Largest latitude shift (rad) that [`shifted_trig`] takes by series:
+/// 6 m of latitude, 120 m/s over a 50 ms step.
+const SERIES_SHIFT: f64 = 1e-6;
+
+/// Sine and cosine of `lat + d` from those of `lat`, by the angle-sum
+/// formulas with cos d = 1 - d^2/2 and sin d = d - d^3/6. For |d| <=
+/// [`SERIES_SHIFT`] the truncation is below d^4/24 = 4.2e-26 absolute,
+/// under half an ulp of the cosine anywhere but within 1e-9 rad of a pole:
+/// the result is libm's to rounding. `None` for a larger (or non-finite)
+/// shift.
+fn shifted_trig(trig: &LatitudeTrig, d: f64) -> Option<LatitudeTrig> {
+    if d.abs() > SERIES_SHIFT || d.is_nan() {
+        return None;
+    }
+    let d2 = d * d;
+    let cos_d = 1.0 - 0.5 * d2;
+    let sin_d = d - d * d2 * (1.0 / 6.0);
+    Some(LatitudeTrig {
+        sin: trig.sin * cos_d + trig.cos * sin_d,
+        cos: trig.cos * cos_d - trig.sin * sin_d,
+    })
+}
+
+/// `q / |q|` for a quaternion that is a product of unit quaternions, so
+/// |q|^2 = 1 + e with e at rounding level: 1/|q| = 1 - e/2 + 3 e^2/8 with a
+/// truncation below 5 |e|^3 / 16 (3e-19 for |e| <= 1e-6, under f64's
+/// resolution). Larger departures take the square root.
+fn renormalized(q: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
+    let q = q.into_inner();
+    let e = q.norm_squared() - 1.0;
+    let scale = if e.abs() <= 1e-6 {
+        1.0 - e * (0.5 - 0.375 * e)
+    } else {
+        1.0 / libm::sqrt(1.0 + e)
+    };
+    UnitQuaternion::new_unchecked(q * scale)
 }
 
 /// Builds the mechanization's input from the probe's sensors: the x and z
@@ -172,8 +242,15 @@ impl ProbeInput {
         specific_force: &Vector3<f64>,
         dt: f64,
     ) -> (ImuSample, ToolAxisRate) {
-        let omega_in_n =
-            earth_rate_n(state.position.lat) + transport_rate_n(&state.position, &state.velocity);
+        let pos = &state.position;
+        let trig = LatitudeTrig::new(pos.lat);
+        let omega_in_n = earth_rate_n_from_trig(&trig)
+            + transport_rate_n_from_trig(
+                &trig,
+                &radii_from_trig(&trig),
+                pos.height,
+                &state.velocity,
+            );
         let omega_in_b = state.attitude.inverse_transform_vector(&omega_in_n);
         let derived = self
             .tool_axis
@@ -194,6 +271,8 @@ impl ProbeInput {
 mod tests {
     use super::*;
     use crate::conventions::{dcm_from_quat, quat_from_euler, Euler};
+    use crate::earth::{earth_rate_n, gravity_n, transport_rate_n};
+    use nalgebra::Matrix3;
     use proptest::prelude::*;
 
     /// The exact outputs of a perfect probe at rest.
@@ -231,6 +310,80 @@ mod tests {
                 - Matrix3::identity()).abs().max();
             prop_assert!(turn < 1e-9);
         }
+    }
+
+    #[test]
+    fn small_angle_quaternion_series_are_libm_to_rounding() {
+        // Below SMALL_ANGLE (1e-4 rad) the series' truncation is < 2.2e-29
+        // (scalar part) and < 5.2e-20 relative (vector part): what is left
+        // is the rounding of a few operations.
+        for (i, angle) in [1e-12, 3e-9, 4.4e-6, 1e-5, 3.3e-5, 7.7e-5, 9.99e-5]
+            .into_iter()
+            .enumerate()
+        {
+            let axis = Vector3::new(0.3, -0.5 + 0.1 * i as f64, 0.8).normalize();
+            let v = axis * angle;
+            let q = quat_from_rotation_vector(&v);
+            let half = 0.5 * v.norm();
+            assert!((q.w - libm::cos(half)).abs() <= 2.3e-16, "{angle}: {}", q.w);
+            let k = libm::sin(half) / v.norm();
+            for j in 0..3 {
+                let (got, want) = (q.imag()[j], k * v[j]);
+                assert!((got - want).abs() <= 4.5e-16 * want.abs(), "{angle} {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn shifted_latitude_trig_is_libm_to_rounding() {
+        for lat in [-1.4, -0.8, 0.0, 0.3, 0.798_968, 1.2, 1.55] {
+            let trig = LatitudeTrig::new(lat);
+            for d in [-1e-6, -3.1e-7, -2e-9, 0.0, 5e-12, 8.8e-9, 4.4e-7, 1e-6] {
+                let shifted = shifted_trig(&trig, d).unwrap();
+                let exact = LatitudeTrig::new(lat + d);
+                // lat + d itself is rounded: half an ulp of lat.
+                let tol = 4.5e-16;
+                assert!((shifted.sin - exact.sin).abs() <= tol, "{lat} {d}");
+                assert!((shifted.cos - exact.cos).abs() <= tol, "{lat} {d}");
+            }
+        }
+        assert!(shifted_trig(&LatitudeTrig::new(0.5), 1.1e-6).is_none());
+        assert!(shifted_trig(&LatitudeTrig::new(0.5), f64::NAN).is_none());
+    }
+
+    #[test]
+    fn renormalization_is_the_division_by_the_norm_to_rounding() {
+        let a = quat_from_euler(&Euler::new(0.3, -1.2, 2.9));
+        let b = quat_from_rotation_vector(&Vector3::new(1e-5, -3e-6, 2e-5));
+        let q = a * b * a * b;
+        let fast = renormalized(q);
+        let exact = q.into_inner().normalize();
+        assert!((fast.into_inner() - exact).coords.amax() <= 2.3e-16);
+        assert!((fast.norm() - 1.0).abs() <= 2.3e-16);
+        // Far from unit: the square root.
+        let far = UnitQuaternion::new_unchecked(q.into_inner() * 1.5);
+        assert!((renormalized(far).into_inner() - exact).coords.amax() <= 2.3e-16);
+    }
+
+    #[test]
+    fn correction_after_a_step_uses_the_step_latitude_terms() {
+        // With and without the latitude terms kept from the step, the
+        // corrected position is the same to rounding.
+        let start = NavState::at_rest(
+            quat_from_euler(&Euler::new(0.1, -0.2, 2.0)),
+            Position::paper_site(),
+        );
+        let mut moving = start;
+        moving.velocity = Vector3::new(3.0, -2.0, 0.5);
+        let mut nav = Strapdown::new(moving, 0.05);
+        nav.step(&ideal_static_sample(&start));
+        let mut fresh = Strapdown::new(*nav.state(), 0.05);
+        let dp = Vector3::new(0.02, -0.03, 0.01);
+        nav.apply_correction(&Vector3::zeros(), &Vector3::zeros(), &dp);
+        fresh.apply_correction(&Vector3::zeros(), &Vector3::zeros(), &dp);
+        let (a, b) = (nav.state().position, fresh.state().position);
+        assert!((a.lat - b.lat).abs() <= 2.3e-16 && (a.lon - b.lon).abs() <= 4.5e-16);
+        assert_eq!(a.height, b.height);
     }
 
     #[test]

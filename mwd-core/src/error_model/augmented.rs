@@ -18,7 +18,7 @@
 
 use super::{
     is_model_size, navigation_error_dynamics_with, EarthTerms, LinearizationPoint, SensorBiases,
-    ACCEL_AR, ACCEL_BIAS, AR_ORDER, ATT, GYRO_AR, GYRO_BIAS, NAV_STATES, STATES,
+    ACCEL_AR, ACCEL_BIAS, AR_ORDER, ATT, GYRO_AR, GYRO_BIAS, NAV_STATES, POS, STATES,
     STATES_WITH_BIASES, VEL,
 };
 use crate::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
@@ -53,7 +53,7 @@ impl ProcessNoise {
         for i in 0..3 {
             nav_per_step[ATT + i] = attitude * dt;
             nav_per_step[VEL + i] = velocity * dt;
-            nav_per_step[super::POS + i] = position * dt;
+            nav_per_step[POS + i] = position * dt;
         }
         Self { nav_per_step }
     }
@@ -159,8 +159,21 @@ impl AugmentedModel {
         &self,
         nav_diag: &[f64; NAV_STATES],
     ) -> SMatrix<T, N, N> {
-        const { assert!(is_model_size(N), "the augmented model has 33 or 39 states") };
         let mut p = SMatrix::<T, N, N>::zeros();
+        self.write_initial_covariance(nav_diag, &mut p);
+        p
+    }
+
+    /// The same written into `p` (overwritten whole): on the probe a 39 x
+    /// 39 matrix is 6 KiB of stack per temporary copy, so the filter is
+    /// (re)initialised in place.
+    pub fn write_initial_covariance<T: FilterScalar, const N: usize>(
+        &self,
+        nav_diag: &[f64; NAV_STATES],
+        p: &mut SMatrix<T, N, N>,
+    ) {
+        const { assert!(is_model_size(N), "the augmented model has 33 or 39 states") };
+        p.fill(T::zero());
         for (i, v) in nav_diag.iter().enumerate() {
             p[(i, i)] = T::of(*v);
         }
@@ -184,7 +197,6 @@ impl AugmentedModel {
                 p[(GYRO_BIAS + axis, GYRO_BIAS + axis)] = T::of(g.initial_sigma * g.initial_sigma);
             }
         }
-        p
     }
 }
 
@@ -247,65 +259,342 @@ impl<T: FilterScalar, const N: usize> AugmentedTransition<T, N> {
         phi
     }
 
-    /// Shifts one AR block of rows of `m` by its companion matrix.
-    fn shift_ar_rows<const C: usize>(
-        m: &mut SMatrix<T, N, C>,
-        first: usize,
-        last_row: &[T; AR_ORDER],
-    ) {
-        for col in 0..C {
-            let mut newest = T::zero();
-            for (j, a) in last_row.iter().enumerate() {
-                newest += *a * m[(first + j, col)];
-            }
-            for j in 0..AR_ORDER - 1 {
-                m[(first + j, col)] = m[(first + j + 1, col)];
-            }
-            m[(first + AR_ORDER - 1, col)] = newest;
-        }
+    /// Whether every entry of `nav` outside [`NAV_NONZERO`] is zero, as in
+    /// every transition the model builds. A hand-made `nav` without that
+    /// structure gets the dense 9 x 9 product instead.
+    fn nav_is_structured(&self) -> bool {
+        (0..NAV_STATES)
+            .all(|i| (0..NAV_STATES).all(|j| NAV_NONZERO[i][j] || self.nav[(i, j)] == T::zero()))
     }
 
-    /// `m <- Phi m` for any number of columns, touching only the non-zero
-    /// blocks: ~9*9*C + 2*9*C + 6*4*C multiplies (+ 2*9*C with the biases)
-    /// instead of N*N*C. The bias rows are identity rows: left as they are.
-    fn apply<const C: usize>(&self, m: &mut SMatrix<T, N, C>) {
+    /// Row `i` of `nav` times the navigation part of column `x`, over the
+    /// entries that can be non-zero (all of them unless `STRUCTURED`), in
+    /// column order: the dense product's sum without its zero terms.
+    #[inline(always)]
+    fn nav_row<const STRUCTURED: bool>(&self, i: usize, x: &[T; N]) -> T {
+        let mut acc = T::zero();
+        for j in 0..NAV_STATES {
+            if !STRUCTURED || NAV_NONZERO[i][j] {
+                acc += self.nav[(i, j)] * x[j];
+            }
+        }
+        acc
+    }
+
+    /// Shifts the AR block of rows starting at `first` of one column by its
+    /// companion matrix.
+    #[inline(always)]
+    fn shift_ar_block(x: &mut [T; N], first: usize, last_row: &[T; AR_ORDER]) {
+        let mut newest = T::zero();
+        for (j, a) in last_row.iter().enumerate() {
+            newest += *a * x[first + j];
+        }
+        for j in 0..AR_ORDER - 1 {
+            x[first + j] = x[first + j + 1];
+        }
+        x[first + AR_ORDER - 1] = newest;
+    }
+
+    /// `x <- Phi x` for one column `x` (length `N`).
+    #[inline(always)]
+    fn apply_column<const STRUCTURED: bool>(&self, x: &mut [T; N]) {
         // Navigation rows first: they need the AR rows before their shift.
-        // (F is dense in motion, and nearly so at rest through the sample's
-        // specific force: a dense 9 x 9 product beats skipping zeros.)
-        let mut nav_rows: SMatrix<T, 9, C> = self.nav * m.fixed_rows::<9>(0);
+        let mut nav = [T::zero(); NAV_STATES];
+        for (i, v) in nav.iter_mut().enumerate() {
+            *v = self.nav_row::<STRUCTURED>(i, x);
+        }
         if self.coupled {
             for axis in 0..3 {
-                let fa = super::newest_ar_state(ACCEL_AR, axis);
-                let wa = super::newest_ar_state(GYRO_AR, axis);
+                let fa = x[super::newest_ar_state(ACCEL_AR, axis)];
+                let wa = x[super::newest_ar_state(GYRO_AR, axis)];
+                let (ba, bw) = if Self::HAS_BIASES {
+                    (x[ACCEL_BIAS + axis], x[GYRO_BIAS + axis])
+                } else {
+                    (T::zero(), T::zero())
+                };
                 for i in 0..3 {
                     let g = self.c_bn_dt[(i, axis)];
-                    for col in 0..C {
-                        nav_rows[(VEL + i, col)] += g * m[(fa, col)];
-                        nav_rows[(ATT + i, col)] -= g * m[(wa, col)];
-                    }
+                    nav[VEL + i] += g * fa;
+                    nav[ATT + i] -= g * wa;
                     if Self::HAS_BIASES {
-                        let (ba, bw) = (ACCEL_BIAS + axis, GYRO_BIAS + axis);
-                        for col in 0..C {
-                            nav_rows[(VEL + i, col)] += g * m[(ba, col)];
-                            nav_rows[(ATT + i, col)] -= g * m[(bw, col)];
-                        }
+                        nav[VEL + i] += g * ba;
+                        nav[ATT + i] -= g * bw;
                     }
                 }
             }
         }
+        // The bias rows are identity rows: left as they are.
         for axis in 0..3 {
-            Self::shift_ar_rows(m, ACCEL_AR + axis * AR_ORDER, &self.accel_last_rows[axis]);
-            Self::shift_ar_rows(m, GYRO_AR + axis * AR_ORDER, &self.gyro_last_rows[axis]);
+            Self::shift_ar_block(x, ACCEL_AR + axis * AR_ORDER, &self.accel_last_rows[axis]);
+            Self::shift_ar_block(x, GYRO_AR + axis * AR_ORDER, &self.gyro_last_rows[axis]);
         }
-        m.fixed_rows_mut::<9>(0).copy_from(&nav_rows);
+        x[..NAV_STATES].copy_from_slice(&nav);
+    }
+
+    /// `m <- Phi m` for any number of columns, column by column, touching
+    /// only the non-zero blocks and, in the navigation block, only the
+    /// entries that can be non-zero: 47 of the 9 x 9 ([`NAV_NONZERO`]),
+    /// 2*9 coupling (+ 2*9 with the biases) and 6*4 AR multiplies per
+    /// column instead of N.
+    fn apply<const C: usize>(&self, m: &mut SMatrix<T, N, C>) {
+        if self.nav_is_structured() {
+            for x in m.data.0.iter_mut() {
+                self.apply_column::<true>(x);
+            }
+        } else {
+            for x in m.data.0.iter_mut() {
+                self.apply_column::<false>(x);
+            }
+        }
+    }
+
+    /// `m <- Phi m` where only the lower triangle (row >= column) of the
+    /// result is wanted. Column `c >= 9` of it has no navigation rows there:
+    /// only the AR blocks reaching row `c` are shifted (the bias rows are
+    /// identity rows), and only rows from the block's first one down are
+    /// read. The upper triangle is left partly stale.
+    fn apply_lower(&self, m: &mut SMatrix<T, N, N>, structured: bool) {
+        for (c, x) in m.data.0.iter_mut().enumerate() {
+            if c < NAV_STATES {
+                if structured {
+                    self.apply_column::<true>(x);
+                } else {
+                    self.apply_column::<false>(x);
+                }
+                continue;
+            }
+            for axis in 0..3 {
+                let first = ACCEL_AR + axis * AR_ORDER;
+                if first + AR_ORDER > c {
+                    Self::shift_ar_block(x, first, &self.accel_last_rows[axis]);
+                }
+                let first = GYRO_AR + axis * AR_ORDER;
+                if first + AR_ORDER > c {
+                    Self::shift_ar_block(x, first, &self.gyro_last_rows[axis]);
+                }
+            }
+        }
+    }
+
+    /// `m <- m Phi^T` by column operations (column `i` of the result
+    /// combines the columns of `m` with row `i` of Phi), for a structured
+    /// `nav`; the AR columns only from the first row of their block down,
+    /// the part [`apply_lower`](Self::apply_lower) reads afterwards (the
+    /// rows above are left stale). Phi (P Phi^T) needs no transpose of P.
+    fn right_transposed_for_lower<const COUPLED: bool>(&self, m: &mut SMatrix<T, N, N>) {
+        let cols = &mut m.data.0;
+        // The navigation columns read the old columns: formed aside first.
+        let mut nav = [[T::zero(); N]; NAV_STATES];
+        self.nav_column::<0, COUPLED>(cols, &mut nav[0]);
+        self.nav_column::<1, COUPLED>(cols, &mut nav[1]);
+        self.nav_column::<2, COUPLED>(cols, &mut nav[2]);
+        self.nav_column::<3, COUPLED>(cols, &mut nav[3]);
+        self.nav_column::<4, COUPLED>(cols, &mut nav[4]);
+        self.nav_column::<5, COUPLED>(cols, &mut nav[5]);
+        self.nav_column::<6, COUPLED>(cols, &mut nav[6]);
+        self.nav_column::<7, COUPLED>(cols, &mut nav[7]);
+        self.nav_column::<8, COUPLED>(cols, &mut nav[8]);
+        for axis in 0..3 {
+            let first = ACCEL_AR + axis * AR_ORDER;
+            Self::shift_ar_columns(cols, first, &self.accel_last_rows[axis]);
+            let first = GYRO_AR + axis * AR_ORDER;
+            Self::shift_ar_columns(cols, first, &self.gyro_last_rows[axis]);
+        }
+        // The bias columns (identity rows of Phi) stay as they are.
+        cols[..NAV_STATES].copy_from_slice(&nav);
+    }
+
+    /// Column `I` of `m Phi^T`: row `I` of the structured `nav` and of the
+    /// coupling (+C_b^n dt on the accelerometer AR and bias columns for the
+    /// velocity rows, -C_b^n dt on the rate ones for the attitude rows).
+    #[inline(always)]
+    fn nav_column<const I: usize, const COUPLED: bool>(
+        &self,
+        cols: &[[T; N]; N],
+        out: &mut [T; N],
+    ) {
+        let coef: [T; NAV_STATES] = core::array::from_fn(|j| self.nav[(I, j)]);
+        let couples = COUPLED && I < POS;
+        let (ar, bias, sign) = if I >= VEL {
+            (ACCEL_AR, ACCEL_BIAS, T::one())
+        } else {
+            (GYRO_AR, GYRO_BIAS, -T::one())
+        };
+        let row = I % 3;
+        let g: [T; 3] = core::array::from_fn(|axis| sign * self.c_bn_dt[(row, axis)]);
+        for (e, o) in out.iter_mut().enumerate() {
+            let mut acc = T::zero();
+            for (j, c) in coef.iter().enumerate() {
+                if NAV_NONZERO[I][j] {
+                    acc += *c * cols[j][e];
+                }
+            }
+            if couples {
+                for (axis, ga) in g.iter().enumerate() {
+                    acc += *ga * cols[super::newest_ar_state(ar, axis)][e];
+                    if Self::HAS_BIASES {
+                        acc += *ga * cols[bias + axis][e];
+                    }
+                }
+            }
+            *o = acc;
+        }
+    }
+
+    /// The AR block of columns starting at `first` of `m Phi^T`: the
+    /// columns shift by one and the newest is the companion's last row
+    /// applied to the old ones; rows from `first` down only.
+    #[inline(always)]
+    fn shift_ar_columns(cols: &mut [[T; N]; N], first: usize, last_row: &[T; AR_ORDER]) {
+        if let [c0, c1, c2, c3] = &mut cols[first..first + AR_ORDER] {
+            let [a0, a1, a2, a3] = *last_row;
+            for e in first..N {
+                let newest = a0 * c0[e] + a1 * c1[e] + a2 * c2[e] + a3 * c3[e];
+                c0[e] = c1[e];
+                c1[e] = c2[e];
+                c2[e] = c3[e];
+                c3[e] = newest;
+            }
+        }
+    }
+
+    /// `p <- Phi p Phi^T`, lower triangle (see [`Transition::propagate_lower`]).
+    fn propagate_lower(&self, p: &mut SMatrix<T, N, N>) {
+        if !self.nav_is_structured() {
+            self.apply(p);
+            p.transpose_mut();
+            self.apply_lower(p, false);
+        } else {
+            if self.coupled {
+                self.right_transposed_for_lower::<true>(p);
+            } else {
+                self.right_transposed_for_lower::<false>(p);
+            }
+            self.apply_lower(p, true);
+        }
     }
 }
+
+/// Where I + F dt can be non-zero (`navigation_error_dynamics_with`,
+/// derivation section 2), by row and column; everything else is zero for
+/// any linearisation point. Per block:
+/// phi <- phi: I - [w_in x] dt, full; phi <- dv: only (N,E), (E,N), (D,E)
+/// (d omega_en / dv); phi <- dp: no dpE column, no (E,N);
+/// dv <- phi: [f x] dt, zero diagonal; dv <- dv: full; dv <- dp: no dpE
+/// column; dp <- phi: zero; dp <- dv: I dt; dp <- dp: I + F33 dt with
+/// rows (1 0 x), (x x x), (0 0 1).
+#[rustfmt::skip]
+const NAV_NONZERO: [[bool; NAV_STATES]; NAV_STATES] = {
+    const X: bool = true;
+    const O: bool = false;
+    [
+        // phiN phiE phiD dvN dvE dvD dpN dpE dpD
+        [X, X, X,  O, X, O,  X, O, X], // phiN
+        [X, X, X,  X, O, O,  O, O, X], // phiE
+        [X, X, X,  O, X, O,  X, O, X], // phiD
+        [O, X, X,  X, X, X,  X, O, X], // dvN
+        [X, O, X,  X, X, X,  X, O, X], // dvE
+        [X, X, O,  X, X, X,  X, O, X], // dvD
+        [O, O, O,  X, O, O,  X, O, X], // dpN
+        [O, O, O,  O, X, O,  X, X, X], // dpE
+        [O, O, O,  O, O, X,  O, O, X], // dpD
+    ]
+};
 
 impl<T: FilterScalar, const N: usize> Transition<T, N> for AugmentedTransition<T, N> {
     fn apply_to_matrix(&self, m: &mut SMatrix<T, N, N>) {
         self.apply(m);
     }
+    fn propagate_lower(&self, p: &mut SMatrix<T, N, N>) {
+        AugmentedTransition::propagate_lower(self, p);
+    }
     fn apply_to_vector(&self, x: &mut SVector<T, N>) {
         self.apply(x);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::earth::{gravity_n, Position};
+    use nalgebra::Vector3;
+
+    fn moving_point() -> LinearizationPoint {
+        let position = Position::new(0.7, 0.3, 150.0);
+        LinearizationPoint {
+            c_bn: nalgebra::Rotation3::from_euler_angles(0.2, -0.4, 2.1).into_inner(),
+            velocity_n: Vector3::new(2.0, -3.0, 0.7),
+            position,
+            specific_force_n: -gravity_n(&position) + Vector3::new(0.3, -0.1, 0.2),
+        }
+    }
+
+    /// A symmetric positive definite test matrix with entries of mixed size.
+    fn covariance<const N: usize>() -> SMatrix<f64, N, N> {
+        let l =
+            SMatrix::<f64, N, N>::from_fn(|i, j| libm::sin(1.0 + 3.7 * i as f64 + 0.9 * j as f64));
+        l * l.transpose() + SMatrix::identity() * 1e-3
+    }
+
+    fn lower_rel_diff<const N: usize>(a: &SMatrix<f64, N, N>, b: &SMatrix<f64, N, N>) -> f64 {
+        let mut worst = 0.0f64;
+        for j in 0..N {
+            for i in j..N {
+                worst = worst.max((a[(i, j)] - b[(i, j)]).abs());
+            }
+        }
+        worst / b.amax()
+    }
+
+    fn check_against_dense<const N: usize>(phi: &AugmentedTransition<f64, N>) {
+        let dense = phi.to_dense();
+        let p = covariance::<N>();
+        let mut m = p;
+        phi.apply(&mut m);
+        assert!((m - dense * p).amax() <= 1e-14 * (dense * p).amax());
+        let mut m = p;
+        phi.propagate_lower(&mut m);
+        let reference = dense * p * dense.transpose();
+        assert!(lower_rel_diff(&m, &reference) < 1e-14);
+    }
+
+    #[test]
+    fn model_transitions_have_the_assumed_navigation_structure() {
+        let model = AugmentedModel::paper();
+        let phi = model.transition::<f64, STATES>(&moving_point());
+        assert!(phi.nav_is_structured());
+        // Every entry the structure allows is in use somewhere: the table
+        // is not looser than the model.
+        for (i, row) in NAV_NONZERO.iter().enumerate() {
+            for (j, allowed) in row.iter().enumerate() {
+                assert_eq!(*allowed, phi.nav[(i, j)] != 0.0, "({i}, {j})");
+            }
+        }
+    }
+
+    #[test]
+    fn structured_products_match_dense_coupled_and_not_33_and_39_states() {
+        for coupling in [
+            Coupling::SensorErrorsDriveNavigation,
+            Coupling::BlockDiagonalAsPublished,
+        ] {
+            let mut model = AugmentedModel::paper();
+            model.coupling = coupling;
+            check_against_dense(&model.transition::<f64, STATES>(&moving_point()));
+            check_against_dense(&model.transition::<f64, STATES_WITH_BIASES>(&moving_point()));
+        }
+    }
+
+    #[test]
+    fn a_hand_made_dense_navigation_block_gets_the_dense_product() {
+        let model = AugmentedModel::paper();
+        let mut phi = model.transition::<f64, STATES>(&moving_point());
+        phi.nav = SMatrix::from_fn(|i, j| 0.1 * libm::cos(2.0 * i as f64 + j as f64));
+        assert!(!phi.nav_is_structured());
+        check_against_dense(&phi);
+        let mut phi = model.transition::<f64, STATES_WITH_BIASES>(&moving_point());
+        phi.nav[(POS + 2, ATT)] = 0.5; // one entry outside the structure
+        assert!(!phi.nav_is_structured());
+        check_against_dense(&phi);
     }
 }

@@ -2,9 +2,11 @@
 //! (f32 on the probe, f64 on the host; paper section 2.4).
 //!
 //! - Time update (eq. 17-18) through a [`Transition`], which applies the
-//!   discrete transition Phi (eq. 15) to a matrix from the left. The
-//!   structured 33-state transition of `error_model` does that in a fraction
-//!   of the dense cost; [`dense::DenseTransition`] is the textbook reference.
+//!   discrete transition Phi (eq. 15) to a matrix from the left and forms
+//!   the lower triangle of Phi P Phi^T, mirrored so P stays exactly
+//!   symmetric. The structured 33- and 39-state transition of
+//!   `error_model` does that in a fraction of the dense cost;
+//!   [`dense::DenseTransition`] is the textbook reference.
 //! - Measurement update (eq. 19-21) one scalar at a time with a sparse
 //!   measurement row, the Joseph covariance (eq. 21) expanded to
 //!   P - k c^T - c k^T + s k k^T, computed on the upper triangle and
@@ -47,6 +49,15 @@ impl FilterScalar for f64 {
 pub trait Transition<T: FilterScalar, const N: usize> {
     /// `m <- Phi m`.
     fn apply_to_matrix(&self, m: &mut SMatrix<T, N, N>);
+    /// `p <- Phi p Phi^T` for a symmetric `p`, of which only the lower
+    /// triangle (row >= column) is used afterwards: an implementation may
+    /// leave anything in the strict upper triangle. The default is
+    /// Phi (Phi p)^T (p symmetric) with one transpose and two left products.
+    fn propagate_lower(&self, p: &mut SMatrix<T, N, N>) {
+        self.apply_to_matrix(p);
+        p.transpose_mut();
+        self.apply_to_matrix(p);
+    }
     /// `x <- Phi x`.
     fn apply_to_vector(&self, x: &mut SVector<T, N>);
 }
@@ -134,16 +145,14 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
     /// The covariance half of [`predict`](Self::predict), for runs that
     /// only study P (e.g. long static covariance checks).
     pub fn propagate_covariance<F: Transition<T, N>>(&mut self, phi: &F, q_diag: &SVector<T, N>) {
-        // Phi P Phi^T = Phi (Phi P)^T because P is symmetric: one transpose
-        // and two structured left products (cheaper on the M4F than the
-        // column-wise right product).
-        phi.apply_to_matrix(&mut self.p);
-        self.p.transpose_mut();
-        phi.apply_to_matrix(&mut self.p);
+        // Phi P Phi^T is symmetric: its lower triangle is formed (the
+        // structured transition skips most of the rest) and mirrored, so P
+        // stays exactly symmetric.
+        phi.propagate_lower(&mut self.p);
         for i in 0..N {
             self.p[(i, i)] += q_diag[i];
         }
-        symmetrize(&mut self.p);
+        mirror_lower(&mut self.p);
     }
 
     /// One scalar measurement (eq. 19-21 with a 1 x N row). Leaves the
@@ -196,25 +205,42 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
     }
 }
 
+// The triangle loops below are index loops running down the columns (i
+// outer): the cheapest form on the M4F (measured, ~4.8 instructions per f32
+// entry at N = 33; the iterator forms cost up to 60 % more).
+
 /// Makes `p` exactly symmetric by averaging mirrored entries.
+#[allow(clippy::needless_range_loop)]
 pub fn symmetrize<T: FilterScalar, const N: usize>(p: &mut SMatrix<T, N, N>) {
     let half = T::of(0.5);
-    let data = p.as_mut_slice();
-    for j in 1..N {
-        for i in 0..j {
-            let v = (data[j * N + i] + data[i * N + j]) * half;
-            data[j * N + i] = v;
-            data[i * N + j] = v;
+    let d = &mut p.data.0; // d[column][row]
+    for i in 0..N {
+        for j in i + 1..N {
+            let v = (d[j][i] + d[i][j]) * half;
+            d[j][i] = v;
+            d[i][j] = v;
+        }
+    }
+}
+
+/// Copies the lower triangle of `p` onto its upper triangle.
+#[allow(clippy::needless_range_loop)]
+fn mirror_lower<T: FilterScalar, const N: usize>(p: &mut SMatrix<T, N, N>) {
+    let d = &mut p.data.0; // d[column][row]
+    for i in 0..N {
+        for j in i + 1..N {
+            d[j][i] = d[i][j];
         }
     }
 }
 
 /// Copies the upper triangle of `p` onto its lower triangle.
+#[allow(clippy::needless_range_loop)]
 fn mirror_upper<T: FilterScalar, const N: usize>(p: &mut SMatrix<T, N, N>) {
-    let data = p.as_mut_slice();
-    for j in 1..N {
-        for i in 0..j {
-            data[i * N + j] = data[j * N + i];
+    let d = &mut p.data.0; // d[column][row]
+    for i in 0..N {
+        for j in i + 1..N {
+            d[i][j] = d[j][i];
         }
     }
 }

@@ -22,17 +22,16 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
 
     // c = P h, and h^T P h. Column i of P from the upper triangle: rows
     // 0..=i of stored column i, then row i of the later columns.
-    let mut c = SVector::<T, N>::zeros();
+    let mut c = [T::zero(); N];
     {
-        let data = p.as_slice(); // column-major: (r, i) at i * N + r
+        let d = &p.data.0; // d[column][row]
         for (i, coef) in m.h.entries() {
-            for (r, cr) in c.iter_mut().enumerate() {
-                let v = if r <= i {
-                    data[i * N + r]
-                } else {
-                    data[r * N + i]
-                };
-                *cr += coef * v;
+            let column = &d[i];
+            for (cr, v) in c[..=i].iter_mut().zip(&column[..=i]) {
+                *cr += coef * *v;
+            }
+            for (cr, later) in c[i + 1..].iter_mut().zip(&d[i + 1..]) {
+                *cr += coef * later[i];
             }
         }
     }
@@ -60,14 +59,27 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
         }
     }
 
-    // Gain, eq. 19 (the inverse is a division for a scalar).
-    let k = c / variance;
-    if !k.iter().all(|v| v.is_finite()) {
+    // Gain, eq. 19: the inverse is one reciprocal for a scalar (the Joseph
+    // form below is right for any gain, so its rounding does not matter).
+    let inverse = T::one() / variance;
+    let mut k = [T::zero(); N];
+    let mut finite = true;
+    for (ki, ci) in k.iter_mut().zip(&c) {
+        *ki = if inverse.is_finite() {
+            *ci * inverse
+        } else {
+            *ci / variance
+        };
+        finite &= ki.is_finite();
+    }
+    if !finite {
         return ScalarOutcome::Degenerate;
     }
 
     // State, eq. 20.
-    x.axpy(innovation, &k, T::one());
+    for (xi, ki) in x.iter_mut().zip(&k) {
+        *xi += innovation * *ki;
+    }
 
     // Covariance, eq. 21. Expanding (I - k h^T) P (I - k h^T)^T + r k k^T
     // with c = P h and s = h^T c + r gives P - k c^T - c k^T + s k k^T,
@@ -75,19 +87,67 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     // s dk dk^T (second order, the Joseph form's robustness), and every term
     // is symmetric, so the upper triangle is computed and mirrored: about a
     // quarter of the work of the two matrix products.
-    let (k, c) = (k.as_slice(), c.as_slice());
-    let data = p.as_mut_slice(); // column-major: (i, j) at j * N + i
-    for j in 0..N {
-        let (kj, cj) = (k[j], c[j]);
-        let skj = variance * kj - cj;
-        let column = &mut data[j * N..j * N + j + 1];
-        for ((pij, ki), ci) in column.iter_mut().zip(&k[..=j]).zip(&c[..=j]) {
-            *pij = *pij + *ki * skj - *ci * kj;
-        }
-    }
+    joseph_upper::<T, N, 8>(&mut p.data.0, &k, &c, variance);
 
     ScalarOutcome::Accepted {
         innovation,
         variance,
+    }
+}
+
+/// `p_ij += k_i (s k_j - c_j) - c_i k_j` on the upper triangle (i <= j),
+/// in blocks of `R` rows: right of the block's diagonal part, its k_i and
+/// c_i stay in registers while the columns go by (~4.5 instructions per
+/// f32 entry on the M4F against ~10 column by column).
+#[inline(always)]
+fn joseph_upper<T: FilterScalar, const N: usize, const R: usize>(
+    d: &mut [[T; N]; N], // d[column][row]
+    k: &[T; N],
+    c: &[T; N],
+    s: T,
+) {
+    let mut b = 0;
+    while b + R <= N {
+        let kb: [T; R] = core::array::from_fn(|r| k[b + r]);
+        let cb: [T; R] = core::array::from_fn(|r| c[b + r]);
+        let after = b + R;
+        // The block's diagonal part (unrolled: R is a constant).
+        for jj in 0..R {
+            let (kj, cj) = (kb[jj], cb[jj]);
+            let skj = s * kj - cj;
+            let column = &mut d[b + jj][b..after];
+            for ii in 0..R {
+                if ii <= jj {
+                    column[ii] = column[ii] + kb[ii] * skj - cb[ii] * kj;
+                }
+            }
+        }
+        for ((column, kj), cj) in d[after..].iter_mut().zip(&k[after..]).zip(&c[after..]) {
+            let skj = s * *kj - *cj;
+            for ((pij, ki), ci) in column[b..after].iter_mut().zip(&kb).zip(&cb) {
+                *pij = *pij + *ki * skj - *ci * *kj;
+            }
+        }
+        b = after;
+    }
+    joseph_last_rows(d, k, c, s, b);
+}
+
+/// The same on the rows `first..N` left over (fewer than a block), upper
+/// triangle, entry by entry.
+#[inline(always)]
+fn joseph_last_rows<T: FilterScalar, const N: usize>(
+    d: &mut [[T; N]; N],
+    k: &[T; N],
+    c: &[T; N],
+    s: T,
+    first: usize,
+) {
+    for j in first..N {
+        let (kj, cj) = (k[j], c[j]);
+        let skj = s * kj - cj;
+        for i in first..=j {
+            d[j][i] = d[j][i] + k[i] * skj - c[i] * kj;
+        }
     }
 }

@@ -104,7 +104,7 @@ fn dense_cycle<T: FilterScalar>() -> u32 {
 }
 
 /// The fast cycle's parts, to see where the instructions go.
-fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 4] {
+fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 5] {
     let (state, sample) = setup();
     let model = AugmentedModel::paper();
     let mut sd = Strapdown::new(state, model.dt);
@@ -113,6 +113,25 @@ fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 4] {
         sd.step(core::hint::black_box(&sample));
     }
     let mech = ticks(start) / CYCLES;
+    // Feedback after each step, as in the cycle (corrections of the size
+    // the fine alignment feeds back at rest).
+    let (phi, dv, dp) = (
+        Vector3::new(2e-7, -1e-7, 3e-6),
+        Vector3::new(1e-4, -2e-4, 5e-5),
+        Vector3::new(1e-3, 2e-3, -1e-3),
+    );
+    let mut feedback = 0;
+    for _ in 0..CYCLES {
+        sd.step(core::hint::black_box(&sample));
+        let start = SYST::get_current();
+        sd.apply_correction(
+            core::hint::black_box(&phi),
+            core::hint::black_box(&dv),
+            core::hint::black_box(&dp),
+        );
+        feedback += ticks(start);
+    }
+    let feedback = feedback / CYCLES;
     let s = *sd.state();
     let c_bn = s.attitude.to_rotation_matrix().into_inner();
     let lp = LinearizationPoint {
@@ -156,6 +175,7 @@ fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 4] {
         ("transition build (cached geodetic terms)", build),
         ("time update", predict),
         ("6 scalar updates", update),
+        ("feedback (apply_correction, f64)", feedback),
     ]
 }
 
