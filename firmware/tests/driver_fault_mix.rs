@@ -61,10 +61,15 @@ proptest::proptest! {
 
     /// Any mix of faults: no panic, every reading that claims to be good
     /// is within one LSB of the truth, and once the faults stop the part
-    /// comes back by itself through `recover`.
+    /// comes back by itself through `recover`; under either reading of the
+    /// accelerometer's dPAR (driver and mock set alike).
     #[test]
-    fn any_fault_mix_is_survived(faults in random_faults(), seed in 1u32..1000) {
-        with_seeded_part(seed, |clock, mock, part| {
+    fn any_fault_mix_is_survived(
+        faults in random_faults(),
+        seed in 1u32..1000,
+        scope in proptest::sample::select(DPAR_SCOPES.to_vec()),
+    ) {
+        with_dpar_scope(scope, seed, |clock, mock, part| {
             mock.borrow_mut().faults = faults;
             for _ in 0..60 {
                 clock.advance_ms(PERIOD_MS);

@@ -3,15 +3,24 @@
 //! `[-, FRME, PORST, ST, SAT, 0, 1, dPAR]`, then the in-frame data, read
 //! registers decrementing from the address (burst).
 //!
-//! FRME and dPAR speak about the previous frame: the status byte is clocked
-//! out while the command is still coming in, so it cannot depend on it.
-//! dPAR is the odd-parity bit over the previous frame's data bytes (our
-//! reading of the spec, see the driver's `datasheet.rs`).
+//! The status byte is the state before this frame's command takes effect;
+//! FRME speaks about the previous frame [spec: "FRME = the previous frame had
+//! an error"]. dPAR is the odd-parity bit over the data bytes of the
+//! previous frame or of this frame, as [`Scc1300::dpar_scope`] says: the spec
+//! does not tell which (see [`DparScope`] and the driver's
+//! `datasheet::ACCEL_DPAR_SCOPE`).
+//!
+//! Start-up [TN92 step 3: "write CTRL = 0x00 (clears PORST), wait 10 ms"]:
+//! a CTRL write clears PORST and starts [`ACCEL_SETTLE_NS`] of settling,
+//! during which the output registers (axes, temperature) read 0 with no
+//! status bit to say so (what the real part shows then is unknown); every
+//! frame that reads them early is counted in
+//! [`crate::MockStats::accel_output_reads_while_settling`].
 
 use mwd_core::sensor_units::{self, ACCEL_RANGE_G, ACCEL_TEMPERATURE, STANDARD_GRAVITY_M_S2};
 
 use crate::clock::TimeSource;
-use crate::part::{Scc1300, MOCK_ACCEL_ID, MOCK_ACCEL_REVID};
+use crate::part::{DparScope, Scc1300, MOCK_ACCEL_ID, MOCK_ACCEL_REVID};
 use crate::source::SampleSource;
 
 const FRME: u8 = 1 << 6;
@@ -28,6 +37,11 @@ const TEMP_LSB: u8 = 0x12;
 const TEMP_MSB: u8 = 0x13;
 const INT_STATUS: u8 = 0x16;
 const ID: u8 = 0x27;
+
+/// Settling of the accelerometer after a CTRL write, before its outputs are
+/// valid: the 10 ms TN92 step 3 waits after CTRL = 0x00 (spec "Start-up and
+/// supervision", item 3).
+pub const ACCEL_SETTLE_NS: u64 = 10_000_000;
 
 /// The output registers at the instant of a frame.
 struct Outputs {
@@ -53,11 +67,21 @@ pub(crate) fn frame<T: TimeSource, S: SampleSource>(
     if part.faults.accel_saturated || sample.accel_m_s2.iter().any(|a| a.abs() > limit) {
         part.accel.sat_latched = true;
     }
-    let outputs = Outputs {
-        axes: sample
-            .accel_m_s2
-            .map(|a| sensor_units::count_to_word(sensor_units::m_s2_to_accel_count(a))),
-        temp: sensor_units::count_to_word(ACCEL_TEMPERATURE.degc_to_count(sample.temperature_degc)),
+    let settling = part.accel.settle_until_ns.is_some_and(|t| now < t);
+    let outputs = if settling {
+        Outputs {
+            axes: [0; 3],
+            temp: 0,
+        }
+    } else {
+        Outputs {
+            axes: sample
+                .accel_m_s2
+                .map(|a| sensor_units::count_to_word(sensor_units::m_s2_to_accel_count(a))),
+            temp: sensor_units::count_to_word(
+                ACCEL_TEMPERATURE.degc_to_count(sample.temperature_degc),
+            ),
+        }
     };
     let st = &part.accel;
     let mut status = FIXED;
@@ -66,7 +90,6 @@ pub(crate) fn frame<T: TimeSource, S: SampleSource>(
         (st.porst, PORST),
         (part.faults.accel_self_test_failed, ST),
         (st.sat_latched, SAT),
-        (st.next_dpar, DPAR),
     ] {
         if on {
             status |= bit;
@@ -76,11 +99,10 @@ pub(crate) fn frame<T: TimeSource, S: SampleSource>(
         Some(split) => split,
         None => return,
     };
-    *status_out = status;
     part.accel.frame_error_pending = false;
     let accepted = match mosi.split_first() {
         Some((cmd, tx)) if cmd.count_ones() % 2 == 1 => {
-            execute(part, *cmd, tx, data_out, &outputs);
+            execute(part, now, *cmd, tx, data_out, &outputs, settling);
             true
         }
         _ => false,
@@ -90,31 +112,57 @@ pub(crate) fn frame<T: TimeSource, S: SampleSource>(
         part.accel.frame_error_pending = true;
         part.stats.accel_mosi_errors += 1;
     }
-    part.accel.next_dpar = odd_parity_bit(data_out);
+    let this_frame = odd_parity_bit(data_out);
+    let dpar = match part.dpar_scope {
+        DparScope::PreviousFrame => {
+            let previous = part.accel.next_dpar;
+            part.accel.next_dpar = this_frame;
+            previous
+        }
+        DparScope::SameFrame => this_frame,
+    };
+    if dpar {
+        status |= DPAR;
+    }
+    *status_out = status;
 }
 
 fn execute<T: TimeSource, S: SampleSource>(
     part: &mut Scc1300<T, S>,
+    now: u64,
     cmd: u8,
     tx: &[u8],
     data_out: &mut [u8],
     outputs: &Outputs,
+    settling: bool,
 ) {
     let addr = cmd >> 2;
     if cmd & (1 << 1) != 0 {
         if let (CTRL, Some(value)) = (addr, tx.first()) {
             part.accel.ctrl = *value;
-            // Writing CTRL clears PORST [TN92 step 3].
+            // Writing CTRL clears PORST [TN92 step 3], and the outputs
+            // settle for the 10 ms TN92 waits next.
             part.accel.porst = false;
+            part.accel.settle_until_ns = Some(now.saturating_add(ACCEL_SETTLE_NS));
         }
         data_out.fill(0);
         return;
     }
     let mut reg = addr;
+    let mut early = false;
     for out in data_out.iter_mut() {
+        early |= settling && is_output(reg);
         *out = register(part, reg, outputs);
         reg = reg.wrapping_sub(1) & 0x3F;
     }
+    if early {
+        part.stats.accel_output_reads_while_settling += 1;
+    }
+}
+
+/// The registers that hold measurements (axes and temperature).
+fn is_output(reg: u8) -> bool {
+    matches!(reg, X_LSB..=0x09 | TEMP_LSB | TEMP_MSB)
 }
 
 fn register<T: TimeSource, S: SampleSource>(
@@ -167,6 +215,7 @@ mod tests {
         let mut miso = [0u8; 2];
         frame(&mut p, &[0x07, 0x00], &mut miso); // CTRL = 0
         assert_eq!(miso[0], PORST | FIXED | DPAR, "power-up status");
+        clock.advance_ns(ACCEL_SETTLE_NS);
         let mut burst = [0u8; 7];
         frame(&mut p, &[0x25, 0, 0, 0, 0, 0, 0], &mut burst);
         // No PORST any more; dPAR = parity of the CTRL frame's data (0x00).
@@ -177,6 +226,53 @@ mod tests {
         let dpar = u8::from(odd_parity_bit(&burst[1..]));
         assert_eq!(miso[0], FIXED | dpar);
         assert_eq!(p.stats().accel_mosi_errors, 0);
+        assert_eq!(p.stats().accel_output_reads_while_settling, 0);
+    }
+
+    #[test]
+    fn same_frame_parity_covers_the_frame_it_is_in() {
+        let clock = SimClock::new();
+        let g = STANDARD_GRAVITY_M_S2;
+        let mut p = part(&clock, [g, -g, 0.0]);
+        p.dpar_scope = DparScope::SameFrame;
+        let mut miso = [0u8; 2];
+        frame(&mut p, &[0x07, 0x00], &mut miso); // CTRL = 0: data 0x00
+        assert_eq!(miso[0], PORST | FIXED | DPAR);
+        clock.advance_ns(ACCEL_SETTLE_NS);
+        let mut burst = [0u8; 7];
+        frame(&mut p, &[0x25, 0, 0, 0, 0, 0, 0], &mut burst);
+        assert_eq!(&burst[1..], &[0x00, 0x00, 0xF5, 0xD8, 0x0A, 0x28]);
+        // 0xF5D8 and 0x0A28 hold 10 + 4 ones: even, so dPAR = 1.
+        assert_eq!(burst[0], FIXED | u8::from(odd_parity_bit(&burst[1..])));
+        assert_eq!(burst[0], FIXED | DPAR);
+        // REVID 0x01: one 1, odd, so dPAR = 0 in this very frame, whatever
+        // the burst before held.
+        frame(&mut p, &[0x01, 0], &mut miso);
+        assert_eq!(miso, [FIXED, MOCK_ACCEL_REVID]);
+    }
+
+    #[test]
+    fn outputs_settle_for_10_ms_after_ctrl() {
+        let clock = SimClock::new();
+        let g = STANDARD_GRAVITY_M_S2;
+        let mut p = part(&clock, [g, 0.0, 0.0]);
+        let mut burst = [0u8; 7];
+        // Before any CTRL write the outputs run (PORST tells the driver).
+        frame(&mut p, &[0x25, 0, 0, 0, 0, 0, 0], &mut burst);
+        assert_eq!(&burst[5..], &[0x0A, 0x28]);
+        let mut miso = [0u8; 2];
+        frame(&mut p, &[0x07, 0x00], &mut miso); // CTRL = 0
+        clock.advance_ns(ACCEL_SETTLE_NS - 1);
+        frame(&mut p, &[0x25, 0, 0, 0, 0, 0, 0], &mut burst);
+        assert_eq!(&burst[1..], &[0; 6], "not settled yet");
+        assert_eq!(burst[0] & PORST, 0, "no status bit tells");
+        // Registers other than the outputs are not counted.
+        frame(&mut p, &[0x08, 0], &mut miso);
+        assert_eq!(p.stats().accel_output_reads_while_settling, 1);
+        clock.advance_ns(1);
+        frame(&mut p, &[0x25, 0, 0, 0, 0, 0, 0], &mut burst);
+        assert_eq!(&burst[5..], &[0x0A, 0x28]);
+        assert_eq!(p.stats().accel_output_reads_while_settling, 1);
     }
 
     #[test]

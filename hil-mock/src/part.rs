@@ -15,6 +15,23 @@ pub const MOCK_GYRO_IC_ID: u16 = 0x0130;
 pub const MOCK_ACCEL_ID: u8 = 0x13;
 pub const MOCK_ACCEL_REVID: u8 = 0x01;
 
+/// Which frame's data the accelerometer's dPAR status bit covers. The spec
+/// (`shared/spec/scc1300.md`, "Accelerometer part") names the bit but not
+/// its coverage, so the mock can model either; the driver's single switch
+/// is `firmware::scc1300::datasheet::ACCEL_DPAR_SCOPE`, and the firmware
+/// tests check that [`DEFAULT_DPAR_SCOPE`] agrees with it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DparScope {
+    /// Odd parity over the data bytes of the previous accelerometer frame.
+    PreviousFrame,
+    /// Odd parity over the data bytes of the same frame.
+    SameFrame,
+}
+
+/// UNVERIFIED: the dPAR coverage a new part models (keep it equal to the
+/// driver's `datasheet::ACCEL_DPAR_SCOPE`).
+pub const DEFAULT_DPAR_SCOPE: DparScope = DparScope::PreviousFrame;
+
 /// What the mock has seen: lets tests prove that the driver built every
 /// word's parity right (`mosi_parity_errors` stays 0 without injection).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -28,6 +45,11 @@ pub struct MockStats {
     pub power_on_resets: u32,
     /// INT_STATUS reads (SAT acknowledgements).
     pub sat_acknowledged: u32,
+    /// Accelerometer frames that read an output register (axes or
+    /// temperature) within [`crate::ACCEL_SETTLE_NS`] of a CTRL write,
+    /// i.e. before the outputs were valid: a driver that honours TN92's
+    /// 10 ms wait keeps this at 0.
+    pub accel_output_reads_while_settling: u32,
 }
 
 /// Gyro-side state.
@@ -49,6 +71,8 @@ pub(crate) struct AccelState {
     /// dPAR for the next status byte: parity of the last frame's data.
     pub next_dpar: bool,
     pub ctrl: u8,
+    /// Outputs invalid until this time (set by a CTRL write).
+    pub settle_until_ns: Option<u64>,
 }
 
 /// One simulated SCC1300. Share it between its two slaves by putting it in
@@ -59,6 +83,9 @@ pub struct Scc1300<T, S> {
     pub(crate) source: S,
     /// The faults to inject; change them at any time.
     pub faults: Faults,
+    /// What the accelerometer's dPAR bit covers (a model choice, see
+    /// [`DparScope`]); [`DEFAULT_DPAR_SCOPE`] unless changed.
+    pub dpar_scope: DparScope,
     pub(crate) rng: Rng,
     pub(crate) gyro: GyroState,
     pub(crate) accel: AccelState,
@@ -73,6 +100,7 @@ impl<T: TimeSource, S: SampleSource> Scc1300<T, S> {
             time,
             source,
             faults: Faults::default(),
+            dpar_scope: DEFAULT_DPAR_SCOPE,
             rng: Rng::new(seed),
             gyro: power_on_gyro(now),
             accel: power_on_accel(),
@@ -152,6 +180,7 @@ fn power_on_accel() -> AccelState {
         // Odd parity over "no previous data".
         next_dpar: true,
         ctrl: 0,
+        settle_until_ns: None,
     }
 }
 

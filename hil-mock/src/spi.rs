@@ -147,10 +147,11 @@ fn corrupt_miso(link: &mut LinkFaults, which: Which, miso: &mut [u8], rng: &mut 
     if link.miso_bit_flip.fires(rng) {
         match which {
             Which::Gyro => flip_random_bit(miso, rng),
-            // Not dPAR (bit 0 of the status byte): dPAR vouches for the
-            // previous frame, so a flip there could cancel a flip in that
-            // frame's data and make two single-bit faults one undetectable
-            // double error. dPAR has its own fault, `miso_parity`.
+            // Not dPAR (bit 0 of the status byte): with
+            // `DparScope::PreviousFrame` dPAR vouches for the previous
+            // frame, so a flip there could cancel a flip in that frame's
+            // data and make two single-bit faults one undetectable double
+            // error. dPAR has its own fault, `miso_parity`.
             Which::Accel => {
                 let n = u32::try_from(miso.len()).unwrap_or(0);
                 let bit = 1 + rng.below(n.saturating_mul(8).saturating_sub(1));

@@ -5,6 +5,8 @@
 //! drivers. Sensitivities and count conversions live in
 //! `mwd_core::sensor_units`, shared with the mock and the host.
 
+use mwd_core::sensor_units;
+
 /// Gyro registers [TN92].
 pub mod gyro_reg {
     pub const RATE_X: u8 = 0x00;
@@ -74,10 +76,51 @@ pub const SPI_CLOCK_HZ: u32 = 500_000;
 pub const GYRO_IC_ID_EXPECTED: Option<u16> = None;
 pub const ACCEL_ID_EXPECTED: Option<u8> = None;
 
-/// UNVERIFIED (deduced, not documented): dPAR is clocked out in the first
-/// status bit times, before the part has decoded this frame's command, so
-/// it cannot protect this frame's data. We take it as the odd-parity bit of
-/// all MISO data bytes of the *previous* accelerometer frame ("delayed
-/// parity"), checked one transaction late. If the datasheet says otherwise,
-/// change `accel.rs` and the mock's `accel` model together.
-pub const ACCEL_DPAR_COVERS_PREVIOUS_FRAME: bool = true;
+/// Gyro rate beyond which the output is out of the specified range: the D04
+/// measures +-300 deg/s at 18 LSB per deg/s [spec "Gyro part": "D04
+/// sensitivity 18 LSB per deg/s, range +-300 deg/s", TN92 and the datasheet
+/// front page] = +-5400 counts. The 14-bit word could carry +-8191 counts
+/// (+-455 deg/s), but beyond the range the output is not specified, so such
+/// a count is reported as saturated / out of range. Derived from
+/// `mwd_core::sensor_units::{GYRO_RANGE_DEG_S, GYRO_LSB_PER_DEG_S}`.
+pub const GYRO_RANGE_COUNTS: i16 =
+    (sensor_units::GYRO_RANGE_DEG_S * sensor_units::GYRO_LSB_PER_DEG_S) as i16;
+
+/// Which accelerometer frame the dPAR bit of a MISO status byte protects.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DparScope {
+    /// dPAR is the odd-parity bit over the MISO data bytes of the
+    /// *previous* accelerometer frame ("delayed parity"): checked one
+    /// transaction late.
+    PreviousFrame,
+    /// dPAR is the odd-parity bit over the MISO data bytes of the *same*
+    /// frame: checked as soon as the frame is in.
+    SameFrame,
+}
+
+/// UNVERIFIED, the single switch for the meaning of the accelerometer's
+/// dPAR bit; the driver ([`super::accel::Accel::new`]) follows it, and the
+/// driver-against-mock tests configure hil-mock's `Scc1300::dpar_scope`
+/// from it (they also check that the mock's default agrees).
+///
+/// What the spec says (`shared/spec/scc1300.md`, "Accelerometer part"):
+/// only "MISO byte 1 = status `[-, FRME, PORST, ST, SAT, 0, 1, dPAR]`;
+/// byte 2 = data", and "No CRC: odd parity only" (section "Bus"). The
+/// SCA3100-derived meanings it lists cover SAT, ST, FRME ("the previous
+/// frame had an error") and PORST, not dPAR. So neither the frame nor the
+/// bytes dPAR covers is documented; the full datasheet (Murata doc
+/// 82 1131 00) was not available.
+///
+/// An earlier note argued that dPAR "cannot protect this frame's data"
+/// because it is clocked out before the command is decoded. That does not
+/// hold: dPAR is the last status bit, shifted out on the falling edge after
+/// the 7th SCK rising edge, by which time A5..A0 and RW are in (only the
+/// command's P bit is still to come), so the part could compute the parity
+/// of the addressed data in time. Both readings are therefore possible;
+/// `PreviousFrame` stays the default because it is what the driver, the
+/// mock and the recorded QEMU captures have used so far. Both settings are
+/// tested against the mock. In both, dPAR is taken over *all* data bytes of
+/// the frame (six for the axis burst), which is unverified too. Correct
+/// this constant (and hil-mock's `DEFAULT_DPAR_SCOPE`) once the datasheet
+/// is found.
+pub const ACCEL_DPAR_SCOPE: DparScope = DparScope::PreviousFrame;

@@ -36,11 +36,14 @@ pub enum Error {
     Parity(Slave, Word),
     /// Gyro S_OK is clear: output invalid (start-up, or a transient).
     NotReady,
-    /// Gyro LOOPF_OK stayed clear after the 60 ms recheck; the gyro was
-    /// soft-reset (TN92 step 4).
+    /// Gyro LOOPF_OK was clear at the 60 ms recheck after S_OK dropped, so
+    /// the recovery soft-reset the gyro and repeated its start-up (TN92
+    /// step 4). Reported as the gyro error of the first sample after that
+    /// recovery (raw flag RESET_SEEN); the recovery is already done.
     LoopFailure,
     /// Output beyond range: accelerometer SAT (acknowledged through
-    /// INT_STATUS), or a gyro count at a 14-bit limit.
+    /// INT_STATUS), or a gyro count beyond the specified +-300 deg/s
+    /// (`datasheet::GYRO_RANGE_COUNTS`).
     Saturated(Slave),
     /// Accelerometer ST: self-test or memory checksum failure.
     SelfTest,
@@ -53,11 +56,9 @@ pub enum Error {
 
 impl Error {
     /// True when the part needs its recovery sequence (not just a retry).
+    /// Not [`Error::LoopFailure`]: it reports a recovery that has been run.
     pub fn needs_recovery(&self) -> bool {
-        matches!(
-            self,
-            Error::NotReady | Error::LoopFailure | Error::PowerOnReset
-        )
+        matches!(self, Error::NotReady | Error::PowerOnReset)
     }
 
     /// The raw-sample flag bit this error sets.
@@ -144,6 +145,9 @@ mod tests {
             (EventKind::SensorFault, 1, 0x109, 3)
         );
         assert!(Error::PowerOnReset.needs_recovery());
+        assert!(Error::NotReady.needs_recovery());
+        assert!(!Error::LoopFailure.needs_recovery());
+        assert_eq!(Error::LoopFailure.raw_flag(), raw_flags::RESET_SEEN);
         assert!(!Error::Parity(Slave::Gyro, Word::Data).needs_recovery());
     }
 }

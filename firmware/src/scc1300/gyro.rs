@@ -3,11 +3,11 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Error as _, SpiDevice};
-use mwd_core::sensor_units::{self, COUNT_MAX, COUNT_MIN, GYRO_TEMPERATURE};
+use mwd_core::sensor_units::{self, GYRO_TEMPERATURE};
 
 use super::datasheet::{
-    gyro_reg, GYRO_LOOPF_OK, GYRO_RECHECK_WAIT_MS, GYRO_SOFT_RESET_DATA, GYRO_S_OK,
-    POWER_UP_WAIT_MS,
+    gyro_reg, GYRO_LOOPF_OK, GYRO_RANGE_COUNTS, GYRO_RECHECK_WAIT_MS, GYRO_SOFT_RESET_DATA,
+    GYRO_S_OK, POWER_UP_WAIT_MS,
 };
 use super::error::{Error, Slave, Word};
 use super::frame::{gyro_command, gyro_write_word, is_dead_word, is_odd_parity, GYRO_READ_WORD};
@@ -43,11 +43,24 @@ pub enum Recovery {
 /// One gyro, owning its chip select's `SpiDevice`.
 pub struct Gyro<SPI> {
     spi: SPI,
+    /// [`Gyro::supervise`] found a loop failure and soft-reset the gyro;
+    /// not yet reported in a sample ([`Gyro::take_loop_failure`]).
+    loop_failure_pending: bool,
 }
 
 impl<SPI: SpiDevice> Gyro<SPI> {
     pub fn new(spi: SPI) -> Self {
-        Self { spi }
+        Self {
+            spi,
+            loop_failure_pending: false,
+        }
+    }
+
+    /// True once after [`Gyro::supervise`] found LOOPF_OK clear and
+    /// soft-reset the gyro: the next sample reports [`Error::LoopFailure`]
+    /// (raw flag RESET_SEEN), as the accelerometer's PORST is reported.
+    pub fn take_loop_failure(&mut self) -> bool {
+        core::mem::take(&mut self.loop_failure_pending)
     }
 
     /// Gives the `SpiDevice` back.
@@ -101,8 +114,9 @@ impl<SPI: SpiDevice> Gyro<SPI> {
         Ok(sensor_units::word_to_count(answer.data))
     }
 
-    /// Rate about the part's X axis in counts (18 LSB per deg/s). A count at
-    /// a 14-bit limit is reported as saturation.
+    /// Rate about the part's X axis in counts (18 LSB per deg/s). A count
+    /// beyond the specified +-300 deg/s ([`GYRO_RANGE_COUNTS`]) is reported
+    /// as saturation.
     pub fn read_rate_count(&mut self) -> Result<i16, Error> {
         let count = self.read_count(gyro_reg::RATE_X)?;
         if is_saturated(count) {
@@ -163,13 +177,16 @@ impl<SPI: SpiDevice> Gyro<SPI> {
     /// TN92 step 4, after S_OK dropped: read STATUS, wait 60 ms, read it
     /// again; if LOOPF_OK is clear, soft-reset and repeat the 800 ms
     /// start-up. Blocks for 60 ms (860+ ms with a reset): run it outside
-    /// the 20 Hz acquisition interrupt.
+    /// the 20 Hz acquisition interrupt. A loop failure is remembered for
+    /// the next sample ([`Gyro::take_loop_failure`]).
     pub fn supervise(&mut self, delay: &mut impl DelayNs) -> Result<Recovery, Error> {
         self.read_status()?;
         delay.delay_ms(GYRO_RECHECK_WAIT_MS);
         let status = self.read_status()?;
         if !status.loop_ok {
             self.soft_reset()?;
+            // Reported in the next sample even if the restart below fails.
+            self.loop_failure_pending = true;
             delay.delay_ms(POWER_UP_WAIT_MS);
             self.start()?;
             return Ok(Recovery::SoftReset);
@@ -183,9 +200,11 @@ impl<SPI: SpiDevice> Gyro<SPI> {
     }
 }
 
-/// A rate count at a 14-bit limit: the true rate may be beyond it.
+/// A rate count beyond the specified range (+-[`GYRO_RANGE_COUNTS`] =
+/// +-300 deg/s), the 14-bit limits included: the output is not specified
+/// there, and at the limits the true rate may be beyond it.
 pub const fn is_saturated(count: i16) -> bool {
-    count == COUNT_MAX || count == COUNT_MIN
+    count > GYRO_RANGE_COUNTS || count < -GYRO_RANGE_COUNTS
 }
 
 #[cfg(test)]
@@ -263,6 +282,33 @@ mod tests {
         );
         assert_eq!(gyro.read_rate_count(), Err(Error::NoResponse(Slave::Gyro)));
         assert_eq!(gyro.read_rate_count(), Err(Error::NotReady));
+        assert_eq!(gyro.read_rate_count(), Err(Error::Saturated(Slave::Gyro)));
+        spi.done();
+    }
+
+    #[test]
+    fn rates_beyond_300_deg_s_are_out_of_range() {
+        // Spec: 18 LSB per deg/s, range +-300 deg/s -> +-5400 counts.
+        assert_eq!(GYRO_RANGE_COUNTS, 5400);
+        for (count, saturated) in [
+            (0, false),
+            (5400, false),
+            (-5400, false),
+            (5401, true),
+            (-5401, true),
+            (8191, true),
+            (-8192, true),
+        ] {
+            assert_eq!(is_saturated(count), saturated, "{count}");
+        }
+        // Over the bus: +5400 (0x5460 left-aligned, P = 0 with 5 ones) is
+        // good, +5401 (0x5464, 6 ones, P = 1) is flagged.
+        let mut expect = vec![];
+        expect.extend(read([0x00, 0x01], [0x00, 0x02, 0x54, 0x60]));
+        expect.extend(read([0x00, 0x01], [0x00, 0x02, 0x54, 0x65]));
+        let mut spi = Mock::new(&expect);
+        let mut gyro = Gyro::new(spi.clone());
+        assert_eq!(gyro.read_rate_count(), Ok(5400));
         assert_eq!(gyro.read_rate_count(), Err(Error::Saturated(Slave::Gyro)));
         spi.done();
     }

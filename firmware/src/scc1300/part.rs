@@ -77,18 +77,36 @@ impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
     }
 
     /// Reads both slaves once: gyro rate and temperature, accelerometer
-    /// axes and temperature. Never blocks on a delay.
+    /// axes and temperature. Never blocks on a delay. A gyro rate beyond
+    /// the specified range is [`Error::Saturated`] (count kept); the first
+    /// sample after a recovery that soft-reset the gyro reports
+    /// [`Error::LoopFailure`].
     pub fn sample(&mut self) -> PartReading {
         let mut reading = PartReading::default();
         let raw = &mut reading.raw;
-        match self.read_gyro(raw) {
+        let mut gyro = self.read_gyro(raw);
+        if self.gyro.take_loop_failure() {
+            // The recovery after the previous sample found a loop failure
+            // and soft-reset the gyro [TN92 step 4]: this sample reports it
+            // (RESET_SEEN), unless its own error asks for recovery again.
+            raw.flags |= Error::LoopFailure.raw_flag();
+            if !gyro.is_err_and(|e| e.needs_recovery()) {
+                gyro = Err(Error::LoopFailure);
+            }
+        }
+        match gyro {
             Ok(()) => raw.flags |= raw_flags::GYRO_VALID,
             Err(e) => {
                 raw.flags |= e.raw_flag();
                 reading.gyro_error = Some(e);
             }
         }
-        match self.accel.read_counts() {
+        let accel = self.accel.read_counts();
+        if self.accel.saturation_seen() {
+            // SAT came with another flag whose error is reported instead.
+            raw.flags |= raw_flags::ACCEL_SATURATED;
+        }
+        match accel {
             Ok(counts) => {
                 raw.accel = counts.xyz;
                 raw.accel_temp = counts.temp;
@@ -117,8 +135,10 @@ impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
     }
 
     /// After a sample that [`PartReading::needs_recovery`]: gyro S_OK lost
-    /// -> TN92 supervision (60 ms, or a soft reset and 800 ms); accelerometer
-    /// PORST -> its start-up again (10 ms). Blocking: run it outside the
+    /// -> TN92 supervision (60 ms, or a soft reset and 800 ms; a soft reset
+    /// is reported as [`Error::LoopFailure`] by the next sample, unless the
+    /// same reading showed the accelerometer's PORST, i.e. the whole part
+    /// power-cycled); accelerometer PORST -> its start-up again (10 ms). Blocking: run it outside the
     /// acquisition interrupt, and mark the samples it costs as skipped.
     pub fn recover(
         &mut self,
@@ -127,7 +147,14 @@ impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
     ) -> Result<RecoveryReport, Error> {
         let mut report = RecoveryReport::default();
         if reading.gyro_error.is_some_and(|e| e.needs_recovery()) {
-            report.gyro = Some(self.gyro.supervise(delay)?);
+            let gyro = self.gyro.supervise(delay);
+            if reading.accel_error == Some(Error::PowerOnReset) {
+                // The whole part power-cycled (PORST, already flagged as
+                // RESET_SEEN): that, not a loop failure, is why LOOPF_OK
+                // was clear during the gyro's own start-up.
+                self.gyro.take_loop_failure();
+            }
+            report.gyro = Some(gyro?);
         }
         if reading.accel_error.is_some_and(|e| e.needs_recovery()) {
             self.accel.start(delay)?;

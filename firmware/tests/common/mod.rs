@@ -5,7 +5,8 @@
 
 use core::cell::RefCell;
 
-use firmware::scc1300::{Part, PartReading};
+use firmware::scc1300::datasheet::{DparScope, ACCEL_DPAR_SCOPE};
+use firmware::scc1300::{Accel, Gyro, Part, PartReading};
 use hil_mock::{
     AccelSpi, Generator, GyroSpi, MountedSource, PhysicalSample, Scc1300, SimClock, SimDelay,
 };
@@ -35,11 +36,45 @@ pub fn seeded_mock_part(clock: &SimClock, index: usize, seed: u32) -> RefCell<Mo
         },
         mounting: PART_MOUNTINGS[index],
     };
-    RefCell::new(Scc1300::new(clock, source, seed))
+    let mut part = Scc1300::new(clock, source, seed);
+    // The driver's one dPAR switch decides what the mock models too.
+    part.dpar_scope = mock_dpar_scope(ACCEL_DPAR_SCOPE);
+    RefCell::new(part)
 }
+
+/// The mock's model of the driver's dPAR reading.
+pub fn mock_dpar_scope(scope: DparScope) -> hil_mock::DparScope {
+    match scope {
+        DparScope::PreviousFrame => hil_mock::DparScope::PreviousFrame,
+        DparScope::SameFrame => hil_mock::DparScope::SameFrame,
+    }
+}
+
+/// Both readings of the spec's dPAR.
+pub const DPAR_SCOPES: [DparScope; 2] = [DparScope::PreviousFrame, DparScope::SameFrame];
 
 pub fn driver<'p, 'c>(part: &'p RefCell<MockPart<'c>>) -> Driver<'p, 'c> {
     Part::new(GyroSpi::new(part), AccelSpi::new(part))
+}
+
+/// [`with_seeded_part`] with driver and mock both set to `scope`.
+pub fn with_dpar_scope(
+    scope: DparScope,
+    seed: u32,
+    scenario: impl FnOnce(&SimClock, &RefCell<MockPart>, &mut Driver),
+) {
+    let clock = SimClock::new();
+    let mock = seeded_mock_part(&clock, 0, seed);
+    mock.borrow_mut().dpar_scope = mock_dpar_scope(scope);
+    let mut part = Part {
+        gyro: Gyro::new(GyroSpi::new(&mock)),
+        accel: Accel::with_dpar_scope(AccelSpi::new(&mock), scope),
+    };
+    part.start(&mut SimDelay::new(&clock)).unwrap();
+    clock.advance_ms(PERIOD_MS);
+    let first = part.sample();
+    assert_eq!((first.gyro_error, first.accel_error), (None, None));
+    scenario(&clock, &mock, &mut part);
 }
 
 /// Checks a good reading against the source, within one LSB.
