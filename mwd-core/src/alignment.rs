@@ -25,7 +25,13 @@
 //!
 //! Every heading carries its 1-sigma uncertainty from the sensor error
 //! budget ([`ImuNoise`]), propagated through the estimator by central
-//! differences, and flags for ill-conditioning and ambiguity.
+//! differences, and flags for ill-conditioning and ambiguity. The local
+//! (linearised) sigma is only a floor: near east/west the misfit is far
+//! from quadratic in heading, so the printed bound also covers every
+//! heading the data allow (the profile-likelihood interval: misfit within
+//! [`COVERAGE_FACTOR`]^2 of the estimate's), and the ill-conditioning flag
+//! is raised when the geometry is weak anywhere in that interval, not only
+//! at the estimate, which noise can pull away from east/west.
 use crate::attitude::level;
 use crate::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler};
 use crate::earth::{earth_rate_n, EARTH_RATE};
@@ -44,8 +50,9 @@ pub const ALL_GYROS: [bool; 3] = [true, true, true];
 /// Omega cos(lat): gyro errors are then magnified more than about three
 /// times (for a horizontal tool: within about 17 deg of east or west).
 pub const ILL_CONDITIONED_SENSITIVITY: f64 = 0.3;
-/// Beyond this 1-sigma (rad) the linearised uncertainty no longer describes
-/// the error and the heading is reported as undetermined.
+/// Beyond this 1-sigma (rad) the heading is reported as undetermined: the
+/// headings the data allow span more than 2 x 40 deg, or the linearised
+/// uncertainty no longer describes the error.
 pub const MAX_DETERMINED_SIGMA: f64 = 20.0 * PI / 180.0;
 /// A second heading candidate whose misfit exceeds the best one's by less
 /// than this (chi-square, 1 degree of freedom, 99 %) explains the data as
@@ -53,6 +60,15 @@ pub const MAX_DETERMINED_SIGMA: f64 = 20.0 * PI / 180.0;
 pub const AMBIGUITY_CHI2: f64 = 6.63;
 /// Coverage factor of the printed bounds: 2 sigma, about 95 %.
 pub const COVERAGE_FACTOR: f64 = 2.0;
+
+/// The headings the data allow: the connected set around an estimate
+/// whose misfit exceeds the estimate's by at most this (chi-square, 1
+/// degree of freedom: the profile-likelihood interval at the printed
+/// coverage, [`COVERAGE_FACTOR`] sigma).
+const ALLOWED_CHI2: f64 = COVERAGE_FACTOR * COVERAGE_FACTOR;
+/// Bisection steps that place an edge of the allowed interval within a
+/// grid step / 2^10 (0.005 deg).
+const EDGE_ITERATIONS: usize = 10;
 
 const GRID_POINTS: usize = 72;
 /// Golden-section steps that bring the bracket (one grid step either side)
@@ -116,7 +132,8 @@ pub struct HeadingEstimate {
     /// True when `alternative` explains the data as well (and no prior, or a
     /// prior, chose between them).
     pub ambiguous: bool,
-    /// True when the geometry makes heading insensitive to the earth rate.
+    /// True when the geometry makes heading insensitive to the earth rate
+    /// anywhere among the headings the data allow (or at the prior).
     pub ill_conditioned: bool,
     /// False when sigma exceeds [`MAX_DETERMINED_SIGMA`]: the value is then
     /// no better than a guess.
@@ -198,7 +215,8 @@ pub fn gyrocompass(
     check_all(segments, config)?;
     let sigmas = MeanSigmas::new(segments, config);
     let model = Misfit::new(segments, config, &sigmas);
-    let [first, second] = model.local_minima();
+    let grid = model.grid();
+    let [first, second] = model.local_minima(&grid);
     let (best, other) = match (first, second) {
         (Some(a), Some(b)) if b.1 - a.1 < AMBIGUITY_CHI2 => {
             // Ambiguous: a prior chooses, otherwise the lower misfit.
@@ -222,7 +240,21 @@ pub fn gyrocompass(
     let propagated = heading_sigma(segments, config, &sigmas, |perturbed| {
         Misfit::new(perturbed, config, &sigmas).refine(heading)
     });
-    let sigma = propagated.max(model.cramer_rao_sigma(heading));
+    // Both are local: near east/west the misfit is far from quadratic in
+    // heading, and noise that pulls the estimate away from east/west leaves
+    // it where the local curvature is high but the misfit stays low all the
+    // way to east/west (the local sigma there once printed 30 deg bounds
+    // for errors of 60). The headings the data allow (the profile-likelihood
+    // interval) are the honest measure, and their farther edge bounds the
+    // printed interval from below. The grid of the search is reused, so
+    // this costs some 20 misfit evaluations (of some 450).
+    let allowed = model.allowed_interval(&grid, heading, best.1 + ALLOWED_CHI2);
+    let sigma = propagated
+        .max(model.cramer_rao_sigma(heading))
+        .max(half_width(allowed) / COVERAGE_FACTOR);
+    // The other candidate, when ambiguous, is allowed as well.
+    let other_allowed =
+        other.map(|o| (o.0, model.allowed_interval(&grid, o.0, o.1 + ALLOWED_CHI2)));
     Ok(HeadingEstimate {
         heading: Uncertain {
             value: wrap_pi(heading),
@@ -230,7 +262,7 @@ pub fn gyrocompass(
         },
         alternative: other.map(|o| wrap_pi(o.0)),
         ambiguous: other.is_some(),
-        ill_conditioned: ill_conditioned(&model, heading, config),
+        ill_conditioned: ill_conditioned(&model, (heading, allowed), other_allowed, config),
         determined: sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA,
         gyro_bias: model.biases(heading),
     })
@@ -273,14 +305,30 @@ pub fn analytical(
         f64::INFINITY
     };
     let model = Misfit::new(core::slice::from_ref(segment), config, &sigmas);
+    // The headings the misfit allows around the result (those explaining
+    // the gyro means about as well), as in [`gyrocompass`]: they bound the
+    // locally propagated sigma from below and decide the flag. Without a
+    // solution, around the misfit's best grid heading.
+    let grid = model.grid();
+    let centre = if heading.is_finite() {
+        heading
+    } else {
+        let best = (0..GRID_POINTS).fold(0, |b, j| if grid[j] < grid[b] { j } else { b });
+        best as f64 * TAU / GRID_POINTS as f64
+    };
+    let allowed = model.allowed_interval(&grid, centre, model.cost(centre) + ALLOWED_CHI2);
+    // The two signs are distinct candidates when further apart than the
+    // propagated sigma (the wider floor describes the data, not the signs).
+    let ambiguous = alternative.is_some_and(|a| wrap_pi(a - heading).abs() > sigma);
+    let sigma = sigma.max(half_width(allowed) / COVERAGE_FACTOR);
     Ok(HeadingEstimate {
         heading: Uncertain {
             value: if heading.is_finite() { heading } else { 0.0 },
             sigma,
         },
         alternative: alternative.filter(|a| a.is_finite()),
-        ambiguous: alternative.is_some_and(|a| wrap_pi(a - heading).abs() > sigma),
-        ill_conditioned: ill_conditioned(&model, heading, config),
+        ambiguous,
+        ill_conditioned: ill_conditioned(&model, (centre, allowed), None, config),
         determined: sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA,
         gyro_bias: Vector3::zeros(),
     })
@@ -318,12 +366,40 @@ fn triad_heading(segment: &StaticSegment, config: &AlignmentConfig, sign: f64) -
     euler_from_dcm(&c_bn).heading
 }
 
-/// Ill-conditioned at the estimate, or at the prior (the well plan's
-/// azimuth, say): with noise the estimate of a tool heading east may land
-/// well away from east, but the geometry is still the weak one.
-fn ill_conditioned(model: &Misfit, heading: f64, config: &AlignmentConfig) -> bool {
+/// The headings the data allow around an estimate: the distances (rad) to
+/// the lower and upper edge of the interval, None when it is the whole
+/// circle.
+type Allowed = Option<(f64, f64)>;
+
+/// The larger distance from the estimate to an edge of its allowed
+/// interval (pi for the whole circle).
+fn half_width(allowed: Allowed) -> f64 {
+    allowed.map_or(PI, |(below, above)| below.max(above).min(PI))
+}
+
+/// Ill-conditioned when the geometry is weak anywhere in the headings the
+/// data allow: with noise the estimate of a tool heading east may land well
+/// away from east, but east is still among the headings the data allow
+/// and the geometry is still the weak one. Checked over the estimate's
+/// allowed interval and, when ambiguous, the other candidate's (the north/
+/// south pair), and at the prior (the well plan's azimuth, say). When the
+/// data allow every heading (the heading is undetermined, its bound pi),
+/// the interval says nothing about the geometry: the candidates themselves
+/// are checked.
+fn ill_conditioned(
+    model: &Misfit,
+    estimate: (f64, Allowed),
+    other: Option<(f64, Allowed)>,
+    config: &AlignmentConfig,
+) -> bool {
     let weak = |h: f64| model.sensitivity(h) < ILL_CONDITIONED_SENSITIVITY;
-    weak(heading) || config.heading_prior.is_some_and(weak)
+    let weak_around = |(centre, allowed): (f64, Allowed)| match allowed {
+        Some((below, above)) => model.weak_between(centre - below, centre + above),
+        None => weak(centre),
+    };
+    weak_around(estimate)
+        || other.is_some_and(weak_around)
+        || config.heading_prior.is_some_and(weak)
 }
 
 fn check_segment(segment: &StaticSegment) -> Result<(), AlignmentError> {
@@ -562,13 +638,19 @@ impl<'a> Misfit<'a> {
         b
     }
 
-    /// The (at most two) local minima as (heading, misfit), best first.
-    fn local_minima(&self) -> [Option<(f64, f64)>; 2] {
+    /// The misfit at the grid headings j 2 pi / [`GRID_POINTS`].
+    fn grid(&self) -> [f64; GRID_POINTS] {
         let step = TAU / GRID_POINTS as f64;
         let mut grid = [0.0; GRID_POINTS];
         for (j, g) in grid.iter_mut().enumerate() {
             *g = self.cost(j as f64 * step);
         }
+        grid
+    }
+
+    /// The (at most two) local minima as (heading, misfit), best first.
+    fn local_minima(&self, grid: &[f64; GRID_POINTS]) -> [Option<(f64, f64)>; 2] {
+        let step = TAU / GRID_POINTS as f64;
         let mut found: [Option<(f64, f64)>; 2] = [None, None];
         for j in 0..GRID_POINTS {
             let here = grid[j];
@@ -655,12 +737,89 @@ impl<'a> Misfit<'a> {
         h.is_finite().then_some(h)
     }
 
+    /// The connected interval around `centre` where the misfit stays within
+    /// `threshold`: walked along the grid in both directions to the first
+    /// grid heading beyond it, and the crossing then bisected (the outer end
+    /// kept, so the interval errs on the wide side). The misfit is a
+    /// trigonometric polynomial of degree two in heading, so it cannot dip
+    /// below the threshold and out again between grid headings 5 deg apart
+    /// by more than rounding.
+    fn allowed_interval(&self, grid: &[f64; GRID_POINTS], centre: f64, threshold: f64) -> Allowed {
+        let step = TAU / GRID_POINTS as f64;
+        let mut c = wrap_pi(centre);
+        if c < 0.0 {
+            c += TAU;
+        }
+        // The grid heading at or below the centre.
+        let j0 = ((c / step) as usize).min(GRID_POINTS - 1);
+        let inside = |h: f64| self.cost(h) <= threshold; // false for NaN
+        let edge = |up: bool| -> Option<f64> {
+            let mut last_inside = 0.0;
+            for m in 0..GRID_POINTS {
+                let (index, offset) = if up {
+                    let j = j0 + 1 + m;
+                    (j % GRID_POINTS, j as f64 * step - c)
+                } else {
+                    let j = j0 as f64 - m as f64;
+                    ((j0 + GRID_POINTS - m) % GRID_POINTS, c - j * step)
+                };
+                if grid[index] <= threshold {
+                    last_inside = offset;
+                    continue;
+                }
+                let sign = if up { 1.0 } else { -1.0 };
+                let (mut lo, mut hi) = (last_inside, offset);
+                for _ in 0..EDGE_ITERATIONS {
+                    let mid = 0.5 * (lo + hi);
+                    if inside(centre + sign * mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                return Some(hi);
+            }
+            None
+        };
+        let above = edge(true)?;
+        let below = edge(false)?;
+        (below + above < TAU).then_some((below, above))
+    }
+
+    /// True when the geometry is weak (sensitivity below
+    /// [`ILL_CONDITIONED_SENSITIVITY`]) anywhere from `lo` to `hi` (rad,
+    /// lo <= hi, less than a turn apart), checked at both ends and at most
+    /// a grid step apart between: the weak zones are about 35 deg wide
+    /// (seven grid steps) for a horizontal tool; only a zone whose least
+    /// sensitivity is barely below the threshold is narrower than a step,
+    /// and may be missed.
+    fn weak_between(&self, lo: f64, hi: f64) -> bool {
+        let step = TAU / GRID_POINTS as f64;
+        let span = (hi - lo).max(0.0);
+        let n = (libm::ceil(span / step) as usize).min(GRID_POINTS);
+        (0..=n).any(|t| {
+            let h = if n == 0 {
+                lo
+            } else {
+                lo + span * t as f64 / n as f64
+            };
+            self.sensitivity(h) < ILL_CONDITIONED_SENSITIVITY
+        })
+    }
+
+    /// Rate of change with heading of the predicted gyro means of segment
+    /// i (exact: the derivative of the heading rotation).
+    fn predicted_slope(&self, i: usize, heading: f64) -> Vector3<f64> {
+        let (s, c) = (libm::sin(heading), libm::cos(heading));
+        let drz = Matrix3::new(-s, -c, 0.0, c, -s, 0.0, 0.0, 0.0, 0.0);
+        (drz * self.levelled[i]).transpose() * earth_rate_n(self.config.latitude)
+    }
+
     /// The Cramer-Rao bound of the heading: 1/sqrt of the expected
     /// information of the gyro means with the biases profiled out (per
     /// axis: sum w d^2 - (sum w d)^2 / (sum w + w_bias), d the derivative
     /// of the predicted rate with heading).
     fn cramer_rao_sigma(&self, heading: f64) -> f64 {
-        let h = 1e-6;
         let mut information = 0.0;
         for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
             let prior = self.config.noise.gyro[axis].residual_bias;
@@ -671,9 +830,7 @@ impl<'a> Misfit<'a> {
             };
             let (mut wdd, mut wd, mut w) = (0.0, 0.0, 0.0);
             for i in 0..self.count() {
-                let d = (self.predicted(i, heading + h)[axis]
-                    - self.predicted(i, heading - h)[axis])
-                    / (2.0 * h);
+                let d = self.predicted_slope(i, heading)[axis];
                 let wi = self.weights[i][axis];
                 wdd += wi * d * d;
                 wd += wi * d;
@@ -703,10 +860,9 @@ impl<'a> Misfit<'a> {
         if self.count() == 0 || horizontal <= 1e-3 * EARTH_RATE {
             return 0.0;
         }
-        let h = 1e-6;
         let mut sum = 0.0;
         for i in 0..self.count() {
-            let d = (self.predicted(i, heading + h) - self.predicted(i, heading - h)) / (2.0 * h);
+            let d = self.predicted_slope(i, heading);
             for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
                 sum += d[axis] * d[axis];
             }

@@ -13,7 +13,7 @@ use mwd_core::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
 use mwd_core::attitude::quat_from_rotation_vector;
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{earth_rate_n, gravity_n, Position};
-use mwd_core::error_model::{AugmentedModel, ProcessNoise, NAV_STATES};
+use mwd_core::error_model::{AugmentedModel, ProcessNoise, NAV_STATES, POS, VEL};
 use mwd_core::fine_alignment::{
     ArInitialCovariance, FineAlignment, FineAlignmentConfig, SpecificForceInModel, TiltPrior,
 };
@@ -122,6 +122,18 @@ fn run<T: FilterScalar>(
     phi0: Vector3<f64>,
     config: FineAlignmentConfig,
 ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let (_, phi, sigma, sigma0) = align::<T>(seed, phi0, config, 1200);
+    (phi, sigma, sigma0)
+}
+
+/// [`run`] for `steps` samples, also returning the alignment itself (its
+/// solution and covariance) at the end.
+fn align<T: FilterScalar>(
+    seed: u64,
+    phi0: Vector3<f64>,
+    config: FineAlignmentConfig,
+    steps: usize,
+) -> (FineAlignment<T>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
     let t = truth();
     let coarse = NavState {
         attitude: quat_from_rotation_vector(&-phi0) * t.attitude,
@@ -130,13 +142,23 @@ fn run<T: FilterScalar>(
     let mut sensors = StaticSensors::new(&t, seed);
     let mut fa = FineAlignment::<T>::new(coarse, t.position, config);
     let sigma0 = fa.attitude_error_covariance().diagonal().map(libm::sqrt);
-    for _ in 0..1200 {
+    for _ in 0..steps {
         let report = fa.step(&sensors.next());
         assert!(report.zero_velocity.all_accepted() && report.zero_position.all_accepted());
+        // Three scalars from each enabled update, none from a disabled one.
+        let expected = |enabled: Option<f64>| if enabled.is_some() { 3 } else { 0 };
+        assert_eq!(
+            report.zero_velocity.accepted,
+            expected(config.zero_velocity_variance)
+        );
+        assert_eq!(
+            report.zero_position.accepted,
+            expected(config.zero_position_variance)
+        );
     }
     let phi = (t.attitude * fa.state().attitude.inverse()).scaled_axis();
     let sigma = fa.attitude_error_covariance().diagonal().map(libm::sqrt);
-    (phi, sigma, sigma0)
+    (fa, phi, sigma, sigma0)
 }
 
 #[test]
@@ -214,4 +236,113 @@ fn non_finite_samples_are_skipped_without_touching_the_solution() {
     assert_eq!((*fa.state(), fa.filter().p), (state, p));
     assert_eq!((fa.rejected_samples(), fa.steps()), (1, 20));
     assert!(fa.step(&sensors.next()).sample_used);
+}
+
+/// [`physical`] with only the updates given (variances in (m/s)^2 and m^2).
+fn aided_by(zero_velocity: Option<f64>, zero_position: Option<f64>) -> FineAlignmentConfig {
+    FineAlignmentConfig {
+        zero_velocity_variance: zero_velocity,
+        zero_position_variance: zero_position,
+        ..physical()
+    }
+}
+
+/// Diagonal of the velocity (or position) block of the filter's covariance.
+fn block_variances<T: FilterScalar>(fa: &FineAlignment<T>, first: usize) -> Vector3<f64> {
+    let p = &fa.filter().p;
+    Vector3::from_fn(|i, _| p[(first + i, first + i)].as_f64())
+}
+
+/// The tilts converge as in `tilt_converges_and_azimuth_lags_far_behind_in_60_s`.
+fn assert_tilt_converged(
+    name: &str,
+    phi: &Vector3<f64>,
+    phi0: &Vector3<f64>,
+    sigma: &Vector3<f64>,
+    sigma0: &Vector3<f64>,
+) {
+    for i in 0..2 {
+        assert!(
+            sigma[i] < 0.1 * sigma0[i],
+            "{name}, axis {i}: {sigma} vs {sigma0}"
+        );
+        assert!(
+            phi[i].abs() < 0.1 * phi0[i].abs(),
+            "{name}, axis {i}: {phi}"
+        );
+    }
+}
+
+const PHI0_DEG: [f64; 3] = [0.3, -0.4, 1.5];
+
+/// ZUPT alone (no zero-position update): every step applies the three
+/// velocity scalars and nothing else; roll and pitch converge as with both
+/// updates (the ZUPT sees g x tilt); the velocity stays held near the ZUPT
+/// noise (variance < 1e-5 (m/s)^2 with R = 1e-6); the position is
+/// unaided: its variance never falls below P0 (1e-4 m^2), grows from 20 s
+/// to 60 s, and ends over 100 times the variance with both updates.
+#[test]
+fn zupt_alone_converges_the_tilt_and_leaves_position_unaided() {
+    let phi0 = Vector3::from(PHI0_DEG).map(f64::to_radians);
+    let config = aided_by(Some(1e-6), None);
+    let (early, ..) = align::<f32>(1, phi0, config, 400);
+    let (fa, phi, sigma, sigma0) = align::<f32>(1, phi0, config, 1200);
+    let (both, ..) = align::<f32>(1, phi0, physical(), 1200);
+    assert_tilt_converged("ZUPT only", &phi, &phi0, &sigma, &sigma0);
+    let velocity = block_variances(&fa, VEL);
+    assert!(velocity.max() < 1e-5, "velocity variance {velocity}");
+    let (p_early, p_end, p_both) = (
+        block_variances(&early, POS),
+        block_variances(&fa, POS),
+        block_variances(&both, POS),
+    );
+    let p0 = physical().initial_nav_variance[POS];
+    for i in 0..3 {
+        assert!(
+            p_end[i] >= p0,
+            "axis {i}: position variance {p_end} below P0"
+        );
+        assert!(
+            p_end[i] > p_early[i],
+            "axis {i}: {p_early} -> {p_end} not growing"
+        );
+        assert!(
+            p_end[i] > 100.0 * p_both[i],
+            "axis {i}: {p_end} vs {p_both} with both"
+        );
+    }
+}
+
+/// Zero-position update alone (no ZUPT): every step applies the three
+/// position scalars and nothing else; roll and pitch converge; and the
+/// position measurement still bounds the velocity: its variance stays
+/// below P0 (1e-4 (m/s)^2) and does not grow from 20 s to 60 s (10 %
+/// slack), and the velocity itself stays below 1 cm/s, where the same run
+/// with neither update drifts to metres per second (variance > 1).
+#[test]
+fn zero_position_alone_converges_the_tilt_and_bounds_velocity() {
+    let phi0 = Vector3::from(PHI0_DEG).map(f64::to_radians);
+    let config = aided_by(None, Some(1e-6));
+    let (early, ..) = align::<f32>(1, phi0, config, 400);
+    let (fa, phi, sigma, sigma0) = align::<f32>(1, phi0, config, 1200);
+    let (unaided, ..) = align::<f32>(1, phi0, aided_by(None, None), 1200);
+    assert_tilt_converged("zero position only", &phi, &phi0, &sigma, &sigma0);
+    let (v_early, v_end) = (block_variances(&early, VEL), block_variances(&fa, VEL));
+    let p0 = physical().initial_nav_variance[VEL];
+    for i in 0..3 {
+        assert!(v_end[i] < p0, "axis {i}: velocity variance {v_end}");
+        assert!(
+            v_end[i] <= 1.1 * v_early[i],
+            "axis {i}: {v_early} -> {v_end} growing"
+        );
+    }
+    let speed = fa.state().velocity.norm();
+    assert!(speed < 0.01, "velocity {} m/s", speed);
+    let drift = block_variances(&unaided, VEL);
+    assert!(
+        drift.x > 1.0 && drift.y > 1.0,
+        "unaided velocity variance {drift}"
+    );
+    let position = block_variances(&fa, POS);
+    assert!(position.max() < 1e-6, "position variance {position}");
 }
