@@ -10,9 +10,9 @@ cd "$(dirname "$0")/.."
 
 target=thumbv7em-none-eabihf
 target_dir="${CARGO_TARGET_DIR:-target}/qemu-probe"
-CARGO_TARGET_DIR="$target_dir" cargo build -q -p firmware --release --target "$target" \
+CARGO_TARGET_DIR="$target_dir" cargo build -q -p firmware --profile probe --target "$target" \
   --features board-qemu --bin probe-qemu
-elf="$target_dir/$target/release/probe-qemu"
+elf="$target_dir/$target/probe/probe-qemu"
 
 echo "== sections (arm-none-eabi-size -A $elf)"
 arm-none-eabi-size -A "$elf" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
@@ -31,8 +31,8 @@ bytes=$(stat -c %s "$serial")
 echo "uart_bytes=$bytes uart_bytes_per_s=$((bytes / 60)) (of 11520 at 115200 baud 8N1)"
 
 stm32_dir="${CARGO_TARGET_DIR:-target}"
-cargo build -q -p firmware --release --target "$target" --features board-stm32 --bin probe-stm32
-elf="$stm32_dir/$target/release/probe-stm32"
+cargo build -q -p firmware --profile probe --target "$target" --features board-stm32 --bin probe-stm32
+elf="$stm32_dir/$target/probe/probe-stm32"
 echo "== real board (arm-none-eabi-size -A $elf)"
 arm-none-eabi-size -A "$elf" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
 arm-none-eabi-size -A "$elf" | awk '

@@ -8,7 +8,9 @@
 //! host, advanced by the driver's waits through [`SimDelay`]), reads the
 //! physics from a [`SampleSource`], and answers every frame as TN92 frames
 //! it: odd parity on every word, in-frame answers, the accelerometer's FRME
-//! and dPAR one frame late. [`Faults`] injects errors on either side.
+//! one frame late and its dPAR over the frame [`DparScope`] names, the
+//! accelerometer's 10 ms settling after CTRL = 0. [`Faults`] injects errors
+//! on either side.
 //!
 //! ```
 //! use core::cell::RefCell;
@@ -32,12 +34,15 @@ mod gyro;
 pub mod part;
 pub mod source;
 pub mod spi;
+pub mod still;
 
+pub use accel::ACCEL_SETTLE_NS;
 pub use clock::{SimClock, SimDelay, TimeSource};
 pub use faults::{Chance, DeadLevel, Faults, LinkFaults, Window};
-pub use part::{MockStats, Scc1300, START_UP_NS};
+pub use part::{DparScope, MockStats, Scc1300, DEFAULT_DPAR_SCOPE, START_UP_NS};
 pub use source::{
     BodySample, BodySource, Constant, Generator, MountedSource, PhysicalSample, SampleSource,
     SliceSource,
 };
 pub use spi::{AccelSpi, GyroSpi, MockBusError};
+pub use still::StillProbe;

@@ -10,19 +10,16 @@ use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory, 
 use anyhow::Result;
 use mwd_core::alignment::{AlignmentConfig, PROBE_GYROS};
 use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, wrap_pi, Euler};
-use mwd_core::earth::{earth_rate_n, transport_rate_n, Position};
+use mwd_core::earth::Position;
 use mwd_core::error_model::{
     AugmentedModel, Coupling, ProcessNoise, NAV_STATES, STATES, STATES_WITH_BIASES, VEL,
 };
-use mwd_core::fine_alignment::{
-    ArInitialCovariance, FineAlignment, FineAlignmentConfig, SpecificForceInModel, TiltPrior,
-};
-use mwd_core::mechanization::{ImuSample, NavState};
+use mwd_core::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
+use mwd_core::mechanization::NavState;
 use mwd_core::sensor_noise::ImuNoise;
 use nalgebra::Vector3;
 
 pub const DEG: f64 = std::f64::consts::PI / 180.0;
-use std::f64::consts::FRAC_PI_2;
 /// Samples of the paper's test and of its coarse-alignment window.
 pub const SAMPLES: usize = 1200;
 pub const COARSE_SAMPLES: usize = 100;
@@ -84,67 +81,23 @@ impl Settings {
         }
     }
 
-    fn config(&self, coarse_sigma: &[f64; 3]) -> FineAlignmentConfig {
-        let mut model = AugmentedModel::paper();
+    /// The filter settings on `model`'s AR and bias models (the paper's:
+    /// [`AugmentedModel::paper`]; `--ar-models` loads fitted ones).
+    fn config(&self, model: &AugmentedModel, coarse_sigma: &[f64; 3]) -> FineAlignmentConfig {
+        let mut model = *model;
         match self {
             Settings::PaperAsPublished => {
                 model.coupling = Coupling::BlockDiagonalAsPublished;
                 FineAlignmentConfig::paper(model)
             }
             Settings::PaperCoupled => FineAlignmentConfig::paper(model),
-            Settings::Physical | Settings::PhysicalWithoutBiases => {
-                let with_biases = *self == Settings::Physical;
-                let mut p0 = [1e-4; NAV_STATES];
-                p0[0] = coarse_sigma[0].max(0.05 * DEG).powi(2);
-                p0[1] = coarse_sigma[1].max(0.05 * DEG).powi(2);
-                if with_biases {
-                    // The coarse tilt sigma holds the accelerometer bias's
-                    // share, sigma_b / g; the filter adds it back together
-                    // with its correlation to the bias states
-                    // (`TiltPrior::LevelledWithSameAccelerometers`), so P0
-                    // takes the levelling noise alone.
-                    let g = mwd_core::earth::normal_gravity(Position::paper_site().lat, 0.0);
-                    let bias_tilt = model.biases.accel[0].initial_sigma / g;
-                    for v in &mut p0[..2] {
-                        *v = (*v - bias_tilt * bias_tilt).max((0.01 * DEG).powi(2));
-                    }
-                }
-                p0[2] = coarse_sigma[2].clamp(1.0 * DEG, 30.0 * DEG).powi(2);
-                let arw = (0.86 * DEG / 60.0).powi(2);
-                let vrw = (0.052 / 60.0f64).powi(2);
-                // An azimuth error psi misplaces the horizontal earth rate by
-                // Omega cos(lat) sin(psi): a tilt drift the small-angle model
-                // cannot follow for large psi. Budget it as attitude noise
-                // over the 60 s alignment.
-                let lat = Position::paper_site().lat;
-                let drift =
-                    mwd_core::earth::EARTH_RATE * lat.cos() * coarse_sigma[2].min(FRAC_PI_2).sin();
-                let att = arw + drift * drift * 60.0;
-                // The tool-axis rate fed to the mechanization is the frame's
-                // (see `fine_align`): its error is that same misplaced earth
-                // rate, not Table 5's small noise.
-                model.gyro[1].noise_variance = model.gyro[1].noise_variance.max(drift * drift);
-                FineAlignmentConfig {
-                    model,
-                    process_noise: ProcessNoise::from_densities(att, vrw, 0.0, model.dt),
-                    initial_nav_variance: p0,
-                    initial_ar: ArInitialCovariance::Stationary,
-                    zero_velocity_variance: Some(1e-6),
-                    zero_position_variance: Some(1e-6),
-                    gate: None,
-                    ar_noise_scale: 1.0,
-                    tilt_prior: if with_biases {
-                        TiltPrior::LevelledWithSameAccelerometers
-                    } else {
-                        TiltPrior::Independent
-                    },
-                    specific_force: if with_biases {
-                        SpecificForceInModel::GravityAtRest
-                    } else {
-                        SpecificForceInModel::MeasuredSample
-                    },
-                }
-            }
+            Settings::Physical | Settings::PhysicalWithoutBiases => FineAlignmentConfig::physical(
+                model,
+                &ImuNoise::scc1300(),
+                coarse_sigma,
+                Position::paper_site().lat,
+                *self == Settings::Physical,
+            ),
         }
     }
 }
@@ -217,14 +170,15 @@ pub struct History {
 }
 
 /// Fine alignment of `records` from a coarse attitude, in f32 (the probe's
-/// precision).
+/// precision), with `model`'s AR noise models.
 pub fn fine_align(
     records: &[Record],
     coarse: &Euler,
     coarse_sigma: &[f64; 3],
     settings: Settings,
+    model: &AugmentedModel,
 ) -> History {
-    let config = settings.config(coarse_sigma);
+    let config = settings.config(model, coarse_sigma);
     if settings.states() == STATES_WITH_BIASES {
         fine_align_with::<STATES_WITH_BIASES>(records, coarse, config)
     } else {
@@ -243,21 +197,8 @@ fn fine_align_with<const N: usize>(
     let t = truth();
     let mut h = History::default();
     for r in records {
-        let s = *fa.state();
-        let c_nb = dcm_from_quat(&s.attitude).transpose();
-        let omega_in_b =
-            c_nb * (earth_rate_n(s.position.lat) + transport_rate_n(&s.position, &s.velocity));
         // The tool is at rest: its rate about the tool axis is the frame's.
-        // The rate derived from accelerometer roll (eq. 1-2) differences two
-        // single-sample rolls: with Table 4's accelerometer noise (0.058
-        // m/s^2 on x) that is ~0.17 rad/s per sample, far above Table 5's
-        // model for it, and its sum is the last sample's roll noise (~0.3
-        // deg of roll error). Static alignment does better without it.
-        let rate_y = omega_in_b.y;
-        fa.step(&ImuSample {
-            rate: Vector3::new(r.gyro.x, rate_y, r.gyro.z),
-            specific_force: r.accel,
-        });
+        fa.step(&at_rest_sample(fa.state(), r.gyro.x, r.gyro.z, r.accel));
         let e = euler_from_quat(&fa.state().attitude);
         let sigma = fa.euler_std() / DEG;
         let p = &fa.filter().p;
@@ -285,7 +226,13 @@ pub struct MonteCarlo {
     pub mean_sigma_deg: [f64; 3],
 }
 
-pub fn monte_carlo(runs: usize, settings: Settings, full_model: bool) -> Result<MonteCarlo> {
+/// `full_model` as in [`simulate`]; `model` is the filter's.
+pub fn monte_carlo(
+    runs: usize,
+    settings: Settings,
+    full_model: bool,
+    model: &AugmentedModel,
+) -> Result<MonteCarlo> {
     let mut mc = MonteCarlo {
         runs,
         inside: 0,
@@ -295,7 +242,7 @@ pub fn monte_carlo(runs: usize, settings: Settings, full_model: bool) -> Result<
     for seed in 1..=runs as u64 {
         let records = simulate(seed, full_model);
         let (coarse, sigma) = coarse_align(&records)?;
-        let h = fine_align(&records, &coarse, &sigma, settings);
+        let h = fine_align(&records, &coarse, &sigma, settings, model);
         let (Some(e), Some(s)) = (h.euler_error_deg.last(), h.euler_sigma_deg.last()) else {
             continue;
         };
@@ -378,7 +325,13 @@ mod tests {
     fn paper_settings_azimuth_sigma_grows_while_tilt_sigmas_settle() {
         let records = simulate(3, true);
         let (coarse, sigma) = coarse_align(&records).expect("coarse alignment");
-        let h = fine_align(&records, &coarse, &sigma, Settings::PaperCoupled);
+        let h = fine_align(
+            &records,
+            &coarse,
+            &sigma,
+            Settings::PaperCoupled,
+            &AugmentedModel::paper(),
+        );
         let (early, late) = (h.euler_sigma_deg[100], h.euler_sigma_deg[SAMPLES - 1]);
         assert!(late[2] > 2.0 * early[2], "{early:?} -> {late:?}");
         // Tilt sigmas are pinned by the ZUPT: they stop changing.
@@ -388,7 +341,8 @@ mod tests {
 
     #[test]
     fn physical_settings_are_consistent_in_tilt_on_the_filters_own_noise_model() {
-        let mc = monte_carlo(10, Settings::Physical, false).expect("runs");
+        let mc =
+            monte_carlo(10, Settings::Physical, false, &AugmentedModel::paper()).expect("runs");
         assert!(mc.inside >= 9, "{} of 10", mc.inside);
         assert!(mc.mean_sigma_deg[0] < 0.1 && mc.mean_sigma_deg[1] < 0.1);
     }
@@ -397,7 +351,7 @@ mod tests {
     fn bias_state_settings_are_consistent_in_tilt_on_the_full_sensor_model() {
         // Residual biases, bias instability, white noise, quantisation: the
         // 33-state physical filter is inside 3 sigma in ~61 % of such runs.
-        let mc = monte_carlo(20, Settings::Physical, true).expect("runs");
+        let mc = monte_carlo(20, Settings::Physical, true, &AugmentedModel::paper()).expect("runs");
         assert!(mc.inside >= 19, "{} of 20", mc.inside);
     }
 
@@ -407,7 +361,13 @@ mod tests {
         // azimuth sigma must not collapse, the tilt sigmas settle.
         let records = simulate(3, true);
         let (coarse, sigma) = coarse_align(&records).expect("coarse alignment");
-        let h = fine_align(&records, &coarse, &sigma, Settings::Physical);
+        let h = fine_align(
+            &records,
+            &coarse,
+            &sigma,
+            Settings::Physical,
+            &AugmentedModel::paper(),
+        );
         let (early, late) = (h.euler_sigma_deg[100], h.euler_sigma_deg[SAMPLES - 1]);
         assert!(late[2] > 0.5 * early[2], "{early:?} -> {late:?}");
         let before = h.euler_sigma_deg[SAMPLES - 200];

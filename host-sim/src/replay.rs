@@ -9,7 +9,7 @@ use std::io::{self, Write};
 
 use firmware::app::Navigator;
 use mwd_core::earth::Position;
-use mwd_core::protocol::frame::MAX_BODY_LEN;
+use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{encode_body, Frame, NavSolution, Payload};
 
 /// One replayed solution and, if the capture had one, whether the probe's
@@ -85,7 +85,7 @@ impl Replayer {
             Payload::Raw(raw) => {
                 self.summary.raw_frames += 1;
                 let solution = self.navigator.step(&raw);
-                if firmware::app::navigation::body_sample(&raw).is_none() {
+                if solution.flags & nav_flags::SENSOR_DEGRADED != 0 {
                     self.summary.degraded += 1;
                 }
                 let index = self.rows.len();

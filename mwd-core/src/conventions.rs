@@ -121,6 +121,33 @@ pub fn euler_from_dcm(c_bn: &Matrix3<f64>) -> Euler {
     Euler::new(roll, pitch, heading)
 }
 
+/// d(roll, pitch, heading) / d(phi) for an attitude error phi in the
+/// navigation frame (computed C = (I - [phi x]) C_true, i.e. q_computed =
+/// q(-phi) q_true), evaluated at C_b^n `c_bn`.
+///
+/// With C_f^n = Rz(heading) Ry(pitch) Rx(roll), a small rotation w of the
+/// navigation frame changes the angles by d(r, p, h) with
+/// w = d_h e3 + d_p Rz(h) e2 + d_r Rz(h) Ry(p) e1 = M d(r, p, h), where the
+/// columns of M are the tool axis t = C_b^n e_y = (cp ch, cp sh, -sp),
+/// (-sh, ch, 0) and (0, 0, 1). The error is a rotation by -phi, so
+/// J = -M^-1 = -[[ch/cp, sh/cp, 0], [-sh, ch, 0], [tp ch, tp sh, 1]].
+/// The sines and cosines come from t itself: no trigonometric call. At a
+/// vertical tool axis (cp = 0) roll and heading have no meaning and the
+/// entries are infinite. Checked against central differences of
+/// [`euler_from_dcm`] in the tests.
+pub fn euler_error_jacobian(c_bn: &Matrix3<f64>) -> Matrix3<f64> {
+    let (tn, te, td) = (c_bn[(0, 1)], c_bn[(1, 1)], c_bn[(2, 1)]);
+    let cp = libm::sqrt(tn * tn + te * te);
+    let sp = -td;
+    let (ch, sh) = if cp > 0.0 {
+        (tn / cp, te / cp)
+    } else {
+        (1.0, 0.0)
+    };
+    let tp = sp / cp;
+    -Matrix3::new(ch / cp, sh / cp, 0.0, -sh, ch, 0.0, tp * ch, tp * sh, 1.0)
+}
+
 /// The unit quaternion of the rotation C_b^n.
 pub fn quat_from_dcm(c: &Matrix3<f64>) -> UnitQuaternion<f64> {
     // Shepperd's method: take the square root of the largest of the four
@@ -255,6 +282,41 @@ mod tests {
         // Keep away from the gimbal lock, where roll and heading are not
         // separable (tested on its own below).
         (-PI..PI, -1.55f64..1.55, -PI..PI).prop_map(|(r, p, h)| Euler::new(r, p, h))
+    }
+
+    /// The slow reference of [`euler_error_jacobian`]: central differences
+    /// of the Euler extraction itself.
+    fn euler_error_jacobian_numeric(c_bn: &Matrix3<f64>) -> Matrix3<f64> {
+        let h = 1e-6;
+        let euler = |phi: &Vector3<f64>| {
+            let e = euler_from_dcm(&((Matrix3::identity() - skew(phi)) * c_bn));
+            Vector3::new(e.roll, e.pitch, e.heading)
+        };
+        let mut j = Matrix3::zeros();
+        for k in 0..3 {
+            let mut d = Vector3::zeros();
+            d[k] = h;
+            let (plus, minus) = (euler(&d), euler(&-d));
+            for i in 0..3 {
+                j[(i, k)] = wrap_pi(plus[i] - minus[i]) / (2.0 * h);
+            }
+        }
+        j
+    }
+
+    proptest! {
+        #[test]
+        fn euler_error_jacobian_matches_central_differences(e in euler_strategy()) {
+            let c = dcm_from_euler(&e);
+            let fast = euler_error_jacobian(&c);
+            let slow = euler_error_jacobian_numeric(&c);
+            // Central differences with h = 1e-6 of a first-order rotation:
+            // O(h) curvature terms scaled by 1/cos(pitch) (<= 48 here).
+            let scale = 1.0 / libm::cos(e.pitch);
+            for (a, b) in fast.iter().zip(slow.iter()) {
+                prop_assert!((a - b).abs() < 1e-5 * scale * scale, "{fast} vs {slow}");
+            }
+        }
     }
 
     proptest! {

@@ -9,9 +9,10 @@
 //! so they stay in the state; so do the bias estimates (the mechanization
 //! takes raw samples: the filter's dynamics carry the bias's effect).
 
-use crate::attitude::quat_from_rotation_vector;
-use crate::conventions::{euler_from_quat, wrap_pi};
-use crate::earth::{gravity_n, normal_gravity, Position};
+use crate::conventions::{dcm_from_quat, euler_error_jacobian};
+use crate::earth::{
+    earth_rate_n, gravity_n, normal_gravity, transport_rate_n, Position, EARTH_RATE,
+};
 use crate::error_model::{
     AugmentedModel, AugmentedTransition, EarthTerms, LinearizationPoint, ProcessNoise, ACCEL_BIAS,
     ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
@@ -19,7 +20,8 @@ use crate::error_model::{
 use crate::kalman::{FilterScalar, KalmanFilter, UpdateReport};
 use crate::measurement::{ZeroPosition, ZeroVelocity};
 use crate::mechanization::{ImuSample, NavState, Strapdown};
-use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use crate::sensor_noise::ImuNoise;
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// How the AR states start.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,6 +108,100 @@ impl FineAlignmentConfig {
             specific_force: SpecificForceInModel::MeasuredSample,
         }
     }
+
+    /// Settings scaled to the sensors' error budget for a probe that is
+    /// really still, starting from a coarse alignment with 1-sigma
+    /// `coarse_sigma` (roll, pitch, heading; rad) at `latitude`: P0 from the
+    /// coarse sigmas, AR blocks at their stationary covariance, process
+    /// noise from the white-noise densities of `noise`, tight ZUPT and
+    /// zero-position noise. With `with_biases` (the 39-state form, which
+    /// must then be the filter's size) the tilt-bias correlation of
+    /// levelling and f^n = -g^n in F21 (derivation sections 3b and 6).
+    /// The one place the probe and the host tool take these settings from.
+    pub fn physical(
+        mut model: AugmentedModel,
+        noise: &ImuNoise,
+        coarse_sigma: &[f64; 3],
+        latitude: f64,
+        with_biases: bool,
+    ) -> Self {
+        const DEG: f64 = core::f64::consts::PI / 180.0;
+        let square = |v: f64| v * v;
+        let mut p0 = [1e-4; NAV_STATES];
+        p0[ATT] = square(coarse_sigma[0].max(0.05 * DEG));
+        p0[ATT + 1] = square(coarse_sigma[1].max(0.05 * DEG));
+        if with_biases {
+            // The coarse tilt sigma holds the accelerometer bias's share,
+            // sigma_b / g; the filter adds it back with its correlation to
+            // the bias states (`TiltPrior::LevelledWithSameAccelerometers`),
+            // so P0 takes the levelling noise alone.
+            let bias_tilt = model.biases.accel[0].initial_sigma / normal_gravity(latitude, 0.0);
+            for v in &mut p0[ATT..ATT + 2] {
+                *v = (*v - square(bias_tilt)).max(square(0.01 * DEG));
+            }
+        }
+        p0[ATT + 2] = square(coarse_sigma[2].clamp(1.0 * DEG, 30.0 * DEG));
+        // An azimuth error psi misplaces the horizontal earth rate by
+        // Omega cos(lat) sin(psi): a tilt drift the small-angle model cannot
+        // follow for large psi. Budgeted as attitude noise over a minute.
+        let drift = EARTH_RATE
+            * libm::cos(latitude)
+            * libm::sin(coarse_sigma[2].min(core::f64::consts::FRAC_PI_2));
+        let attitude_density = square(noise.gyro[0].white_density) + square(drift) * 60.0;
+        let velocity_density = square(noise.accel[2].white_density);
+        // At rest the tool-axis rate fed to the mechanization is the
+        // frame's (see `at_rest_sample`): its error is that same misplaced
+        // earth rate, not the accelerometer-derived rate's noise model.
+        model.gyro[1].noise_variance = model.gyro[1].noise_variance.max(square(drift));
+        Self {
+            process_noise: ProcessNoise::from_densities(
+                attitude_density,
+                velocity_density,
+                0.0,
+                model.dt,
+            ),
+            model,
+            initial_nav_variance: p0,
+            initial_ar: ArInitialCovariance::Stationary,
+            zero_velocity_variance: Some(1e-6),
+            zero_position_variance: Some(1e-6),
+            gate: None,
+            ar_noise_scale: 1.0,
+            tilt_prior: if with_biases {
+                TiltPrior::LevelledWithSameAccelerometers
+            } else {
+                TiltPrior::Independent
+            },
+            specific_force: if with_biases {
+                SpecificForceInModel::GravityAtRest
+            } else {
+                SpecificForceInModel::MeasuredSample
+            },
+        }
+    }
+}
+
+/// The sample a still tool gives the mechanization: the x and z gyros and
+/// the accelerometers as measured, and for the tool axis (y), which has no
+/// gyro, the rate the navigation frame turns at (earth and transport rate
+/// in body axes at the current solution). The rate derived from
+/// accelerometer roll (eq. 1-2) differences two single-sample rolls: with
+/// Table 4's accelerometer noise (0.058 m/s^2 on x) that is ~0.17 rad/s per
+/// sample, far above Table 5's model, and its sum is the last sample's roll
+/// noise; a static alignment does better without it.
+pub fn at_rest_sample(
+    state: &NavState,
+    rate_x: f64,
+    rate_z: f64,
+    specific_force: Vector3<f64>,
+) -> ImuSample {
+    let omega_in_n =
+        earth_rate_n(state.position.lat) + transport_rate_n(&state.position, &state.velocity);
+    let frame_rate = state.attitude.inverse_transform_vector(&omega_in_n);
+    ImuSample {
+        rate: Vector3::new(rate_x, frame_rate.y, rate_z),
+        specific_force,
+    }
 }
 
 /// What one fine-alignment step did.
@@ -139,8 +235,27 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Starts from a coarse alignment `initial` (attitude, zero velocity,
     /// known position) and the known position `reference` of the tool.
     pub fn new(initial: NavState, reference: Position, config: FineAlignmentConfig) -> Self {
+        let mut alignment = Self {
+            strapdown: Strapdown::new(initial, config.model.dt),
+            filter: KalmanFilter::new(SMatrix::zeros()),
+            config,
+            q: SVector::zeros(),
+            earth: EarthTerms::at(&initial.position),
+            reference_terms: EarthTerms::at(&reference),
+            steps: 0,
+            rejected_samples: 0,
+        };
+        alignment.restart(initial, reference, config);
+        alignment
+    }
+
+    /// Starts again, in place, as [`new`](Self::new) would: the probe keeps
+    /// one filter for its whole run (moving a 39-state filter costs 6 KiB
+    /// of stack per copy).
+    pub fn restart(&mut self, initial: NavState, reference: Position, config: FineAlignmentConfig) {
         let model = &config.model;
-        let mut p0: SMatrix<T, N, N> = model.initial_covariance(&config.initial_nav_variance);
+        let p0 = &mut self.filter.p;
+        model.write_initial_covariance(&config.initial_nav_variance, p0);
         if let ArInitialCovariance::Diagonal(v) = config.initial_ar {
             p0.view_mut(
                 (NAV_STATES, NAV_STATES),
@@ -153,28 +268,29 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
         if N == STATES_WITH_BIASES && config.tilt_prior == TiltPrior::LevelledWithSameAccelerometers
         {
-            add_levelling_bias_correlation(&mut p0, &initial);
+            add_levelling_bias_correlation(p0, &initial);
         }
-        let mut q: SVector<T, N> = model.process_noise(&config.process_noise);
+        self.q = model.process_noise(&config.process_noise);
         for i in NAV_STATES..STATES {
-            q[i] *= T::of(config.ar_noise_scale);
+            self.q[i] *= T::of(config.ar_noise_scale);
         }
-        let mut filter = KalmanFilter::new(p0);
-        filter.gate = config.gate.map(T::of);
-        Self {
-            strapdown: Strapdown::new(initial, model.dt),
-            filter,
-            config,
-            q,
-            earth: EarthTerms::at(&initial.position),
-            reference_terms: EarthTerms::at(&reference),
-            steps: 0,
-            rejected_samples: 0,
-        }
+        self.filter.x.fill(T::zero());
+        self.filter.gate = config.gate.map(T::of);
+        self.strapdown = Strapdown::new(initial, model.dt);
+        self.config = config;
+        self.earth = EarthTerms::at(&initial.position);
+        self.reference_terms = EarthTerms::at(&reference);
+        self.steps = 0;
+        self.rejected_samples = 0;
     }
 
     /// One sample: mechanization, time update, measurement updates,
     /// feedback and reset of the navigation errors.
+    ///
+    /// Never inlined: with its fixed-size loops unrolled it is ~20 KiB of
+    /// Cortex-M code, and a caller that calls it from two places (the
+    /// probe's alignment and navigation phases) would get two copies.
+    #[inline(never)]
     pub fn step(&mut self, sample: &ImuSample) -> StepReport {
         // A non-finite sample would poison the mechanization for good: skip
         // it and say so (the caller counts it; the next sample goes on).
@@ -247,6 +363,16 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
     }
 
+    /// Ends the alignment: no more zero-velocity or zero-position updates,
+    /// and F21 takes the measured specific force (the tool may now move).
+    /// The filter goes on propagating, so the estimated biases keep being
+    /// compensated and the covariance grows as the errors do.
+    pub fn start_navigation(&mut self) {
+        self.config.zero_velocity_variance = None;
+        self.config.zero_position_variance = None;
+        self.config.specific_force = SpecificForceInModel::MeasuredSample;
+    }
+
     /// The corrected navigation solution.
     pub fn state(&self) -> &NavState {
         self.strapdown.state()
@@ -277,7 +403,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Standard deviations of roll, pitch and heading (rad), through the
     /// Jacobian of the project's Euler convention at the current attitude.
     pub fn euler_std(&self) -> Vector3<f64> {
-        let j = euler_error_jacobian(&self.state().attitude);
+        let j = euler_error_jacobian(&dcm_from_quat(&self.state().attitude));
         let p = j * self.attitude_error_covariance() * j.transpose();
         Vector3::new(p[(0, 0)], p[(1, 1)], p[(2, 2)]).map(|v| libm::sqrt(v.max(0.0)))
     }
@@ -312,26 +438,4 @@ fn add_levelling_bias_correlation<T: FilterScalar, const N: usize>(
             p0[(ACCEL_BIAS + j, ATT + i)] = T::of(cross[(i, j)]);
         }
     }
-}
-
-/// d(roll, pitch, heading of the computed attitude) / d(phi), where the
-/// computed attitude is the true one with error phi (q_computed =
-/// q(-phi) q_true): central differences of the conventions module's own
-/// Euler extraction, so this never re-derives the angle convention.
-pub fn euler_error_jacobian(attitude: &UnitQuaternion<f64>) -> Matrix3<f64> {
-    let h = 1e-6;
-    let euler = |phi: &Vector3<f64>| {
-        let e = euler_from_quat(&(quat_from_rotation_vector(&-phi) * attitude));
-        Vector3::new(e.roll, e.pitch, e.heading)
-    };
-    let mut j = Matrix3::zeros();
-    for k in 0..3 {
-        let mut d = Vector3::zeros();
-        d[k] = h;
-        let diff = euler(&d) - euler(&-d);
-        for i in 0..3 {
-            j[(i, k)] = wrap_pi(diff[i]) / (2.0 * h);
-        }
-    }
-    j
 }

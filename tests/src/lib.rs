@@ -58,7 +58,15 @@ pub fn build_firmware_for(features: &str, name: &str, run_seconds: Option<u32>) 
     };
     let mut command = cargo();
     command
-        .args(["build", "-p", "firmware", "--release", "--target", TARGET])
+        .args([
+            "build",
+            "-p",
+            "firmware",
+            "--profile",
+            "probe",
+            "--target",
+            TARGET,
+        ])
         .args(["--features", features, "--bin", "probe-qemu"])
         .env("CARGO_TARGET_DIR", &target_dir);
     match run_seconds {
@@ -73,7 +81,7 @@ pub fn build_firmware_for(features: &str, name: &str, run_seconds: Option<u32>) 
         "cross-build of probe-qemu failed (is the {TARGET} target installed? \
          `rustup target add {TARGET}`)"
     );
-    let built = target_dir.join(TARGET).join("release").join("probe-qemu");
+    let built = target_dir.join(TARGET).join("probe").join("probe-qemu");
     let elf = target_dir.join(format!("probe-qemu-{name}.elf"));
     std::fs::copy(&built, &elf).expect("copy the firmware binary");
     elf

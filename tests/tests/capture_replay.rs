@@ -12,8 +12,7 @@ use mwd_core::protocol::{EventKind, Payload};
 use system_tests::workspace_root;
 
 const SAMPLES: u64 = 6 * 20;
-/// Still samples of the coarse alignment (firmware::app::navigation).
-const ALIGNMENT_SAMPLES: u32 = 100;
+use firmware::app::navigation::ALIGNMENT_SAMPLES;
 
 #[test]
 fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {
@@ -44,13 +43,13 @@ fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {
         "the replay no longer reproduces the recorded probe: if the navigation \
          changed on purpose, record the capture again (scripts/make-test-capture.sh)"
     );
-    // The run covers the coarse alignment and the start of navigation.
+    // The run covers the coarse alignment and the start of the fine one.
     for row in &rows {
         let n = row.solution.sample_counter;
         let expected = if n < ALIGNMENT_SAMPLES - 1 {
             nav_mode::COARSE_ALIGNMENT
         } else {
-            nav_mode::NAVIGATING
+            nav_mode::FINE_ALIGNMENT
         };
         assert_eq!(row.solution.mode, expected, "sample {n}");
         assert_eq!(row.matches_probe, Some(true), "sample {n}");

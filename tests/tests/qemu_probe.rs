@@ -19,20 +19,22 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use firmware::app::Navigator;
+use firmware::app::{navigation, Navigator};
+use hil_mock::StillProbe;
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::{nav_mode, raw_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{
     encode_body, Decoder, DecoderStats, Event, EventKind, Frame, NavSolution, Payload, RawSample,
 };
-use mwd_core::sensor_units::{accel_count_to_m_s2, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+use mwd_core::sensor_units::{accel_count_to_m_s2, PART_MOUNTINGS};
 use system_tests::{build_firmware, require_qemu, summary_value, wait_or_kill};
 
 /// The firmware's default run length (`PROBE_QEMU_RUN_SECONDS`).
 const RUN_SECONDS: u64 = 60;
 const RATE_HZ: u64 = 20;
-/// Still samples of the coarse alignment (firmware::app::navigation).
-const ALIGNMENT_SAMPLES: usize = 100;
+/// Samples of the coarse and of the fine alignment (firmware::app::navigation).
+const ALIGNMENT_SAMPLES: usize = navigation::ALIGNMENT_SAMPLES as usize;
+const FINE_ALIGNMENT_SAMPLES: usize = navigation::FINE_ALIGNMENT_SAMPLES as usize;
 /// Far above the ~1 s the run takes; only a hang reaches it.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(300);
 
@@ -155,26 +157,65 @@ fn static_minute_streams_twenty_clean_raw_frames_per_simulated_second() {
     assert_eq!(summary_value(&run.stdout, "nav_samples_dropped"), 0);
 
     // One navigation solution per raw sample: 5 s of coarse alignment on
-    // the still probe, then navigation from a level attitude (the mock's
-    // tool lies level; it has no earth rate, so only the levelling is
-    // checked, right after the alignment).
+    // the still probe, fine alignment (the 39-state filter with zero
+    // updates) to the end of the minute, then navigation. The simulated
+    // parts sense `hil_mock::StillProbe::paper_test`: the paper's site and
+    // attitude, earth rate, gravity, residual biases and white noise.
     assert_eq!(navs.len(), raws.len());
+    let fine_end = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES - 1;
     for (n, nav) in navs.iter().enumerate() {
         assert_eq!(nav.sample_counter as usize, n);
-        let aligning = n < ALIGNMENT_SAMPLES - 1;
-        let mode = if aligning {
+        let mode = if n < ALIGNMENT_SAMPLES - 1 {
             nav_mode::COARSE_ALIGNMENT
+        } else if n < fine_end {
+            nav_mode::FINE_ALIGNMENT
         } else {
             nav_mode::NAVIGATING
         };
         assert_eq!(nav.mode, mode, "solution {n}");
     }
+    let truth = StillProbe::paper_test(1).attitude;
     let first = navs[ALIGNMENT_SAMPLES - 1];
-    assert!(
-        first.attitude[0].abs() < 2e-3 && first.attitude[1].abs() < 2e-3,
-        "{first:?}"
-    );
-    assert!(first.attitude_std[0] > 0.0 && first.attitude_std[1] > 0.0);
+    let last = navs[fine_end];
+    // Roll and pitch inside 3 sigma of the truth, after the coarse and
+    // after the fine alignment.
+    for nav in [&first, &last] {
+        for (axis, true_angle) in [truth.roll, truth.pitch].into_iter().enumerate() {
+            let error = f64::from(nav.attitude[axis]) - true_angle;
+            let sigma = f64::from(nav.attitude_std[axis]);
+            assert!(
+                sigma > 0.0 && error.abs() < 3.0 * sigma,
+                "axis {axis}: {nav:?}"
+            );
+        }
+        // One still minute cannot give the heading (gyro noise and bias
+        // against 10.5 deg/h of horizontal earth rate): the probe says so.
+        assert!(nav.attitude_std[2].is_infinite(), "{nav:?}");
+    }
+    // The fine alignment converged: velocity and position sigmas fell to a
+    // fifth or less and the velocity is near zero; the tilt sigmas stay
+    // near their floor (accelerometer bias / g: levelling with the same
+    // accelerometers cannot separate tilt from bias).
+    for i in 0..3 {
+        assert!(
+            last.velocity_std[i] < 0.2 * first.velocity_std[i],
+            "{first:?} -> {last:?}"
+        );
+        assert!(
+            last.position_std_ned[i] < 0.2 * first.position_std_ned[i],
+            "{last:?}"
+        );
+        assert!(
+            last.velocity_ned[i].abs() < 3.0 * last.velocity_std[i].max(1e-3),
+            "{last:?}"
+        );
+    }
+    for axis in 0..2 {
+        assert!(
+            last.attitude_std[axis] < 1.5 * first.attitude_std[axis],
+            "{last:?}"
+        );
+    }
 
     // Replay parity: the host runs the probe's navigation code on the
     // recorded raw frames and gets the probe's solutions bit for bit
@@ -197,20 +238,31 @@ fn static_minute_streams_twenty_clean_raw_frames_per_simulated_second() {
     );
 
     // The data are the probe at rest: both parts valid, and both
-    // accelerometers, back in body axes, feel gravity's reaction.
+    // accelerometers, back in body axes, feel gravity's reaction at the
+    // site (each sample within 4 counts: quantisation, 1 mg bias and
+    // noise; the minute's mean within 1.5).
     let lsb = accel_count_to_m_s2(1);
+    let g = mwd_core::earth::normal_gravity(truth_position().lat, truth_position().height) as f32;
+    let mut sum = 0.0f64;
     for raw in &raws {
         for (part, mounting) in raw.parts.iter().zip(PART_MOUNTINGS) {
             let valid = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
             assert_eq!(part.flags & valid, valid, "sample {}", raw.sample_counter);
             let body = mounting.sensor_to_body(part.accel.map(accel_count_to_m_s2));
             let norm = body.iter().map(|a| a * a).sum::<f32>().sqrt();
-            assert!(
-                (norm - STANDARD_GRAVITY_M_S2).abs() <= 2.0 * lsb,
-                "|f| = {norm}"
-            );
+            assert!((norm - g).abs() <= 4.0 * lsb, "|f| = {norm}");
+            sum += f64::from(norm);
         }
     }
+    let mean = sum / (2 * raws.len()) as f64;
+    assert!(
+        (mean - f64::from(g)).abs() <= 1.5 * f64::from(lsb),
+        "mean |f| = {mean}"
+    );
+}
+
+fn truth_position() -> Position {
+    StillProbe::paper_test(1).position
 }
 
 #[test]

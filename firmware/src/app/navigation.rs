@@ -1,139 +1,226 @@
 //! The navigation work of the main loop (lower priority than acquisition):
-//! raw samples in, navigation-solution frames out. First the probe must be
-//! still: the first samples are averaged and coarse-aligned (levelling and
-//! gyrocompassing from `mwd_core::alignment`), then the strapdown
-//! mechanization runs on every sample. The fine alignment (issue 3's
-//! Kalman filter) slots in between once it exists.
+//! raw samples in, navigation-solution frames out. The probe must first be
+//! still:
+//! 1. coarse alignment: the first 5 s of samples are averaged, levelled and
+//!    gyrocompassed (`mwd_core::alignment`);
+//! 2. fine alignment: the 39-state filter (33 AR-augmented states of the
+//!    paper plus six sensor biases) with zero-velocity and zero-position
+//!    updates, closed loop, until 60 s (the paper's test length), with the
+//!    settings scaled to the SCC1300's error budget
+//!    (`FineAlignmentConfig::physical`, the same the host's `paper mgwd`
+//!    runs);
+//! 3. navigation: the same filter without the zero updates, so the
+//!    mechanization runs on (bias estimates still compensated through the
+//!    filter's dynamics) and the reported uncertainties grow honestly.
 //!
-//! Uses only mwd-core (f64 where the core keeps it): the host can replay
-//! the same raw frames through the same code.
+//! Every sample first goes through the probe's calibration (the host's
+//! six-position result, `mwd_core::calibration`). Uses only mwd-core: the
+//! host replays the same raw frames through this same code and must get
+//! the probe's solutions bit for bit.
 
 use mwd_core::alignment::{
     gyrocompass, level_segment, AlignmentConfig, StaticSegment, PROBE_GYROS,
 };
+use mwd_core::attitude::ToolAxisRate;
+use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{euler_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::Position;
-use mwd_core::mechanization::{NavState, ProbeInput, Strapdown};
+use mwd_core::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
+use mwd_core::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
+use mwd_core::mechanization::{NavState, ProbeInput};
 use mwd_core::protocol::frame::{nav_flags, nav_mode, raw_flags};
 use mwd_core::protocol::{NavSolution, RawSample};
 use mwd_core::sensor_noise::ImuNoise;
 use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s, PART_MOUNTINGS};
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// Sample interval of the probe (s).
 pub const SAMPLE_INTERVAL_S: f64 = 0.05;
 /// Still samples averaged for the coarse alignment: 5 s, as in the paper.
 pub const ALIGNMENT_SAMPLES: u32 = 100;
+/// Samples of fine alignment after the coarse one: to 60 s in all, the
+/// paper's static test.
+pub const FINE_ALIGNMENT_SAMPLES: u32 = 1100;
+
+/// The probe's filter: f32 (the M4F's FPU), 39 states.
+type Filter = FineAlignment<f32, STATES_WITH_BIASES>;
 
 /// Body-frame rates (x and z gyros) and specific force of one raw sample,
-/// or `None` when a part's reading is not valid.
-pub fn body_sample(raw: &RawSample) -> Option<(f64, f64, Vector3<f64>)> {
+/// corrected by `calibration`, or `None` when a part's reading is not
+/// valid.
+pub fn body_sample(
+    raw: &RawSample,
+    calibration: &ProbeCalibration,
+) -> Option<(f64, f64, Vector3<f64>)> {
     let valid = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
     if raw.parts.iter().any(|p| p.flags & valid != valid) {
         return None;
     }
-    let mut rate = [0.0f32; 3];
-    let mut force = [0.0f32; 3];
-    for (part, mounting) in raw.parts.iter().zip(PART_MOUNTINGS) {
+    let mut rate = [0.0f64; 3];
+    let mut force = Vector3::zeros();
+    for (((part, mounting), triad), gyro_cal) in raw
+        .parts
+        .iter()
+        .zip(PART_MOUNTINGS)
+        .zip(&calibration.accel)
+        .zip(&calibration.gyro)
+    {
         let gyro = mounting.gyro_axis();
-        let value = gyro_count_to_rad_s(part.gyro_rate);
-        rate[gyro.axis as usize] = if gyro.negative { -value } else { value };
-        // Both parts' accelerometers see the same body force: average them.
-        let body = mounting.sensor_to_body(part.accel.map(accel_count_to_m_s2));
-        for (f, b) in force.iter_mut().zip(body) {
-            *f += 0.5 * b;
-        }
+        let value = f64::from(gyro_count_to_rad_s(part.gyro_rate));
+        let value = if gyro.negative { -value } else { value };
+        rate[gyro.axis as usize] = gyro_cal.apply(value);
+        // Each part's triad is corrected in body axes (the frame the host's
+        // calibration is fitted in); both then see the same body force, so
+        // they are averaged.
+        let body = mounting
+            .sensor_to_body(part.accel.map(accel_count_to_m_s2))
+            .map(f64::from);
+        force += 0.5 * Vector3::from(triad.apply(body));
     }
-    let force = Vector3::new(force[0], force[1], force[2]).cast::<f64>();
-    Some((f64::from(rate[0]), f64::from(rate[2]), force))
+    Some((rate[0], rate[2], force))
+}
+
+/// The filter's settings for a still probe at `position` whose coarse
+/// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
+fn filter_config(position: &Position, coarse_sigma: &[f64; 3]) -> FineAlignmentConfig {
+    FineAlignmentConfig::physical(
+        AugmentedModel::paper(),
+        &ImuNoise::scc1300(),
+        coarse_sigma,
+        position.lat,
+        true,
+    )
 }
 
 enum Phase {
     /// Summing still samples.
-    Aligning {
+    Coarse {
         force: Vector3<f64>,
         rate: Vector3<f64>,
         samples: u32,
     },
-    Navigating {
-        nav: Strapdown,
-        input: ProbeInput,
-    },
+    /// The filter with zero updates; `samples` taken so far.
+    Fine { samples: u32 },
+    /// The filter without zero updates.
+    Navigating { input: ProbeInput },
 }
 
 /// The probe's navigation, one raw sample at a time.
 pub struct Navigator {
     position: Position,
+    calibration: ProbeCalibration,
     phase: Phase,
-    /// 1-sigma of roll, pitch, heading from the alignment (rad).
-    attitude_std: [f32; 3],
+    /// Idle until the coarse alignment ends, then restarted in place from
+    /// it: the filter is the probe's largest object (6 KiB of covariance),
+    /// and every move of it would be another copy on the stack.
+    filter: Filter,
+    /// 1-sigma of roll, pitch, heading from the coarse alignment (rad),
+    /// reported until the filter has its own.
+    coarse_std: [f32; 3],
+    /// The coarse alignment found a heading. If not, the filter still runs
+    /// from its best guess with its largest prior, but its small-angle
+    /// azimuth sigma would not cover the error: the frames then say
+    /// heading unknown (infinite sigma) whatever the filter holds.
+    heading_determined: bool,
     flags: u16,
 }
 
 impl Navigator {
+    /// A navigator for a probe at `position` with uncalibrated sensors.
     pub fn new(position: Position) -> Self {
+        Self::with_calibration(position, ProbeCalibration::default())
+    }
+
+    /// A navigator that corrects every sample with `calibration`.
+    pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
+        let idle = NavState::at_rest(UnitQuaternion::identity(), position);
         Self {
             position,
-            phase: Phase::Aligning {
+            calibration,
+            phase: Phase::Coarse {
                 force: Vector3::zeros(),
                 rate: Vector3::zeros(),
                 samples: 0,
             },
-            attitude_std: [f32::NAN; 3],
+            filter: Filter::new(idle, position, filter_config(&position, &[0.0; 3])),
+            coarse_std: [f32::NAN; 3],
+            heading_determined: false,
             flags: 0,
         }
     }
 
     /// Takes one raw sample and returns the solution after it.
     pub fn step(&mut self, raw: &RawSample) -> NavSolution {
-        let body = body_sample(raw);
+        let body = body_sample(raw, &self.calibration);
         self.flags = if body.is_none() {
             nav_flags::SENSOR_DEGRADED
         } else {
             0
         };
-        let mut aligned = None;
-        match (&mut self.phase, body) {
-            (
-                Phase::Aligning {
-                    force,
-                    rate,
-                    samples,
-                },
-                Some((gx, gz, f)),
-            ) => {
+        // A sample without valid data: the alignment waits, the navigation
+        // coasts (the state is left as it is and flagged).
+        if let Some((gx, gz, f)) = body {
+            self.use_sample(gx, gz, f);
+        }
+        self.solution(raw)
+    }
+
+    fn use_sample(&mut self, gx: f64, gz: f64, f: Vector3<f64>) {
+        let mut coarse_done = None;
+        let mut fine_done = false;
+        let filter = &mut self.filter;
+        match &mut self.phase {
+            Phase::Coarse {
+                force,
+                rate,
+                samples,
+            } => {
                 *force += f;
                 *rate += Vector3::new(gx, 0.0, gz);
                 *samples += 1;
                 if *samples >= ALIGNMENT_SAMPLES {
                     let n = f64::from(*samples);
-                    aligned = Some(StaticSegment {
+                    coarse_done = Some(StaticSegment {
                         specific_force: *force / n,
                         rate: *rate / n,
                         samples: *samples as usize,
                     });
                 }
             }
-            (Phase::Navigating { nav, input }, Some((gx, gz, f))) => {
-                let (sample, _) = input.sample(nav.state(), gx, gz, &f, SAMPLE_INTERVAL_S);
-                nav.step(&sample);
+            Phase::Fine { samples } => {
+                let report = filter.step(&at_rest_sample(filter.state(), gx, gz, f));
+                if report.zero_velocity.accepted > 0 {
+                    self.flags |= nav_flags::ZUPT_APPLIED;
+                }
+                *samples += 1;
+                fine_done = *samples >= FINE_ALIGNMENT_SAMPLES;
             }
-            // A sample without valid data: alignment waits, navigation
-            // coasts (the state is left as it is and flagged).
-            (_, None) => {}
+            Phase::Navigating { input } => {
+                let (sample, derived) = input.sample(filter.state(), gx, gz, &f, SAMPLE_INTERVAL_S);
+                if derived == ToolAxisRate::Unavailable {
+                    self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
+                }
+                filter.step(&sample);
+            }
         }
-        if let Some(segment) = aligned {
-            self.finish_alignment(&segment);
+        if let Some(segment) = coarse_done {
+            self.finish_coarse_alignment(&segment);
         }
-        self.solution(raw)
+        if fine_done {
+            self.filter.start_navigation();
+            self.phase = Phase::Navigating {
+                input: ProbeInput::new(),
+            };
+        }
     }
 
-    fn finish_alignment(&mut self, segment: &StaticSegment) {
+    fn finish_coarse_alignment(&mut self, segment: &StaticSegment) {
+        let noise = ImuNoise::scc1300();
         let config = AlignmentConfig {
             latitude: self.position.lat,
             sample_interval: SAMPLE_INTERVAL_S,
             gyro_axes: PROBE_GYROS,
-            noise: ImuNoise::scc1300(),
+            noise,
             heading_prior: None,
         };
         let (roll, pitch, roll_pitch_std) = match level_segment(segment, &config) {
@@ -141,21 +228,26 @@ impl Navigator {
             Err(_) => (0.0, 0.0, [f64::NAN; 2]),
         };
         // Without a usable heading the solution runs on with heading 0 and
-        // says so through its (infinite) standard deviation.
+        // says so through its (infinite) standard deviation; the filter
+        // starts it with its largest prior (30 deg, see `physical`).
         let (heading, heading_std) = match gyrocompass(core::slice::from_ref(segment), &config) {
             Ok(h) if h.determined => (h.heading.value, h.heading.sigma),
             Ok(h) => (h.heading.value, f64::INFINITY),
             Err(_) => (0.0, f64::INFINITY),
         };
-        self.attitude_std = [roll_pitch_std[0], roll_pitch_std[1], heading_std].map(|s| s as f32);
+        self.heading_determined = heading_std.is_finite();
+        let sigma = [roll_pitch_std[0], roll_pitch_std[1], heading_std];
+        self.coarse_std = sigma.map(|s| s as f32);
+        // A levelling that failed leaves no tilt sigma: the filter then
+        // starts from a 10 deg one.
+        let filter_sigma = sigma.map(|s| if s.is_nan() { 10f64.to_radians() } else { s });
         let attitude = quat_from_euler(&Euler::new(roll, pitch, heading));
-        self.phase = Phase::Navigating {
-            nav: Strapdown::new(
-                NavState::at_rest(attitude, self.position),
-                SAMPLE_INTERVAL_S,
-            ),
-            input: ProbeInput::new(),
-        };
+        self.filter.restart(
+            NavState::at_rest(attitude, self.position),
+            self.position,
+            filter_config(&self.position, &filter_sigma),
+        );
+        self.phase = Phase::Fine { samples: 0 };
     }
 
     fn solution(&self, raw: &RawSample) -> NavSolution {
@@ -167,27 +259,46 @@ impl Navigator {
             latitude: self.position.lat,
             longitude: self.position.lon,
             height: self.position.height as f32,
-            attitude_std: self.attitude_std,
+            attitude_std: self.coarse_std,
             // No filter yet: velocity and position uncertainty unknown.
             velocity_std: [f32::NAN; 3],
             position_std_ned: [f32::NAN; 3],
             ..NavSolution::default()
         };
-        if let Phase::Navigating { nav, .. } = &self.phase {
-            let state = nav.state();
-            let e = euler_from_quat(&state.attitude);
-            solution.mode = nav_mode::NAVIGATING;
-            solution.attitude = [e.roll, e.pitch, e.heading].map(|a| a as f32);
-            solution.velocity_ned =
-                [state.velocity.x, state.velocity.y, state.velocity.z].map(|v| v as f32);
-            solution.latitude = state.position.lat;
-            solution.longitude = state.position.lon;
-            solution.height = state.position.height as f32;
-        }
+        solution.mode = match self.phase {
+            Phase::Coarse { .. } => return solution,
+            Phase::Fine { .. } => nav_mode::FINE_ALIGNMENT,
+            Phase::Navigating { .. } => nav_mode::NAVIGATING,
+        };
+        let filter = &self.filter;
+        let state = filter.state();
+        let e = euler_from_quat(&state.attitude);
+        solution.attitude = [e.roll, e.pitch, e.heading].map(|a| a as f32);
+        let v = state.velocity;
+        solution.velocity_ned = [v.x, v.y, v.z].map(|v| v as f32);
+        solution.latitude = state.position.lat;
+        solution.longitude = state.position.lon;
+        solution.height = state.position.height as f32;
+        let std = filter.euler_std();
+        let heading_std = if self.heading_determined {
+            std.z as f32
+        } else {
+            f32::INFINITY
+        };
+        solution.attitude_std = [std.x as f32, std.y as f32, heading_std];
+        let kalman = filter.filter();
+        solution.velocity_std = core::array::from_fn(|i| kalman.std_dev(VEL + i));
+        solution.position_std_ned = core::array::from_fn(|i| kalman.std_dev(POS + i));
         solution
     }
 
+    /// True once the coarse alignment is done.
     pub fn is_aligned(&self) -> bool {
+        !matches!(self.phase, Phase::Coarse { .. })
+    }
+
+    /// True once the fine alignment is done too.
+    pub fn is_navigating(&self) -> bool {
         matches!(self.phase, Phase::Navigating { .. })
     }
 }
@@ -195,16 +306,15 @@ impl Navigator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mwd_core::calibration::TriadCalibration;
     use mwd_core::protocol::RawPart;
     use mwd_core::sensor_units::{m_s2_to_accel_count, STANDARD_GRAVITY_M_S2};
 
-    /// A still, level probe: gravity's reaction on body +z, no rotation
-    /// (the hil-mock generator's static probe, which has no earth rate).
-    fn level_sample(n: u32) -> RawSample {
+    /// A still probe feeling `force` (body axes, m/s^2), no rotation (the
+    /// hil-mock generator's static probe, which has no earth rate).
+    fn still_sample(n: u32, force: [f32; 3]) -> RawSample {
         let parts = PART_MOUNTINGS.map(|mounting| RawPart {
-            accel: mounting
-                .body_to_sensor([0.0, 0.0, STANDARD_GRAVITY_M_S2])
-                .map(m_s2_to_accel_count),
+            accel: mounting.body_to_sensor(force).map(m_s2_to_accel_count),
             flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
             ..RawPart::default()
         });
@@ -215,12 +325,20 @@ mod tests {
         }
     }
 
+    /// Level: gravity's reaction on body +z.
+    fn level_sample(n: u32) -> RawSample {
+        still_sample(n, [0.0, 0.0, STANDARD_GRAVITY_M_S2])
+    }
+
+    const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
+
     #[test]
-    fn aligns_on_still_samples_then_navigates_level() {
+    fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
         let mut navigator = Navigator::new(Position::paper_site());
         for n in 0..ALIGNMENT_SAMPLES - 1 {
             let s = navigator.step(&level_sample(n));
             assert_eq!((s.mode, s.flags), (nav_mode::COARSE_ALIGNMENT, 0));
+            assert!(s.velocity_std[0].is_nan());
         }
         // A sample with an invalid part is flagged and does not count.
         let mut bad = level_sample(99);
@@ -229,15 +347,93 @@ mod tests {
         assert_eq!(s.flags, nav_flags::SENSOR_DEGRADED);
         assert!(!navigator.is_aligned());
 
-        let s = navigator.step(&level_sample(100));
-        assert!(navigator.is_aligned());
-        assert_eq!(s.mode, nav_mode::NAVIGATING);
-        assert!(s.attitude[0].abs() < 1e-3 && s.attitude[1].abs() < 1e-3);
-        assert!(s.attitude_std[0] > 0.0 && s.attitude_std[1] > 0.0);
-        for n in 101..140 {
-            let s = navigator.step(&level_sample(n));
-            assert_eq!(s.sample_counter, n);
-            assert!(s.attitude[0].abs() < 1e-3 && s.attitude[1].abs() < 1e-3);
+        // The coarse alignment ends: the filter takes over.
+        let first = navigator.step(&level_sample(100));
+        assert!(navigator.is_aligned() && !navigator.is_navigating());
+        assert_eq!(first.mode, nav_mode::FINE_ALIGNMENT);
+        assert!(first.attitude_std[0] > 0.0 && first.attitude_std[1] > 0.0);
+        let mut last = first;
+        for n in 101..=ALL_ALIGNMENT {
+            last = navigator.step(&level_sample(n));
+            assert_eq!(last.sample_counter, n);
+            assert!(last.attitude[0].abs() < 1e-3 && last.attitude[1].abs() < 1e-3);
+            if n < ALL_ALIGNMENT {
+                assert_eq!(last.mode, nav_mode::FINE_ALIGNMENT, "sample {n}");
+                assert_eq!(last.flags, nav_flags::ZUPT_APPLIED, "sample {n}");
+            }
         }
+        // After 60 s the probe navigates; the zero updates are over.
+        assert!(navigator.is_navigating());
+        assert_eq!(last.mode, nav_mode::NAVIGATING);
+        // No earth rate in these samples: the heading stays unknown, and
+        // the frames say so rather than quoting the filter's small-angle
+        // azimuth sigma.
+        assert!(last.attitude_std[2].is_infinite(), "{last:?}");
+        // The fine alignment converged in velocity and position; the tilt
+        // sigmas stay at the floor the accelerometer bias sets (at rest
+        // tilt and bias are inseparable: sigma_tilt >= sigma_b / g,
+        // docs/filter-derivation.md section 3b), a little above it as the
+        // bias random walk grows.
+        let floor = (AugmentedModel::paper().biases.accel[0].initial_sigma
+            / f64::from(STANDARD_GRAVITY_M_S2)) as f32;
+        for axis in 0..2 {
+            let sigma = last.attitude_std[axis];
+            assert!(
+                sigma >= 0.99 * floor && sigma < 1.5 * first.attitude_std[axis],
+                "floor {floor}: {first:?} -> {last:?}"
+            );
+        }
+        for i in 0..3 {
+            assert!(
+                last.velocity_std[i] < 0.2 * first.velocity_std[i],
+                "{last:?}"
+            );
+            assert!(
+                last.position_std_ned[i] < 0.2 * first.position_std_ned[i],
+                "{last:?}"
+            );
+        }
+
+        // Navigating without zero updates, the uncertainties grow.
+        let mut later = last;
+        for n in ALL_ALIGNMENT + 1..ALL_ALIGNMENT + 200 {
+            later = navigator.step(&level_sample(n));
+            assert_eq!(later.mode, nav_mode::NAVIGATING);
+            assert_eq!(later.flags & nav_flags::ZUPT_APPLIED, 0);
+        }
+        assert!(
+            later.velocity_std[0] > 2.0 * last.velocity_std[0],
+            "{later:?}"
+        );
+        assert!(
+            later.position_std_ned[0] > last.position_std_ned[0],
+            "{later:?}"
+        );
+    }
+
+    #[test]
+    fn the_calibration_removes_an_accelerometer_bias_before_alignment() {
+        // 10 counts (~0.15 m/s^2) of bias on body x tilt an uncalibrated
+        // probe by ~0.9 deg in roll; the calibration takes it out.
+        let bias = 10.0 * STANDARD_GRAVITY_M_S2 / 650.0;
+        let biased = |n| still_sample(n, [bias, 0.0, STANDARD_GRAVITY_M_S2]);
+        let triad = TriadCalibration {
+            bias: [f64::from(bias), 0.0, 0.0],
+            ..TriadCalibration::IDENTITY
+        };
+        let calibration = ProbeCalibration {
+            accel: [triad; 2],
+            ..ProbeCalibration::default()
+        };
+        let mut plain = Navigator::new(Position::paper_site());
+        let mut calibrated = Navigator::with_calibration(Position::paper_site(), calibration);
+        let (mut a, mut b) = (NavSolution::default(), NavSolution::default());
+        for n in 0..=ALIGNMENT_SAMPLES {
+            a = plain.step(&biased(n));
+            b = calibrated.step(&biased(n));
+        }
+        let tilt = (bias / STANDARD_GRAVITY_M_S2).atan();
+        assert!((a.attitude[0].abs() - tilt).abs() < 0.05 * tilt, "{a:?}");
+        assert!(b.attitude[0].abs() < 0.02 * tilt, "{b:?}");
     }
 }

@@ -5,6 +5,7 @@
 
 use super::units::InputUnit;
 use anyhow::{bail, Context, Result};
+use mwd_core::calibration::ProbeCalibration;
 use std::path::Path;
 
 /// A table of finite numbers, one `Vec` per column.
@@ -154,7 +155,10 @@ fn capture_columns(path: &Path) -> Result<Columns> {
         let Payload::Raw(raw) = frame.payload else {
             continue;
         };
-        let Some((gx, gz, f)) = firmware::app::navigation::body_sample(&raw) else {
+        // The raw sensor, uncalibrated: noise analysis characterises it as it is.
+        let Some((gx, gz, f)) =
+            firmware::app::navigation::body_sample(&raw, &ProbeCalibration::default())
+        else {
             skipped += 1;
             continue;
         };

@@ -32,7 +32,7 @@ use firmware::app::{start_parts, AcquisitionCycle, FrameQueue, Navigator, TX_QUE
 use firmware::scc1300::PartReading;
 use heapless::Deque;
 use mwd_core::earth::Position;
-use mwd_core::protocol::frame::NO_PART;
+use mwd_core::protocol::frame::{nav_mode, NO_PART};
 use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
 
 use mock_sensors::{Sensors, TickDelay, TICKS};
@@ -206,6 +206,11 @@ struct CycleCost {
     /// above), and the longest such stretch of work.
     overruns: u32,
     longest_overrun: u64,
+    /// The periods in which the navigation changed mode (the once-only
+    /// coarse alignment and the filter's start): not in `worst`/`total`,
+    /// their longest is reported on its own.
+    mode_changes: u32,
+    longest_mode_change: u64,
 }
 
 #[entry]
@@ -235,14 +240,19 @@ fn main() -> ! {
     let mut cost = CycleCost::default();
     // The simulated site: the MGWD paper's test site.
     let mut navigator = Navigator::new(Position::paper_site());
+    let mut mode = nav_mode::INITIALISING;
     loop {
         registers::watchdog_feed();
         let tick = TICKS.load(Ordering::Relaxed);
         if let Some(job) = with_shared(|shared, _| shared.recovery.take()) {
             recover(job);
         }
+        let mut mode_changed = false;
         while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop_front()) {
-            push(&Payload::Nav(navigator.step(&sample)));
+            let solution = navigator.step(&sample);
+            mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
+            mode = solution.mode;
+            push(&Payload::Nav(solution));
         }
         if cfg!(feature = "qemu-stall-demo") && with_shared(|s, _| s.cycle.samples()) >= 200 {
             // A hung main loop (the watchdog run): interrupts go on.
@@ -261,7 +271,12 @@ fn main() -> ! {
         // (only if no new period started meanwhile).
         let elapsed = RELOAD - SYST::get_current();
         let now_tick = TICKS.load(Ordering::Relaxed);
-        if now_tick != tick {
+        if mode_changed {
+            let periods = now_tick.wrapping_sub(tick);
+            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
+            cost.mode_changes += 1;
+            cost.longest_mode_change = cost.longest_mode_change.max(ticks);
+        } else if now_tick != tick {
             // Whole periods plus this one's part (read before the tick
             // count, so possibly one period short: a lower bound).
             let periods = now_tick.wrapping_sub(tick);
@@ -289,6 +304,8 @@ struct Summary {
     nav_dropped: u32,
     overruns: u32,
     longest_overrun_ticks: u64,
+    mode_changes: u32,
+    longest_mode_change_ticks: u64,
 }
 
 fn summary(cost: &CycleCost) -> Summary {
@@ -304,5 +321,7 @@ fn summary(cost: &CycleCost) -> Summary {
         nav_dropped: s.nav_dropped,
         overruns: cost.overruns,
         longest_overrun_ticks: cost.longest_overrun,
+        mode_changes: cost.mode_changes,
+        longest_mode_change_ticks: cost.longest_mode_change,
     })
 }

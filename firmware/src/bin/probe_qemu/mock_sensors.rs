@@ -13,7 +13,7 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::scc1300::Part;
 use hil_mock::{
-    AccelSpi, Chance, Generator, GyroSpi, MockBusError, MountedSource, Scc1300, TimeSource, Window,
+    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe, TimeSource, Window,
 };
 use mwd_core::sensor_units::PART_MOUNTINGS;
 
@@ -47,21 +47,15 @@ impl DelayNs for TickDelay {
     }
 }
 
-type MockPart = Scc1300<BoardClock, MountedSource<Generator>>;
+/// The parts sense a probe lying still at the MGWD paper's site and
+/// attitude, with earth rate, gravity, residual biases and white noise
+/// (`hil_mock::StillProbe`); each part has its own noise stream.
+type MockPart = Scc1300<BoardClock, MountedSource<StillProbe>>;
 
 /// The two simulated parts; set once at boot, then used from whichever
 /// context (timer interrupt or main loop) holds the driver.
 static PARTS: Mutex<[OnceCell<RefCell<MockPart>>; 2]> =
     Mutex::new([OnceCell::new(), OnceCell::new()]);
-
-/// A probe at rest: no rotation, the tool horizontal, temperature creeping.
-fn static_probe() -> Generator {
-    Generator {
-        roll_rate_rad_s: 0.0,
-        wobble_rad_s: 0.0,
-        ..Generator::default()
-    }
-}
 
 /// Which slave of a part a [`MockBus`] selects.
 #[derive(Clone, Copy)]
@@ -104,7 +98,7 @@ pub fn power_up() -> Sensors {
     critical_section::with(|cs| {
         for (index, cell) in PARTS.borrow(cs).iter().enumerate() {
             let source = MountedSource {
-                body: static_probe(),
+                body: StillProbe::paper_test(1 + index as u64),
                 mounting: PART_MOUNTINGS[index],
             };
             // Already set only if called twice; keep the first parts then.
