@@ -293,20 +293,29 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     assert!(seen(EventKind::SensorFault, 0, 10, 11), "{events:#?}");
     assert!(seen(EventKind::SensorFault, 1, 20, 21), "{events:#?}");
     assert!(seen(EventKind::SensorFault, 0, 30, 31), "{events:#?}");
-    // The recoveries ran, succeeded (code 0) and the stream resynchronised.
-    // A power-cycled part takes its 800 ms start-up again: within 2 s.
-    for (part, at_s) in [(1, 20), (0, 30)] {
+    // The recoveries ran, succeeded and the stream resynchronised. A
+    // power-cycled part takes its 800 ms start-up again: within 2 s. The
+    // reset event says what the recovery did: 0 for part 1's transient
+    // S_OK drop, the loop-failure code for part 0, whose gyro came back
+    // from the power cycle with its loop off and was soft-reset.
+    let loop_failure = firmware::scc1300::Error::LoopFailure.code();
+    for (part, at_s, code) in [(1, 20, 0), (0, 30, loop_failure)] {
         assert!(
-            seen(EventKind::SensorReset, part, at_s, at_s + 2),
-            "{events:#?}"
-        );
-        assert!(
-            events
-                .iter()
-                .all(|e| e.kind != EventKind::SensorReset || e.code == 0),
+            events.iter().any(|e| e.kind == EventKind::SensorReset
+                && e.part == part
+                && e.code == code
+                && (at_s..at_s + 2).contains(&(e.time_us / 1_000_000))),
             "{events:#?}"
         );
     }
+    assert_eq!(
+        events
+            .iter()
+            .filter(|e| e.kind == EventKind::SensorReset)
+            .count(),
+        2,
+        "{events:#?}"
+    );
     // Each resynchronisation says how many samples its recovery cost.
     let resyncs: u64 = events
         .iter()

@@ -8,7 +8,7 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
 use mwd_core::protocol::{Event, EventKind, Payload};
 
-use crate::scc1300::{Error, Part};
+use crate::scc1300::{Error, Part, Recovery, RecoveryReport};
 
 /// Start-up attempts per part before giving up on it.
 pub const START_ATTEMPTS: u32 = 3;
@@ -53,6 +53,19 @@ pub fn start_parts<G: SpiDevice, A: SpiDevice>(
     outcome
 }
 
+/// The `code` of the SensorReset event that reports a recovery: 0 when the
+/// part came back by itself (a transient S_OK drop) or only its
+/// accelerometer was restarted, the loop-failure code when the gyro had to
+/// be soft-reset (its loop was off: a loop failure, or the start-up after a
+/// power cycle), and the error's own code when the recovery failed.
+pub fn reset_event_code(outcome: &Result<RecoveryReport, Error>) -> u16 {
+    match outcome {
+        Ok(report) if report.gyro == Some(Recovery::SoftReset) => Error::LoopFailure.code(),
+        Ok(_) => 0,
+        Err(error) => error.code(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -62,6 +75,25 @@ mod tests {
     use hil_mock::{AccelSpi, Constant, DeadLevel, GyroSpi, Scc1300, SimClock, SimDelay};
     use mwd_core::protocol::Decoder;
     use std::vec::Vec;
+
+    #[test]
+    fn reset_event_codes_tell_transient_soft_reset_and_failure_apart() {
+        let transient = RecoveryReport {
+            gyro: Some(Recovery::Transient),
+            accel_restarted: true,
+        };
+        let soft_reset = RecoveryReport {
+            gyro: Some(Recovery::SoftReset),
+            accel_restarted: false,
+        };
+        assert_eq!(reset_event_code(&Ok(transient)), 0);
+        assert_eq!(reset_event_code(&Ok(soft_reset)), Error::LoopFailure.code());
+        assert_eq!(
+            reset_event_code(&Err(Error::NotReady)),
+            Error::NotReady.code()
+        );
+        assert_ne!(Error::LoopFailure.code(), 0);
+    }
 
     #[test]
     fn a_dead_part_is_retried_reported_and_the_other_starts() {

@@ -59,7 +59,8 @@ pub mod raw_flags {
     pub const ACCEL_VALID: u16 = 1 << 1;
     /// The gyro's S_OK status bit was set.
     pub const GYRO_S_OK: u16 = 1 << 2;
-    /// The gyro rate sits at a 14-bit limit (beyond range).
+    /// The gyro rate is beyond the specified +-300 deg/s (5400 counts) or
+    /// at a 14-bit limit.
     pub const GYRO_SATURATED: u16 = 1 << 3;
     /// The accelerometer reported SAT.
     pub const ACCEL_SATURATED: u16 = 1 << 4;

@@ -28,12 +28,14 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception};
 use critical_section::{CriticalSection, Mutex};
-use firmware::app::{start_parts, AcquisitionCycle, FrameQueue, Navigator, TX_QUEUE_LEN};
+use firmware::app::{
+    reset_event_code, start_parts, AcquisitionCycle, FrameQueue, Navigator, SampleInbox,
+    NAV_INBOX_LEN, TX_QUEUE_LEN,
+};
 use firmware::scc1300::PartReading;
-use heapless::Deque;
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::{nav_mode, NO_PART};
-use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
+use mwd_core::protocol::{Event, EventKind, Payload};
 
 use mock_sensors::{Sensors, TickDelay, TICKS};
 use registers::SYSTEM_CLOCK_HZ;
@@ -43,9 +45,6 @@ const RUN_SECONDS: u32 = parse_seconds(option_env!("PROBE_QEMU_RUN_SECONDS"), 60
 const SAMPLES_TO_RUN: u32 = RUN_SECONDS * 20;
 /// SysTick reload for 20 Hz at the board's clock.
 const RELOAD: u32 = SYSTEM_CLOCK_HZ / 20 - 1;
-/// Raw samples waiting for the navigation: enough for the longest sensor
-/// recovery (about a second), during which the main loop is busy.
-const NAV_INBOX_LEN: usize = 32;
 /// The main loop must come round within this (it normally does every
 /// 50 ms; a sensor recovery holds it up to about a second).
 const WATCHDOG_MS: u32 = 2_000;
@@ -85,8 +84,7 @@ struct Shared {
     tx_busy: bool,
     /// Samples from the acquisition to the navigation; the oldest is
     /// dropped (and counted) when the navigation falls behind.
-    nav_inbox: Deque<RawSample, NAV_INBOX_LEN>,
-    nav_dropped: u32,
+    nav_inbox: SampleInbox<NAV_INBOX_LEN>,
 }
 
 static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
@@ -96,8 +94,7 @@ static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
     cycle: AcquisitionCycle::new(),
     queue: FrameQueue::new(),
     tx_busy: false,
-    nav_inbox: Deque::new(),
-    nav_dropped: 0,
+    nav_inbox: SampleInbox::new(),
 }));
 
 fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
@@ -149,11 +146,7 @@ fn SysTick() {
             .as_mut()
             .map(|parts| parts.each_mut().map(|part| part.sample()));
         let report = shared.cycle.run(readings, &mut shared.queue);
-        if let Err(sample) = shared.nav_inbox.push_back(report.sample) {
-            shared.nav_inbox.pop_front();
-            let _ = shared.nav_inbox.push_back(sample);
-            shared.nav_dropped += 1;
-        }
+        shared.nav_inbox.push(report.sample);
         if report.any_recovery() {
             if let (Some(readings), Some(sensors)) = (readings, shared.sensors.take()) {
                 shared.recovery = Some(Recovery { sensors, readings });
@@ -180,10 +173,7 @@ fn recover(mut job: Recovery) {
         if !reading.needs_recovery() {
             continue;
         }
-        let code = match part.recover(&mut TickDelay, reading) {
-            Ok(_) => 0,
-            Err(error) => error.code(),
-        };
+        let code = reset_event_code(&part.recover(&mut TickDelay, reading));
         push(&event(EventKind::SensorReset, index as u8, code, 0));
     }
     // The samples this recovery cost (taken with no data).
@@ -248,7 +238,7 @@ fn main() -> ! {
             recover(job);
         }
         let mut mode_changed = false;
-        while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop_front()) {
+        while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop()) {
             let solution = navigator.step(&sample);
             mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
             mode = solution.mode;
@@ -318,7 +308,7 @@ fn summary(cost: &CycleCost) -> Summary {
         worst_ticks: cost.worst,
         mean_ticks,
         stack_bytes: stack_paint::high_water_bytes(),
-        nav_dropped: s.nav_dropped,
+        nav_dropped: s.nav_inbox.dropped(),
         overruns: cost.overruns,
         longest_overrun_ticks: cost.longest_overrun,
         mode_changes: cost.mode_changes,

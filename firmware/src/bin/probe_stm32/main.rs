@@ -19,12 +19,14 @@ use core::cell::RefCell;
 use cortex_m_rt::entry;
 use critical_section::{CriticalSection, Mutex};
 use defmt_rtt as _;
-use firmware::app::{start_parts, AcquisitionCycle, FrameQueue, Navigator, TX_QUEUE_LEN};
+use firmware::app::{
+    reset_event_code, start_parts, AcquisitionCycle, FrameQueue, Navigator, SampleInbox,
+    NAV_INBOX_LEN, TX_QUEUE_LEN,
+};
 use firmware::scc1300::PartReading;
-use heapless::Deque;
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::NO_PART;
-use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
+use mwd_core::protocol::{Event, EventKind, Payload};
 use panic_probe as _;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, NVIC};
 use stm32f4xx_hal::prelude::*;
@@ -33,8 +35,6 @@ use stm32f4xx_hal::timer::{Event as TimerEvent, Flag};
 
 use board::{Sensors, Timer, Uart};
 
-/// See the QEMU probe: enough for the longest recovery (about a second).
-const NAV_INBOX_LEN: usize = 32;
 /// The main loop must come round within this (a recovery holds it ~1 s).
 const WATCHDOG_MS: u32 = 2_000;
 const VERSION: u16 = 1;
@@ -57,8 +57,7 @@ struct Shared {
     queue: FrameQueue<TX_QUEUE_LEN>,
     uart: Option<Uart>,
     timer: Option<Timer>,
-    nav_inbox: Deque<RawSample, NAV_INBOX_LEN>,
-    nav_dropped: u32,
+    nav_inbox: SampleInbox<NAV_INBOX_LEN>,
 }
 
 static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
@@ -69,8 +68,7 @@ static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
     queue: FrameQueue::new(),
     uart: None,
     timer: None,
-    nav_inbox: Deque::new(),
-    nav_dropped: 0,
+    nav_inbox: SampleInbox::new(),
 }));
 
 fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
@@ -117,11 +115,7 @@ fn TIM2() {
             .as_mut()
             .map(|parts| parts.each_mut().map(|part| part.sample()));
         let report = shared.cycle.run(readings, &mut shared.queue);
-        if let Err(sample) = shared.nav_inbox.push_back(report.sample) {
-            shared.nav_inbox.pop_front();
-            let _ = shared.nav_inbox.push_back(sample);
-            shared.nav_dropped += 1;
-        }
+        shared.nav_inbox.push(report.sample);
         if report.any_recovery() {
             if let (Some(readings), Some(sensors)) = (readings, shared.sensors.take()) {
                 shared.recovery = Some(Recovery { sensors, readings });
@@ -154,10 +148,7 @@ fn recover(mut job: Recovery, delay: &mut stm32f4xx_hal::timer::SysDelay) {
         if !reading.needs_recovery() {
             continue;
         }
-        let code = match part.recover(delay, reading) {
-            Ok(_) => 0,
-            Err(error) => error.code(),
-        };
+        let code = reset_event_code(&part.recover(delay, reading));
         defmt::warn!("part {=usize} recovered, code {=u16}", index, code);
         push(&event(EventKind::SensorReset, index as u8, code, 0));
     }
@@ -220,7 +211,7 @@ fn main() -> ! {
         if let Some(job) = with_shared(|shared, _| shared.recovery.take()) {
             recover(job, &mut delay);
         }
-        while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop_front()) {
+        while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop()) {
             push(&Payload::Nav(navigator.step(&sample)));
         }
         cortex_m::asm::wfi();
