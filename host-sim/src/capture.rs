@@ -3,6 +3,7 @@
 //! frames, reading and decoding a capture with its loss statistics, and
 //! exporting the frames as CSV.
 
+use firmware::scc1300::datasheet::GYRO_RANGE_COUNTS;
 use std::fmt;
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
@@ -33,8 +34,9 @@ pub struct SiSample {
 
 /// Turns a simulated sample into the raw-sample frame the probe would send:
 /// body -> part axes through `PART_MOUNTINGS`, SI -> 14-bit counts
-/// (rounded, saturated), flags "valid, S_OK" (and saturation when a count
-/// hits a 14-bit limit).
+/// (rounded, saturated), flags "valid, S_OK" (and saturation where the
+/// probe's driver flags it: a gyro count beyond the specified range or at
+/// a 14-bit limit).
 pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
     let [x, z] = sample.gyro_body_xz_rad_s;
     // The tool-axis (y) rate is not sensed by either gyro.
@@ -53,10 +55,12 @@ pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
         part.accel = sensor.map(sensor_units::m_s2_to_accel_count);
         part.accel_temp = ACCEL_TEMPERATURE.degc_to_count(temp);
         part.flags = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
-        if matches!(
-            part.gyro_rate,
-            sensor_units::COUNT_MIN | sensor_units::COUNT_MAX
-        ) {
+        if part.gyro_rate.unsigned_abs() > GYRO_RANGE_COUNTS.unsigned_abs()
+            || matches!(
+                part.gyro_rate,
+                sensor_units::COUNT_MIN | sensor_units::COUNT_MAX
+            )
+        {
             part.flags |= raw_flags::GYRO_SATURATED;
         }
     }

@@ -11,6 +11,8 @@
 //! reports EIO, a USB adapter pulled reports an I/O error) or the time limit
 //! is.
 
+use firmware::app::Navigator;
+use mwd_core::calibration::ProbeCalibration;
 use std::fmt;
 use std::io::{self, ErrorKind, Read};
 use std::time::{Duration, Instant};
@@ -101,6 +103,8 @@ pub struct LiveOptions {
     pub duration: Option<Duration>,
     /// Shortest time between two status lines.
     pub display_interval: Duration,
+    /// The probe's sensor calibration, for the replay (identity: none).
+    pub calibration: ProbeCalibration,
 }
 
 impl Default for LiveOptions {
@@ -108,6 +112,7 @@ impl Default for LiveOptions {
         Self {
             duration: None,
             display_interval: Duration::from_millis(250),
+            calibration: ProbeCalibration::default(),
         }
     }
 }
@@ -132,7 +137,8 @@ pub fn run(
     let started = Instant::now();
     let mut last_shown: Option<Instant> = None;
     let mut decoder = Decoder::new();
-    let mut replayer = Replayer::new(position);
+    let mut replayer =
+        Replayer::with_navigator(Navigator::with_calibration(position, options.calibration));
     let mut frames: Vec<Frame> = Vec::new();
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];
@@ -240,6 +246,7 @@ mod tests {
         let options = LiveOptions {
             duration: None,
             display_interval: Duration::ZERO,
+            ..LiveOptions::default()
         };
         let mut shown = Vec::new();
         let outcome = run(source, Position::paper_site(), options, |s| {

@@ -33,9 +33,15 @@ pub struct ReplaySummary {
 }
 
 /// Replays every raw frame of `frames` through the navigation, starting at
-/// `position` (the probe's configured site).
+/// `position` (the probe's configured site), with uncalibrated sensors.
 pub fn replay(frames: &[Frame], position: Position) -> (Vec<ReplayRow>, ReplaySummary) {
-    let mut replayer = Replayer::new(position);
+    replay_with(frames, Navigator::new(position))
+}
+
+/// The same through a given navigator (e.g. one holding the probe's
+/// calibration, `Navigator::with_calibration`).
+pub fn replay_with(frames: &[Frame], navigator: Navigator) -> (Vec<ReplayRow>, ReplaySummary) {
+    let mut replayer = Replayer::with_navigator(navigator);
     for frame in frames {
         replayer.push(frame);
     }
@@ -59,8 +65,12 @@ pub struct Replayer {
 
 impl Replayer {
     pub fn new(position: Position) -> Self {
+        Self::with_navigator(Navigator::new(position))
+    }
+
+    pub fn with_navigator(navigator: Navigator) -> Self {
         Self {
-            navigator: Navigator::new(position),
+            navigator,
             rows: Vec::new(),
             awaiting_probe: HashMap::new(),
             early_probe: HashMap::new(),
@@ -229,5 +239,30 @@ mod tests {
         let text = String::from_utf8(csv).unwrap();
         assert_eq!(text.lines().count(), 151);
         assert!(text.lines().nth(121).unwrap().ends_with(",no"));
+    }
+
+    #[test]
+    fn a_replay_applies_the_probes_calibration() {
+        use mwd_core::calibration::{ProbeCalibration, TriadCalibration};
+        // The same still, level samples; a calibration claiming a body-x
+        // accelerometer bias of 10 counts tilts the replayed roll by
+        // atan(bias / g), as the probe with that calibration would.
+        let site = Position::paper_site();
+        let raws: Vec<Frame> = (0..120).map(raw).collect();
+        let bias = 10.0 * f64::from(STANDARD_GRAVITY_M_S2) / 650.0;
+        let triad = TriadCalibration {
+            bias: [bias, 0.0, 0.0],
+            ..TriadCalibration::IDENTITY
+        };
+        let calibration = ProbeCalibration {
+            accel: [triad; 2],
+            ..ProbeCalibration::default()
+        };
+        let (plain, _) = replay(&raws, site);
+        let (calibrated, _) = replay_with(&raws, Navigator::with_calibration(site, calibration));
+        let roll = |rows: &[ReplayRow]| f64::from(rows[110].solution.attitude[0]);
+        let expected = (bias / f64::from(STANDARD_GRAVITY_M_S2)).atan();
+        assert!(roll(&plain).abs() < 1e-3, "{}", roll(&plain));
+        assert!((roll(&calibrated).abs() - expected).abs() < 0.05 * expected);
     }
 }

@@ -129,13 +129,25 @@ fn simulate_writes_a_binary_capture_that_decodes_cleanly() {
     let (ok, _, err) = host_sim(&["simulate", "--duration", "5", "-o", path]);
     assert!(ok, "{err}");
     let bytes = std::fs::read(&bin).expect("capture written");
-    // 100 raw-sample frames of 51 bytes on the wire (docs/protocol.md).
-    assert_eq!(bytes.len(), 100 * 51);
+    // What the probe sends (docs/protocol.md): a boot event (27 bytes on
+    // the wire), then per sample a raw frame (51) and a navigation frame
+    // (106).
+    assert_eq!(bytes.len(), 27 + 100 * (51 + 106));
     let (ok, out, err) = host_sim(&["decode", path]);
     assert!(ok, "{err}");
-    assert!(out.contains("raw sample 100"), "{out}");
+    assert!(
+        out.contains("raw sample 100, navigation 100, event 1"),
+        "{out}"
+    );
     assert!(
         out.contains("0 frames lost") && out.contains("0 CRC failures"),
+        "{out}"
+    );
+    // Its navigation frames are the probe's own code's: a replay agrees.
+    let (ok, out, err) = host_sim(&["replay", path]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("replay parity    100 identical, 0 different"),
         "{out}"
     );
     let _ = std::fs::remove_file(bin);

@@ -12,9 +12,12 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::Context;
+use firmware::app::Navigator;
+use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::capture::Capture;
 use host_sim::live::{self, LiveOptions};
 use host_sim::replay::{self, ReplayRow, ReplaySummary};
+use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
 
 #[derive(clap::Args, Debug)]
@@ -40,12 +43,21 @@ pub struct Args {
     /// QEMU probe uses the MGWD paper's site.
     #[arg(long, num_args = 3, value_names = ["LAT", "LON", "HEIGHT"], allow_negative_numbers = true)]
     pub site: Option<Vec<f64>>,
+    /// The probe's sensor calibration (`host-sim calibrate`'s JSON): the
+    /// replay applies it as the probe does. Default: none (the QEMU probe
+    /// runs uncalibrated).
+    #[arg(long, value_name = "PATH")]
+    pub calibration_file: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let site = match args.site.as_deref() {
         Some([lat, lon, height]) => Position::from_degrees(*lat, *lon, *height),
         _ => Position::paper_site(),
+    };
+    let calibration = match &args.calibration_file {
+        Some(path) => CalibrationFile::load(path)?.to_probe(),
+        None => ProbeCalibration::default(),
     };
     let (source, cap, rows, summary) = match (&args.port, &args.file) {
         (Some(port), _) => {
@@ -67,6 +79,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             std::io::stdout().flush()?;
             let options = LiveOptions {
                 duration,
+                calibration,
                 ..LiveOptions::default()
             };
             let outcome = live::run(serial, site, options, |status| println!("{status}"));
@@ -76,7 +89,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(file)) => {
             let cap = host_sim::capture::read_capture(file)
                 .with_context(|| format!("reading {}", file.display()))?;
-            let (rows, summary) = replay::replay(&cap.frames, site);
+            let navigator = Navigator::with_calibration(site, calibration);
+            let (rows, summary) = replay::replay_with(&cap.frames, navigator);
             (file.display().to_string(), cap, rows, summary)
         }
         (None, None) => anyhow::bail!("give a capture file or --port"),

@@ -1,7 +1,8 @@
 //! `host-sim simulate`: a trajectory through the probe's sensor model,
-//! written as a sample CSV.
+//! written as a sample CSV, or as the bytes the probe would send (`.bin`).
 use anyhow::{Context, Result};
 use clap::ValueEnum;
+use firmware::app::Navigator;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::sim::DeterministicErrors;
 use host_sim::sim::{
@@ -10,11 +11,16 @@ use host_sim::sim::{
 use host_sim::{capture, samples_csv};
 use mwd_core::conventions::Euler;
 use mwd_core::earth::Position;
+use mwd_core::protocol::frame::NO_PART;
+use mwd_core::protocol::{Event, EventKind, Payload};
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::PathBuf;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
+/// The `code` of a simulated capture's boot event (a real probe sends its
+/// firmware version, from 1): 0 marks the capture as the simulator's.
+const SIMULATED_FIRMWARE_VERSION: u16 = 0;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum MotionKind {
@@ -150,6 +156,7 @@ pub fn run(args: Args) -> Result<()> {
         return Ok(());
     }
     let trajectory = args.trajectory.trajectory();
+    let site = trajectory.position;
     let duration = args.duration.max(trajectory.scripted_duration());
     anyhow::ensure!(
         duration.is_finite() && duration > 0.0,
@@ -187,22 +194,35 @@ pub fn run(args: Args) -> Result<()> {
         );
         let mut capture = capture::create_capture(&args.output)
             .with_context(|| format!("creating {}", args.output.display()))?;
+        // What the probe sends: its boot event, then per sample the raw
+        // frame and the navigation frame its own navigation code (the same
+        // `Navigator` the firmware runs) makes of that raw frame.
+        capture.write(&Payload::Event(Event {
+            time_us: 0,
+            kind: EventKind::Boot,
+            part: NO_PART,
+            code: SIMULATED_FIRMWARE_VERSION,
+            value: 0,
+        }))?;
+        let mut navigator = Navigator::new(site);
         for (index, s) in samples.enumerate() {
             // Both parts' triads see the same body-frame specific force; the
             // capture's encoder turns each into its part's axes and counts.
             let accel = [s.accel.x, s.accel.y, s.accel.z];
-            capture.write_si_sample(&capture::SiSample {
+            let raw = capture::raw_sample_from_si(&capture::SiSample {
                 index: u32::try_from(index).context("more than 2^32 samples")?,
                 time_s: s.time,
                 gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
                 accel_body_m_s2: [accel, accel],
                 temperature_degc: 25.0,
-            })?;
+            });
+            capture.write(&Payload::Raw(raw))?;
+            capture.write(&Payload::Nav(navigator.step(&raw)))?;
         }
         let bytes = capture.bytes_written();
         capture.finish()?;
         eprintln!(
-            "wrote {n} raw-sample frames ({bytes} bytes) to {}",
+            "wrote a boot event and {n} raw-sample and navigation frames ({bytes} bytes) to {}",
             args.output.display()
         );
     } else if to_stdout {
