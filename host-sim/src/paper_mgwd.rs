@@ -321,17 +321,22 @@ pub fn ranks(coupling: Coupling) -> Ranks {
 mod tests {
     use super::*;
 
-    #[test]
-    fn paper_settings_azimuth_sigma_grows_while_tilt_sigmas_settle() {
+    /// Seed 3 of the full sensor model, coarse- then fine-aligned.
+    fn seed_3_history(settings: Settings) -> History {
         let records = simulate(3, true);
         let (coarse, sigma) = coarse_align(&records).expect("coarse alignment");
-        let h = fine_align(
+        fine_align(
             &records,
             &coarse,
             &sigma,
-            Settings::PaperCoupled,
+            settings,
             &AugmentedModel::paper(),
-        );
+        )
+    }
+
+    #[test]
+    fn paper_settings_azimuth_sigma_grows_while_tilt_sigmas_settle() {
+        let h = seed_3_history(Settings::PaperCoupled);
         let (early, late) = (h.euler_sigma_deg[100], h.euler_sigma_deg[SAMPLES - 1]);
         assert!(late[2] > 2.0 * early[2], "{early:?} -> {late:?}");
         // Tilt sigmas are pinned by the ZUPT: they stop changing.
@@ -359,15 +364,7 @@ mod tests {
     fn bias_state_settings_keep_an_honest_azimuth_sigma() {
         // Rate biases and azimuth are one east tilt drift at rest: the
         // azimuth sigma must not collapse, the tilt sigmas settle.
-        let records = simulate(3, true);
-        let (coarse, sigma) = coarse_align(&records).expect("coarse alignment");
-        let h = fine_align(
-            &records,
-            &coarse,
-            &sigma,
-            Settings::Physical,
-            &AugmentedModel::paper(),
-        );
+        let h = seed_3_history(Settings::Physical);
         let (early, late) = (h.euler_sigma_deg[100], h.euler_sigma_deg[SAMPLES - 1]);
         assert!(late[2] > 0.5 * early[2], "{early:?} -> {late:?}");
         let before = h.euler_sigma_deg[SAMPLES - 200];

@@ -10,6 +10,8 @@
 //! tilt at rest and is overconfident on such data (`host-sim paper mgwd`:
 //! 61 of 100 inside 3 sigma).
 
+mod common;
+use common::Normal;
 use mwd_core::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
 use mwd_core::attitude::level;
 use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, Euler};
@@ -26,21 +28,6 @@ const DT: f64 = 0.05;
 const SAMPLES: usize = 1200; // the paper's 60 s
 const COARSE_SAMPLES: usize = 100; // its 5 s of coarse alignment
 const AZIMUTH_SIGMA: f64 = 2.0 * core::f64::consts::PI / 180.0;
-
-/// Gaussian samples from xorshift64* and Box-Muller: no dependency, seeded.
-struct Normal(u64);
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn sample(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        libm::sqrt(-2.0 * libm::log(u)) * libm::cos(core::f64::consts::TAU * v)
-    }
-}
 
 /// One sensor channel: AR(4) noise + constant residual bias + first-order
 /// Gauss-Markov bias instability (started in its stationary state).
