@@ -28,16 +28,12 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception};
 use critical_section::{CriticalSection, Mutex};
-use firmware::app::{
-    reset_event_code, start_parts, AcquisitionCycle, FrameQueue, Navigator, SampleInbox,
-    NAV_INBOX_LEN, TX_QUEUE_LEN,
-};
-use firmware::scc1300::PartReading;
+use firmware::app::{start_parts, Navigator, ProbeState, Recovery};
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::{nav_mode, NO_PART};
-use mwd_core::protocol::{Event, EventKind, Payload};
+use mwd_core::protocol::{EventKind, Payload};
 
-use mock_sensors::{Sensors, TickDelay, TICKS};
+use mock_sensors::{MockBus, TickDelay, TICKS};
 use registers::SYSTEM_CLOCK_HZ;
 
 /// Simulated seconds of streaming before the probe exits.
@@ -65,36 +61,16 @@ const fn parse_seconds(text: Option<&str>, default: u32) -> u32 {
     value
 }
 
-/// Parts handed from the acquisition interrupt to the main loop for their
-/// blocking recovery, with the readings that asked for it.
-struct Recovery {
-    sensors: Sensors,
-    readings: [PartReading; 2],
-}
-
 /// Everything the contexts share; only touched inside critical sections.
 struct Shared {
-    streaming: bool,
-    /// The parts, while they are the acquisition's (None during recovery).
-    sensors: Option<Sensors>,
-    recovery: Option<Recovery>,
-    cycle: AcquisitionCycle,
-    queue: FrameQueue<TX_QUEUE_LEN>,
+    probe: ProbeState<MockBus, MockBus>,
     /// A byte is in the UART and its interrupt will ask for the next.
     tx_busy: bool,
-    /// Samples from the acquisition to the navigation; the oldest is
-    /// dropped (and counted) when the navigation falls behind.
-    nav_inbox: SampleInbox<NAV_INBOX_LEN>,
 }
 
 static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
-    streaming: false,
-    sensors: None,
-    recovery: None,
-    cycle: AcquisitionCycle::new(),
-    queue: FrameQueue::new(),
+    probe: ProbeState::new(),
     tx_busy: false,
-    nav_inbox: SampleInbox::new(),
 }));
 
 fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
@@ -107,7 +83,7 @@ fn kick_transmitter(shared: &mut Shared) {
     if shared.tx_busy || !registers::uart_ready() {
         return;
     }
-    if let Some(byte) = shared.queue.pop() {
+    if let Some(byte) = shared.probe.queue.pop() {
         registers::uart_write(byte);
         shared.tx_busy = true;
     }
@@ -115,20 +91,17 @@ fn kick_transmitter(shared: &mut Shared) {
 
 fn push(payload: &Payload) {
     with_shared(|shared, _| {
-        shared.queue.push(payload);
+        shared.probe.queue.push(payload);
         kick_transmitter(shared);
     });
 }
 
-fn event(kind: EventKind, part: u8, code: u16, value: u32) -> Payload {
-    let time_us = with_shared(|s, _| AcquisitionCycle::sample_time_us(s.cycle.samples()));
-    Payload::Event(Event {
-        time_us,
-        kind,
-        part,
-        code,
-        value,
-    })
+fn push_event(kind: EventKind, part: u8, code: u16, value: u32) {
+    with_shared(|shared, _| {
+        let event = shared.probe.event(kind, part, code, value);
+        shared.probe.queue.push(&event);
+        kick_transmitter(shared);
+    });
 }
 
 #[exception]
@@ -137,21 +110,13 @@ fn SysTick() {
     with_shared(|shared, _| {
         // The run length is counted here, so the last sample is exact
         // whatever the main loop is doing.
-        if !shared.streaming || shared.cycle.samples() >= SAMPLES_TO_RUN {
+        if shared.probe.cycle.samples() >= SAMPLES_TO_RUN {
             return;
         }
-        mock_sensors::inject_scheduled_faults(shared.cycle.samples());
-        let readings = shared
-            .sensors
-            .as_mut()
-            .map(|parts| parts.each_mut().map(|part| part.sample()));
-        let report = shared.cycle.run(readings, &mut shared.queue);
-        shared.nav_inbox.push(report.sample);
-        if report.any_recovery() {
-            if let (Some(readings), Some(sensors)) = (readings, shared.sensors.take()) {
-                shared.recovery = Some(Recovery { sensors, readings });
-            }
+        if shared.probe.streaming {
+            mock_sensors::inject_scheduled_faults(shared.probe.cycle.samples());
         }
+        shared.probe.acquire();
         kick_transmitter(shared);
     });
 }
@@ -167,21 +132,12 @@ pub fn on_uart_tx() {
 
 /// Runs the recovery of the parts that asked for it, outside any critical
 /// section (it waits), then gives them back to the acquisition.
-fn recover(mut job: Recovery) {
-    let skipped_before = with_shared(|shared, _| shared.cycle.skipped());
-    for (index, (part, reading)) in job.sensors.iter_mut().zip(&job.readings).enumerate() {
-        if !reading.needs_recovery() {
-            continue;
-        }
-        let code = reset_event_code(&part.recover(&mut TickDelay, reading));
-        push(&event(EventKind::SensorReset, index as u8, code, 0));
-    }
-    // The samples this recovery cost (taken with no data).
-    let skipped = with_shared(|shared, _| {
-        shared.sensors = Some(job.sensors);
-        shared.cycle.skipped() - skipped_before
+fn recover(mut job: Recovery<MockBus, MockBus>) {
+    job.run(&mut TickDelay, |part, code| {
+        push_event(EventKind::SensorReset, part, code, 0)
     });
-    push(&event(EventKind::Resync, NO_PART, 0, skipped));
+    let resync = with_shared(|shared, _| shared.probe.end_recovery(job));
+    push(&resync);
 }
 
 /// Instruction budget of the busiest 20 Hz cycle and the sum for the mean,
@@ -218,14 +174,11 @@ fn main() -> ! {
     syst.enable_interrupt();
     syst.enable_counter();
 
-    push(&event(EventKind::Boot, NO_PART, VERSION, 0));
+    push_event(EventKind::Boot, NO_PART, VERSION, 0);
     registers::watchdog_start(WATCHDOG_MS);
     let mut sensors = mock_sensors::power_up();
     start_parts(&mut sensors, &mut TickDelay, push);
-    with_shared(|shared, _| {
-        shared.sensors = Some(sensors);
-        shared.streaming = true;
-    });
+    with_shared(|shared, _| shared.probe.start_streaming(sensors));
 
     let mut cost = CycleCost::default();
     // The simulated site: the MGWD paper's test site.
@@ -234,25 +187,26 @@ fn main() -> ! {
     loop {
         registers::watchdog_feed();
         let tick = TICKS.load(Ordering::Relaxed);
-        if let Some(job) = with_shared(|shared, _| shared.recovery.take()) {
+        if let Some(job) = with_shared(|shared, _| shared.probe.take_recovery()) {
             recover(job);
         }
         let mut mode_changed = false;
-        while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop()) {
+        while let Some(sample) = with_shared(|shared, _| shared.probe.nav_inbox.pop()) {
             let solution = navigator.step(&sample);
             mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
             mode = solution.mode;
             push(&Payload::Nav(solution));
         }
-        if cfg!(feature = "qemu-stall-demo") && with_shared(|s, _| s.cycle.samples()) >= 200 {
+        if cfg!(feature = "qemu-stall-demo") && with_shared(|s, _| s.probe.cycle.samples()) >= 200 {
             // A hung main loop (the watchdog run): interrupts go on.
             loop {
                 cortex_m::asm::wfi();
             }
         }
         let (samples, idle) = with_shared(|s, _| {
-            let done = s.queue.is_empty() && !s.tx_busy && s.nav_inbox.is_empty();
-            (s.cycle.samples(), done)
+            let p = &s.probe;
+            let done = p.queue.is_empty() && !s.tx_busy && p.nav_inbox.is_empty();
+            (p.cycle.samples(), done)
         });
         if samples >= SAMPLES_TO_RUN && idle {
             exit::finish(&summary(&cost));
@@ -301,14 +255,14 @@ struct Summary {
 fn summary(cost: &CycleCost) -> Summary {
     let mean_ticks = (cost.total / u64::from(cost.cycles.max(1))) as u32;
     with_shared(|s, _| Summary {
-        samples: s.cycle.samples(),
-        skipped: s.cycle.skipped(),
-        queued: s.queue.queued(),
-        dropped: s.queue.dropped(),
+        samples: s.probe.cycle.samples(),
+        skipped: s.probe.cycle.skipped(),
+        queued: s.probe.queue.queued(),
+        dropped: s.probe.queue.dropped(),
         worst_ticks: cost.worst,
         mean_ticks,
         stack_bytes: stack_paint::high_water_bytes(),
-        nav_dropped: s.nav_inbox.dropped(),
+        nav_dropped: s.probe.nav_inbox.dropped(),
         overruns: cost.overruns,
         longest_overrun_ticks: cost.longest_overrun,
         mode_changes: cost.mode_changes,

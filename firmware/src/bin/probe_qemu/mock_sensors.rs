@@ -91,7 +91,7 @@ impl SpiDevice for MockBus {
 }
 
 /// The probe's two parts, as the driver sees them.
-pub type Sensors = [Part<MockBus, MockBus>; 2];
+pub type Sensors = firmware::app::Sensors<MockBus, MockBus>;
 
 /// Powers the simulated parts up (now) and returns their drivers.
 pub fn power_up() -> Sensors {

@@ -21,6 +21,7 @@ use core::cell::RefCell;
 
 use critical_section::Mutex;
 use embedded_hal_bus::spi::{CriticalSectionDevice, NoDelay};
+use firmware::scc1300::datasheet::SPI_CLOCK_HZ;
 use firmware::scc1300::Part;
 use stm32f4xx_hal::gpio::{ErasedPin, Output, PushPull};
 use stm32f4xx_hal::pac::{self, SPI1, TIM2, USART1};
@@ -35,14 +36,12 @@ use stm32f4xx_hal::watchdog::IndependentWatchdog;
 /// maximum would need the PLL's odd divider; 96 MHz keeps USB's 48 MHz).
 const HSE_MHZ: u32 = 25;
 const SYSCLK_MHZ: u32 = 96;
-/// TN92's example clock; the datasheet gives no maximum (spec/scc1300.md).
-const SPI_KHZ: u32 = 500;
 pub const BAUD: u32 = 115_200;
 
 pub type Bus = Spi<SPI1>;
 pub type Cs = ErasedPin<Output<PushPull>>;
 pub type Device = CriticalSectionDevice<'static, Bus, Cs, NoDelay>;
-pub type Sensors = [Part<Device, Device>; 2];
+pub type Sensors = firmware::app::Sensors<Device, Device>;
 pub type Uart = Tx<USART1>;
 pub type Timer = CounterHz<TIM2>;
 
@@ -74,7 +73,7 @@ pub fn init(dp: pac::Peripherals, syst: cortex_m::peripheral::SYST) -> Result<Bo
     let spi = dp.SPI1.spi(
         (gpioa.pa5, gpioa.pa6, gpioa.pa7),
         mode,
-        SPI_KHZ.kHz(),
+        SPI_CLOCK_HZ.Hz(),
         &clocks,
     );
     // The four devices share the bus from the timer interrupt and the main

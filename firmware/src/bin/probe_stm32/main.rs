@@ -19,21 +19,17 @@ use core::cell::RefCell;
 use cortex_m_rt::entry;
 use critical_section::{CriticalSection, Mutex};
 use defmt_rtt as _;
-use firmware::app::{
-    reset_event_code, start_parts, AcquisitionCycle, FrameQueue, Navigator, SampleInbox,
-    NAV_INBOX_LEN, TX_QUEUE_LEN,
-};
-use firmware::scc1300::PartReading;
+use firmware::app::{start_parts, Navigator, ProbeState, Recovery};
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::NO_PART;
-use mwd_core::protocol::{Event, EventKind, Payload};
+use mwd_core::protocol::{EventKind, Payload};
 use panic_probe as _;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, NVIC};
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::serial::TxListen;
 use stm32f4xx_hal::timer::{Event as TimerEvent, Flag};
 
-use board::{Sensors, Timer, Uart};
+use board::{Device, Timer, Uart};
 
 /// The main loop must come round within this (a recovery holds it ~1 s).
 const WATCHDOG_MS: u32 = 2_000;
@@ -42,33 +38,17 @@ const VERSION: u16 = 1;
 const PRIORITY_ACQUISITION: u8 = 0x10;
 const PRIORITY_UART: u8 = 0x20;
 
-/// Parts handed from the acquisition to the main loop for recovery.
-struct Recovery {
-    sensors: Sensors,
-    readings: [PartReading; 2],
-}
-
 /// Everything the contexts share; only touched inside critical sections.
 struct Shared {
-    streaming: bool,
-    sensors: Option<Sensors>,
-    recovery: Option<Recovery>,
-    cycle: AcquisitionCycle,
-    queue: FrameQueue<TX_QUEUE_LEN>,
+    probe: ProbeState<Device, Device>,
     uart: Option<Uart>,
     timer: Option<Timer>,
-    nav_inbox: SampleInbox<NAV_INBOX_LEN>,
 }
 
 static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
-    streaming: false,
-    sensors: None,
-    recovery: None,
-    cycle: AcquisitionCycle::new(),
-    queue: FrameQueue::new(),
+    probe: ProbeState::new(),
     uart: None,
     timer: None,
-    nav_inbox: SampleInbox::new(),
 }));
 
 fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
@@ -78,27 +58,24 @@ fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
 /// Bytes wait: let the TX-empty interrupt move them (it fires at once if
 /// the transmitter is idle).
 fn kick_transmitter(shared: &mut Shared) {
-    if let (false, Some(uart)) = (shared.queue.is_empty(), shared.uart.as_mut()) {
+    if let (false, Some(uart)) = (shared.probe.queue.is_empty(), shared.uart.as_mut()) {
         uart.listen();
     }
 }
 
 fn push(payload: &Payload) {
     with_shared(|shared, _| {
-        shared.queue.push(payload);
+        shared.probe.queue.push(payload);
         kick_transmitter(shared);
     });
 }
 
-fn event(kind: EventKind, part: u8, code: u16, value: u32) -> Payload {
-    let time_us = with_shared(|s, _| AcquisitionCycle::sample_time_us(s.cycle.samples()));
-    Payload::Event(Event {
-        time_us,
-        kind,
-        part,
-        code,
-        value,
-    })
+fn push_event(kind: EventKind, part: u8, code: u16, value: u32) {
+    with_shared(|shared, _| {
+        let event = shared.probe.event(kind, part, code, value);
+        shared.probe.queue.push(&event);
+        kick_transmitter(shared);
+    });
 }
 
 #[interrupt]
@@ -107,20 +84,7 @@ fn TIM2() {
         if let Some(timer) = shared.timer.as_mut() {
             timer.clear_flags(Flag::Update);
         }
-        if !shared.streaming {
-            return;
-        }
-        let readings = shared
-            .sensors
-            .as_mut()
-            .map(|parts| parts.each_mut().map(|part| part.sample()));
-        let report = shared.cycle.run(readings, &mut shared.queue);
-        shared.nav_inbox.push(report.sample);
-        if report.any_recovery() {
-            if let (Some(readings), Some(sensors)) = (readings, shared.sensors.take()) {
-                shared.recovery = Some(Recovery { sensors, readings });
-            }
-        }
+        shared.probe.acquire();
         kick_transmitter(shared);
     });
 }
@@ -131,7 +95,7 @@ fn USART1() {
         let Some(uart) = shared.uart.as_mut() else {
             return;
         };
-        match shared.queue.pop() {
+        match shared.probe.queue.pop() {
             // TXE is set (that is why we are here), so the write succeeds.
             Some(byte) => {
                 let _ = uart.write(byte);
@@ -142,21 +106,13 @@ fn USART1() {
 }
 
 /// Recovery of the parts that asked for it, outside any critical section.
-fn recover(mut job: Recovery, delay: &mut stm32f4xx_hal::timer::SysDelay) {
-    let skipped_before = with_shared(|shared, _| shared.cycle.skipped());
-    for (index, (part, reading)) in job.sensors.iter_mut().zip(&job.readings).enumerate() {
-        if !reading.needs_recovery() {
-            continue;
-        }
-        let code = reset_event_code(&part.recover(delay, reading));
-        defmt::warn!("part {=usize} recovered, code {=u16}", index, code);
-        push(&event(EventKind::SensorReset, index as u8, code, 0));
-    }
-    let skipped = with_shared(|shared, _| {
-        shared.sensors = Some(job.sensors);
-        shared.cycle.skipped() - skipped_before
+fn recover(mut job: Recovery<Device, Device>, delay: &mut stm32f4xx_hal::timer::SysDelay) {
+    job.run(delay, |part, code| {
+        defmt::warn!("part {=u8} recovered, code {=u16}", part, code);
+        push_event(EventKind::SensorReset, part, code, 0);
     });
-    push(&event(EventKind::Resync, NO_PART, 0, skipped));
+    let resync = with_shared(|shared, _| shared.probe.end_recovery(job));
+    push(&resync);
 }
 
 #[entry]
@@ -195,23 +151,20 @@ fn main() -> ! {
         NVIC::unmask(Interrupt::USART1);
     }
 
-    push(&event(EventKind::Boot, NO_PART, VERSION, 0));
+    push_event(EventKind::Boot, NO_PART, VERSION, 0);
     watchdog.start(WATCHDOG_MS.millis());
     start_parts(&mut sensors, &mut delay, push);
-    with_shared(|shared, _| {
-        shared.sensors = Some(sensors);
-        shared.streaming = true;
-    });
+    with_shared(|shared, _| shared.probe.start_streaming(sensors));
     defmt::info!("streaming at 20 Hz");
 
     // The probe's site: the MGWD paper's test site until it is configurable.
     let mut navigator = Navigator::new(Position::paper_site());
     loop {
         watchdog.feed();
-        if let Some(job) = with_shared(|shared, _| shared.recovery.take()) {
+        if let Some(job) = with_shared(|shared, _| shared.probe.take_recovery()) {
             recover(job, &mut delay);
         }
-        while let Some(sample) = with_shared(|shared, _| shared.nav_inbox.pop()) {
+        while let Some(sample) = with_shared(|shared, _| shared.probe.nav_inbox.pop()) {
             push(&Payload::Nav(navigator.step(&sample)));
         }
         cortex_m::asm::wfi();

@@ -1,0 +1,204 @@
+//! What the probe's contexts share, the same on every board: the two parts
+//! (while the acquisition has them), the cycle's bookkeeping, the transmit
+//! queue and the navigation inbox. A board keeps one [`ProbeState`] behind
+//! a critical section, calls [`ProbeState::acquire`] from its 20 Hz timer
+//! interrupt and runs a [`Recovery`] from its main loop; it adds only its
+//! timer, UART and watchdog.
+
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::SpiDevice;
+use mwd_core::protocol::frame::NO_PART;
+use mwd_core::protocol::{Event, EventKind, Payload};
+
+use super::cycle::AcquisitionCycle;
+use super::frame_queue::{FrameQueue, TX_QUEUE_LEN};
+use super::sample_inbox::{SampleInbox, NAV_INBOX_LEN};
+use super::start_up::reset_event_code;
+use crate::scc1300::{Part, PartReading};
+
+/// The probe's two parts.
+pub type Sensors<G, A> = [Part<G, A>; 2];
+
+/// Parts taken from the acquisition for their blocking recovery, with the
+/// readings that asked for it.
+pub struct Recovery<G, A> {
+    sensors: Sensors<G, A>,
+    readings: [PartReading; 2],
+    /// Samples skipped before the recovery began (for the Resync event).
+    skipped_before: u32,
+}
+
+impl<G: SpiDevice, A: SpiDevice> Recovery<G, A> {
+    /// Runs the recovery of each part that asked for it (this waits: call
+    /// it outside any critical section); `report` gets one SensorReset event
+    /// per part, stamped by the caller.
+    pub fn run(&mut self, delay: &mut impl DelayNs, mut report: impl FnMut(u8, u16)) {
+        for (index, (part, reading)) in self.sensors.iter_mut().zip(&self.readings).enumerate() {
+            if reading.needs_recovery() {
+                report(index as u8, reset_event_code(&part.recover(delay, reading)));
+            }
+        }
+    }
+}
+
+/// The shared state of one probe.
+pub struct ProbeState<G, A> {
+    /// False until the parts are started: the timer then does nothing.
+    pub streaming: bool,
+    /// The parts, while they are the acquisition's (None during recovery).
+    pub sensors: Option<Sensors<G, A>>,
+    /// Parts waiting for the main loop to recover them.
+    pub recovery: Option<Recovery<G, A>>,
+    pub cycle: AcquisitionCycle,
+    pub queue: FrameQueue<TX_QUEUE_LEN>,
+    /// Samples from the acquisition to the navigation.
+    pub nav_inbox: SampleInbox<NAV_INBOX_LEN>,
+}
+
+impl<G, A> ProbeState<G, A> {
+    pub const fn new() -> Self {
+        Self {
+            streaming: false,
+            sensors: None,
+            recovery: None,
+            cycle: AcquisitionCycle::new(),
+            queue: FrameQueue::new(),
+            nav_inbox: SampleInbox::new(),
+        }
+    }
+
+    /// An event frame stamped with the time of the next sample.
+    pub fn event(&self, kind: EventKind, part: u8, code: u16, value: u32) -> Payload {
+        Payload::Event(Event {
+            time_us: AcquisitionCycle::sample_time_us(self.cycle.samples()),
+            kind,
+            part,
+            code,
+            value,
+        })
+    }
+
+    /// The started parts go to the acquisition; the timer starts sampling.
+    pub fn start_streaming(&mut self, sensors: Sensors<G, A>) {
+        self.sensors = Some(sensors);
+        self.streaming = true;
+    }
+
+    /// The parts that asked for recovery, for the main loop.
+    pub fn take_recovery(&mut self) -> Option<Recovery<G, A>> {
+        self.recovery.take()
+    }
+
+    /// The recovered parts go back to the acquisition; returns the Resync
+    /// event, which says how many samples the recovery cost.
+    pub fn end_recovery(&mut self, job: Recovery<G, A>) -> Payload {
+        self.sensors = Some(job.sensors);
+        let skipped = self.cycle.skipped().saturating_sub(job.skipped_before);
+        self.event(EventKind::Resync, NO_PART, 0, skipped)
+    }
+}
+
+impl<G: SpiDevice, A: SpiDevice> ProbeState<G, A> {
+    /// The timer interrupt's work for one period: sample both parts (or
+    /// note the sample skipped while they are away), queue the raw frame
+    /// and any fault events, hand the sample to the navigation, and take
+    /// the parts away for recovery if a reading asks for it. Never waits.
+    pub fn acquire(&mut self) {
+        if !self.streaming {
+            return;
+        }
+        let readings = self
+            .sensors
+            .as_mut()
+            .map(|parts| parts.each_mut().map(|part| part.sample()));
+        let report = self.cycle.run(readings, &mut self.queue);
+        self.nav_inbox.push(report.sample);
+        if report.any_recovery() {
+            if let (Some(readings), Some(sensors)) = (readings, self.sensors.take()) {
+                self.recovery = Some(Recovery {
+                    sensors,
+                    readings,
+                    skipped_before: self.cycle.skipped(),
+                });
+            }
+        }
+    }
+}
+
+impl<G, A> Default for ProbeState<G, A> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::app::start_parts;
+    use core::cell::RefCell;
+    use hil_mock::{AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, Window};
+    use mwd_core::protocol::Decoder;
+    use std::vec::Vec;
+
+    #[test]
+    fn a_recovery_takes_the_parts_away_and_gives_them_back_with_a_resync() {
+        let clock = SimClock::new();
+        let mocks =
+            [0, 1].map(|i| RefCell::new(Scc1300::new(&clock, Constant::default(), i as u32)));
+        let mut parts =
+            [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
+        let mut delay = SimDelay::new(&clock);
+        let mut probe = ProbeState::new();
+        start_parts(&mut parts, &mut delay, |p| {
+            probe.queue.push(p);
+        });
+        probe.acquire();
+        assert!(probe.nav_inbox.is_empty(), "not streaming yet");
+        probe.start_streaming(parts);
+        for _ in 0..10 {
+            clock.advance_ms(50);
+            probe.acquire();
+        }
+        assert!(probe.take_recovery().is_none());
+
+        // Part 1's gyro loses S_OK for 100 ms: the acquisition hands the
+        // parts over, samples on without them, and gets them back.
+        let now = clock.now_ns();
+        mocks[1].borrow_mut().faults.s_ok_drop = Some(Window {
+            start_ns: now,
+            end_ns: now + 100_000_000,
+        });
+        clock.advance_ms(50);
+        probe.acquire();
+        let Some(mut job) = probe.take_recovery() else {
+            panic!("part 1 asks for recovery")
+        };
+        assert!(probe.sensors.is_none());
+        clock.advance_ms(50);
+        probe.acquire(); // a sample while the parts are away
+        let mut resets = Vec::new();
+        job.run(&mut delay, |part, code| resets.push((part, code)));
+        assert_eq!(resets, [(1, 0)], "a transient: the part came back");
+        let resync = probe.end_recovery(job);
+        assert!(matches!(resync, Payload::Event(e) if e.kind == EventKind::Resync && e.value == 1));
+        clock.advance_ms(50);
+        probe.acquire();
+        assert!(probe.sensors.is_some() && probe.take_recovery().is_none());
+
+        // 13 raw samples reached the navigation and the UART, in order.
+        let mut counters = Vec::new();
+        while let Some(sample) = probe.nav_inbox.pop() {
+            counters.push(sample.sample_counter);
+        }
+        assert_eq!(counters, (0..13).collect::<Vec<u32>>());
+        let mut decoder = Decoder::new();
+        let mut raw = 0;
+        while let Some(b) = probe.queue.pop() {
+            decoder.feed(&[b], |f| {
+                raw += usize::from(matches!(f.payload, Payload::Raw(_)))
+            });
+        }
+        assert_eq!(raw, 13);
+    }
+}
