@@ -10,16 +10,14 @@
 //! takes raw samples: the filter's dynamics carry the bias's effect).
 
 use crate::conventions::{dcm_from_quat, euler_error_jacobian};
-use crate::earth::{
-    earth_rate_n, gravity_n, normal_gravity, transport_rate_n, Position, EARTH_RATE,
-};
+use crate::earth::{gravity_n, normal_gravity, Position, EARTH_RATE};
 use crate::error_model::{
     AugmentedModel, AugmentedTransition, EarthTerms, LinearizationPoint, ProcessNoise, ACCEL_BIAS,
     ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
 };
 use crate::kalman::{FilterScalar, KalmanFilter, UpdateReport};
 use crate::measurement::{ZeroPosition, ZeroVelocity};
-use crate::mechanization::{ImuSample, NavState, Strapdown};
+use crate::mechanization::{frame_rate_in_body, ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -195,11 +193,8 @@ pub fn at_rest_sample(
     rate_z: f64,
     specific_force: Vector3<f64>,
 ) -> ImuSample {
-    let omega_in_n =
-        earth_rate_n(state.position.lat) + transport_rate_n(&state.position, &state.velocity);
-    let frame_rate = state.attitude.inverse_transform_vector(&omega_in_n);
     ImuSample {
-        rate: Vector3::new(rate_x, frame_rate.y, rate_z),
+        rate: Vector3::new(rate_x, frame_rate_in_body(state).y, rate_z),
         specific_force,
     }
 }

@@ -216,6 +216,17 @@ fn renormalized(q: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
     UnitQuaternion::new_unchecked(q * scale)
 }
 
+/// The rate the navigation frame turns at (earth rate plus transport
+/// rate), in body axes at the solution `state`: what a tool at rest senses,
+/// and the reference of the accelerometer-derived tool-axis rate.
+pub fn frame_rate_in_body(state: &NavState) -> Vector3<f64> {
+    let pos = &state.position;
+    let trig = LatitudeTrig::new(pos.lat);
+    let omega_in_n = earth_rate_n_from_trig(&trig)
+        + transport_rate_n_from_trig(&trig, &radii_from_trig(&trig), pos.height, &state.velocity);
+    state.attitude.inverse_transform_vector(&omega_in_n)
+}
+
 /// Builds the mechanization's input from the probe's sensors: the x and z
 /// gyros, the accelerometers, and the tool-axis rate derived from
 /// accelerometer roll (eq. 1-2). Where that rate is unavailable (first
@@ -242,16 +253,7 @@ impl ProbeInput {
         specific_force: &Vector3<f64>,
         dt: f64,
     ) -> (ImuSample, ToolAxisRate) {
-        let pos = &state.position;
-        let trig = LatitudeTrig::new(pos.lat);
-        let omega_in_n = earth_rate_n_from_trig(&trig)
-            + transport_rate_n_from_trig(
-                &trig,
-                &radii_from_trig(&trig),
-                pos.height,
-                &state.velocity,
-            );
-        let omega_in_b = state.attitude.inverse_transform_vector(&omega_in_n);
+        let omega_in_b = frame_rate_in_body(state);
         let derived = self
             .tool_axis
             .update(specific_force, gyro_x, gyro_z, &omega_in_b, dt);

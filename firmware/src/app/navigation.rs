@@ -115,13 +115,11 @@ pub struct Navigator {
     /// and every move of it would be another copy on the stack.
     filter: Filter,
     /// 1-sigma of roll, pitch, heading from the coarse alignment (rad),
-    /// reported until the filter has its own.
+    /// reported until the filter has its own. An infinite heading sigma
+    /// (no heading found) stays in the frames afterwards: the filter then
+    /// runs from its best guess with its largest prior, but its small-angle
+    /// azimuth sigma would not cover the error.
     coarse_std: [f32; 3],
-    /// The coarse alignment found a heading. If not, the filter still runs
-    /// from its best guess with its largest prior, but its small-angle
-    /// azimuth sigma would not cover the error: the frames then say
-    /// heading unknown (infinite sigma) whatever the filter holds.
-    heading_determined: bool,
     flags: u16,
 }
 
@@ -144,7 +142,6 @@ impl Navigator {
             },
             filter: Filter::new(idle, position, filter_config(&position, &[0.0; 3])),
             coarse_std: [f32::NAN; 3],
-            heading_determined: false,
             flags: 0,
         }
     }
@@ -235,7 +232,6 @@ impl Navigator {
             Ok(h) => (h.heading.value, f64::INFINITY),
             Err(_) => (0.0, f64::INFINITY),
         };
-        self.heading_determined = heading_std.is_finite();
         let sigma = [roll_pitch_std[0], roll_pitch_std[1], heading_std];
         self.coarse_std = sigma.map(|s| s as f32);
         // A levelling that failed leaves no tilt sigma: the filter then
@@ -280,7 +276,7 @@ impl Navigator {
         solution.longitude = state.position.lon;
         solution.height = state.position.height as f32;
         let std = filter.euler_std();
-        let heading_std = if self.heading_determined {
+        let heading_std = if self.coarse_std[2].is_finite() {
             std.z as f32
         } else {
             f32::INFINITY
