@@ -14,12 +14,18 @@ CARGO_TARGET_DIR="$target_dir" cargo build -q -p firmware --profile probe --targ
   --features board-qemu --bin probe-qemu
 elf="$target_dir/$target/probe/probe-qemu"
 
+# The sections of ELF $1, then flash (vector table + text + rodata + data)
+# and static RAM (data + bss + uninit), each followed by $2 and $3 (the budget).
+sizes() {
+  arm-none-eabi-size -A "$1" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
+  arm-none-eabi-size -A "$1" | awk -v flash_of="$2" -v ram_of="$3" '
+    $1 ~ /^\.(vector_table|text|rodata|data)$/ { flash += $2 }
+    $1 ~ /^\.(data|bss|uninit)$/ { ram += $2 }
+    END { printf "flash %d B (%.1f KiB)%s, static RAM %d B (%.1f KiB)%s\n", flash, flash/1024, flash_of, ram, ram/1024, ram_of }'
+}
+
 echo "== sections (arm-none-eabi-size -A $elf)"
-arm-none-eabi-size -A "$elf" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
-arm-none-eabi-size -A "$elf" | awk '
-  $1 ~ /^\.(vector_table|text|rodata|data)$/ { flash += $2 }
-  $1 ~ /^\.(data|bss|uninit)$/ { ram += $2 }
-  END { printf "flash %d B (%.1f KiB), static RAM %d B (%.1f KiB)\n", flash, flash/1024, ram, ram/1024 }'
+sizes "$elf" "" ""
 
 serial="$(mktemp)"
 trap 'rm -f "$serial"' EXIT
@@ -34,8 +40,4 @@ stm32_dir="${CARGO_TARGET_DIR:-target}"
 cargo build -q -p firmware --profile probe --target "$target" --features board-stm32 --bin probe-stm32
 elf="$stm32_dir/$target/probe/probe-stm32"
 echo "== real board (arm-none-eabi-size -A $elf)"
-arm-none-eabi-size -A "$elf" | grep -E '^\.(vector_table|text|rodata|data|bss|uninit) '
-arm-none-eabi-size -A "$elf" | awk '
-  $1 ~ /^\.(vector_table|text|rodata|data)$/ { flash += $2 }
-  $1 ~ /^\.(data|bss|uninit)$/ { ram += $2 }
-  END { printf "flash %d B (%.1f KiB) of 128 KiB, static RAM %d B (%.1f KiB) of 32 KiB\n", flash, flash/1024, ram, ram/1024 }'
+sizes "$elf" " of 128 KiB" " of 32 KiB"
