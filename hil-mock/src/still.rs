@@ -10,7 +10,8 @@
 
 use mwd_core::conventions::{quat_from_euler, Euler};
 use mwd_core::earth::{earth_rate_n, gravity_n, Position};
-use mwd_core::sensor_noise::{rate_from_deg_per_hour, ImuNoise, STANDARD_GRAVITY};
+use mwd_core::sensor_noise::{rate_from_deg_per_hour, ImuNoise};
+use mwd_core::sensor_units::STANDARD_GRAVITY;
 
 use crate::source::{BodySample, BodySource};
 

@@ -3,7 +3,6 @@
 //! frames, reading and decoding a capture with its loss statistics, and
 //! exporting the frames as CSV.
 
-use firmware::scc1300::datasheet::GYRO_RANGE_COUNTS;
 use std::fmt;
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
@@ -55,12 +54,7 @@ pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
         part.accel = sensor.map(sensor_units::m_s2_to_accel_count);
         part.accel_temp = ACCEL_TEMPERATURE.degc_to_count(temp);
         part.flags = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
-        if part.gyro_rate.unsigned_abs() > GYRO_RANGE_COUNTS.unsigned_abs()
-            || matches!(
-                part.gyro_rate,
-                sensor_units::COUNT_MIN | sensor_units::COUNT_MAX
-            )
-        {
+        if sensor_units::gyro_count_is_saturated(part.gyro_rate) {
             part.flags |= raw_flags::GYRO_SATURATED;
         }
     }

@@ -11,8 +11,8 @@
 //! reports EIO, a USB adapter pulled reports an I/O error) or the time limit
 //! is.
 
-use firmware::app::Navigator;
 use mwd_core::calibration::ProbeCalibration;
+use mwd_core::probe::Navigator;
 use std::fmt;
 use std::io::{self, ErrorKind, Read};
 use std::time::{Duration, Instant};

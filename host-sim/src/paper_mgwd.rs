@@ -8,7 +8,7 @@ use crate::coarse;
 use crate::samples_csv::Record;
 use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
 use anyhow::Result;
-use mwd_core::alignment::{AlignmentConfig, PROBE_GYROS};
+use mwd_core::alignment::AlignmentConfig;
 use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, wrap_pi, Euler};
 use mwd_core::earth::Position;
 use mwd_core::error_model::{
@@ -136,14 +136,9 @@ pub fn simulate(seed: u64, full_model: bool) -> Vec<Record> {
 
 /// Coarse alignment on the first 5 s: attitude and 1-sigma (rad).
 pub fn coarse_align(records: &[Record]) -> Result<(Euler, [f64; 3])> {
-    let config = AlignmentConfig {
-        latitude: Position::paper_site().lat,
-        sample_interval: SAMPLE_INTERVAL,
-        gyro_axes: PROBE_GYROS,
-        noise: ImuNoise::scc1300(),
-        // South-westerly prior from the parent well resolves north/south.
-        heading_prior: Some(truth().heading + 30.0 * DEG),
-    };
+    // South-westerly prior from the parent well resolves north/south.
+    let config = AlignmentConfig::probe(Position::paper_site().lat)
+        .with_heading_prior(Some(truth().heading + 30.0 * DEG));
     let window = &records[..COARSE_SAMPLES.min(records.len())];
     let whole = 0..window.len();
     let report = coarse::align(window, std::slice::from_ref(&whole), &config)?;

@@ -1,5 +1,5 @@
 //! Replay of a probe capture on the host: the raw-sample frames go through
-//! the probe's own navigation code (`firmware::app::Navigator`, the same
+//! the probe's own navigation code (`mwd_core::probe::Navigator`, the same
 //! source the firmware runs), and where the capture also holds the probe's
 //! navigation frames, each replayed solution is compared with the probe's
 //! bit for bit (as encoded frames, so NaN fields compare too).
@@ -7,8 +7,8 @@
 use std::collections::HashMap;
 use std::io::{self, Write};
 
-use firmware::app::Navigator;
 use mwd_core::earth::Position;
+use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{encode_body, Frame, NavSolution, Payload};
 

@@ -106,6 +106,30 @@ pub struct AlignmentConfig {
     pub heading_prior: Option<f64>,
 }
 
+impl AlignmentConfig {
+    /// The probe's coarse alignment at `latitude` (rad): 20 Hz samples,
+    /// gyros across the tool axis only, the SCC1300's error budget, no
+    /// heading prior. The probe and the host's tools all start from this.
+    pub fn probe(latitude: f64) -> Self {
+        Self {
+            latitude,
+            sample_interval: crate::probe::timing::SAMPLE_INTERVAL_S,
+            gyro_axes: PROBE_GYROS,
+            noise: ImuNoise::scc1300(),
+            heading_prior: None,
+        }
+    }
+
+    /// The same with a rough heading (rad) to choose between ambiguous
+    /// candidates.
+    pub fn with_heading_prior(self, heading_prior: Option<f64>) -> Self {
+        Self {
+            heading_prior,
+            ..self
+        }
+    }
+}
+
 /// A value with its 1-sigma uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Uncertain {

@@ -27,6 +27,10 @@
 use core::f64::consts::{FRAC_PI_2, PI, TAU};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
+/// One degree in radians, for constants written in degrees (at run time
+/// `f64::to_radians` does the same).
+pub const DEG: f64 = PI / 180.0;
+
 /// The fixed rotation from the body frame (right, forward, up) to the
 /// forward-right-down frame the Euler angles are defined in: `v_f = P v_b`.
 /// P is a proper rotation (180 deg about (1, 1, 0)/sqrt 2), symmetric, and its

@@ -24,6 +24,7 @@ pub mod measurement;
 pub mod mechanization;
 #[cfg(feature = "std")]
 pub mod observability;
+pub mod probe;
 pub mod protocol;
 pub mod sensor_noise;
 pub mod sensor_units;

@@ -18,10 +18,8 @@
 //! the stated figure as its standard deviation and [`BIAS_CORRELATION_TIME`]
 //! as its correlation time.
 use crate::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
-
-const DEG: f64 = core::f64::consts::PI / 180.0;
-/// One standard gravity (m/s^2), for figures given in g.
-pub const STANDARD_GRAVITY: f64 = 9.806_65;
+use crate::conventions::DEG;
+use crate::sensor_units::STANDARD_GRAVITY;
 /// Correlation time of the Gauss-Markov bias instability (s): an assumption
 /// (the datasheet gives no figure); Allan plots of MEMS gyros of this class
 /// reach their floor at tens to hundreds of seconds.

@@ -10,7 +10,9 @@
 /// Standard gravity, the "g" of the datasheet's LSB/g sensitivity (the
 /// conventional value of ISO 80000-3, not the local gravity of the earth
 /// model, which the navigation core owns).
-pub const STANDARD_GRAVITY_M_S2: f32 = 9.806_65;
+pub const STANDARD_GRAVITY: f64 = 9.806_65;
+/// [`STANDARD_GRAVITY`] in the probe's single precision.
+pub const STANDARD_GRAVITY_M_S2: f32 = STANDARD_GRAVITY as f32;
 
 /// Both slaves deliver 14-bit two's complement values, left-aligned in a
 /// 16-bit word: `(word as i16) >> 2` [TN92]. Smallest count.
@@ -24,6 +26,19 @@ pub const GYRO_LSB_PER_DEG_S: f32 = 18.0;
 /// Specified gyro range, +-300 deg/s [datasheet front page]. The 14-bit word
 /// could carry +-455 deg/s; beyond the range the output is not specified.
 pub const GYRO_RANGE_DEG_S: f32 = 300.0;
+/// The specified gyro range in counts: +-300 deg/s at 18 LSB per deg/s =
+/// +-5400 counts. The 14-bit word could carry +-8191 counts (+-455 deg/s),
+/// but beyond the range the output is not specified.
+pub const GYRO_RANGE_COUNTS: i16 = (GYRO_RANGE_DEG_S * GYRO_LSB_PER_DEG_S) as i16;
+
+/// Whether a gyro rate count is saturated: beyond the specified range
+/// (+-[`GYRO_RANGE_COUNTS`]), the 14-bit limits included (the output is not
+/// specified there, and at the limits the true rate may be beyond them).
+/// The one rule the driver applies and the simulator's captures follow.
+pub const fn gyro_count_is_saturated(count: i16) -> bool {
+    count > GYRO_RANGE_COUNTS || count < -GYRO_RANGE_COUNTS
+}
+
 /// Accelerometer sensitivity of the D04 variant: 650 LSB/g [TN92].
 pub const ACCEL_LSB_PER_G: f32 = 650.0;
 /// Specified accelerometer range, 6 g [datasheet front page]; the part flags
@@ -216,6 +231,11 @@ pub const PART_MOUNTINGS: [Mounting; PART_COUNT] = [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn single_precision_gravity_is_the_literal() {
+        assert_eq!(STANDARD_GRAVITY_M_S2, 9.806_65_f32);
+    }
 
     fn matrix(m: &Mounting) -> [[f32; 3]; 3] {
         // Column j = body image of sensor unit vector j.

@@ -7,10 +7,9 @@ use host_sim::samples_csv::Record;
 use host_sim::sim::{
     DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL,
 };
-use mwd_core::alignment::{AlignmentConfig, COVERAGE_FACTOR, MAX_DETERMINED_SIGMA, PROBE_GYROS};
+use mwd_core::alignment::{AlignmentConfig, COVERAGE_FACTOR, MAX_DETERMINED_SIGMA};
 use mwd_core::conventions::{wrap_pi, Euler};
 use mwd_core::earth::Position;
-use mwd_core::sensor_noise::ImuNoise;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -44,13 +43,7 @@ fn run_trial(trajectory: Trajectory, seconds: f64, seed: u64, prior: Option<f64>
     .take(n)
     .map(|s| coarse::calibrated(&Record::from(&s), &cal))
     .collect();
-    let config = AlignmentConfig {
-        latitude: trajectory.position.lat,
-        sample_interval: SAMPLE_INTERVAL,
-        gyro_axes: PROBE_GYROS,
-        noise: ImuNoise::scc1300(),
-        heading_prior: prior,
-    };
+    let config = AlignmentConfig::probe(trajectory.position.lat).with_heading_prior(prior);
     let spans = coarse::find_segments(&records);
     let report = coarse::align(&records, &spans, &config).expect("alignment runs");
     let lev = report.levels[0];

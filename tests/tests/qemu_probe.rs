@@ -19,9 +19,9 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use firmware::app::{navigation, Navigator};
 use hil_mock::StillProbe;
 use mwd_core::earth::Position;
+use mwd_core::probe::{timing, Navigator};
 use mwd_core::protocol::frame::{nav_mode, raw_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{
     encode_body, Decoder, DecoderStats, Event, EventKind, Frame, NavSolution, Payload, RawSample,
@@ -32,9 +32,9 @@ use system_tests::{build_firmware, require_qemu, summary_value, wait_or_kill};
 /// The firmware's default run length (`PROBE_QEMU_RUN_SECONDS`).
 const RUN_SECONDS: u64 = 60;
 const RATE_HZ: u64 = 20;
-/// Samples of the coarse and of the fine alignment (firmware::app::navigation).
-const ALIGNMENT_SAMPLES: usize = navigation::ALIGNMENT_SAMPLES as usize;
-const FINE_ALIGNMENT_SAMPLES: usize = navigation::FINE_ALIGNMENT_SAMPLES as usize;
+/// Samples of the coarse and of the fine alignment (mwd_core::probe::timing).
+const ALIGNMENT_SAMPLES: usize = timing::ALIGNMENT_SAMPLES as usize;
+const FINE_ALIGNMENT_SAMPLES: usize = timing::FINE_ALIGNMENT_SAMPLES as usize;
 /// Far above the ~1 s the run takes; only a hang reaches it.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(300);
 

@@ -14,8 +14,7 @@ use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
 use super::frame_queue::FrameQueue;
 use crate::scc1300::{Error, PartReading};
 
-/// The sample period of the probe: 20 Hz.
-pub const SAMPLE_PERIOD_US: u64 = 50_000;
+use mwd_core::probe::timing::SAMPLE_PERIOD_US;
 
 /// What one cycle asks of its caller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -6,14 +6,12 @@
 
 pub mod cycle;
 pub mod frame_queue;
-pub mod navigation;
 pub mod probe;
 pub mod sample_inbox;
 pub mod start_up;
 
-pub use cycle::{AcquisitionCycle, CycleReport, SAMPLE_PERIOD_US};
+pub use cycle::{AcquisitionCycle, CycleReport};
 pub use frame_queue::{FrameQueue, TX_QUEUE_LEN};
-pub use navigation::Navigator;
 pub use probe::{ProbeState, Recovery, Sensors};
 pub use sample_inbox::{SampleInbox, NAV_INBOX_LEN};
 pub use start_up::{reset_event_code, start_parts, START_ATTEMPTS};

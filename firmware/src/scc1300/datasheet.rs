@@ -5,8 +5,6 @@
 //! drivers. Sensitivities and count conversions live in
 //! `mwd_core::sensor_units`, shared with the mock and the host.
 
-use mwd_core::sensor_units;
-
 /// Gyro registers [TN92].
 pub mod gyro_reg {
     pub const RATE_X: u8 = 0x00;
@@ -75,16 +73,6 @@ pub const SPI_CLOCK_HZ: u32 = 500_000;
 /// (spec). `None` means "read and log, do not check".
 pub const GYRO_IC_ID_EXPECTED: Option<u16> = None;
 pub const ACCEL_ID_EXPECTED: Option<u8> = None;
-
-/// Gyro rate beyond which the output is out of the specified range: the D04
-/// measures +-300 deg/s at 18 LSB per deg/s [spec "Gyro part": "D04
-/// sensitivity 18 LSB per deg/s, range +-300 deg/s", TN92 and the datasheet
-/// front page] = +-5400 counts. The 14-bit word could carry +-8191 counts
-/// (+-455 deg/s), but beyond the range the output is not specified, so such
-/// a count is reported as saturated / out of range. Derived from
-/// `mwd_core::sensor_units::{GYRO_RANGE_DEG_S, GYRO_LSB_PER_DEG_S}`.
-pub const GYRO_RANGE_COUNTS: i16 =
-    (sensor_units::GYRO_RANGE_DEG_S * sensor_units::GYRO_LSB_PER_DEG_S) as i16;
 
 /// Which accelerometer frame the dPAR bit of a MISO status byte protects.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -43,7 +43,7 @@ pub enum Error {
     LoopFailure,
     /// Output beyond range: accelerometer SAT (acknowledged through
     /// INT_STATUS), or a gyro count beyond the specified +-300 deg/s
-    /// (`datasheet::GYRO_RANGE_COUNTS`).
+    /// (`mwd_core::sensor_units::GYRO_RANGE_COUNTS`).
     Saturated(Slave),
     /// Accelerometer ST: self-test or memory checksum failure.
     SelfTest,

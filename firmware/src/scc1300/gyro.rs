@@ -6,8 +6,8 @@ use embedded_hal::spi::{Error as _, SpiDevice};
 use mwd_core::sensor_units::{self, GYRO_TEMPERATURE};
 
 use super::datasheet::{
-    gyro_reg, GYRO_LOOPF_OK, GYRO_RANGE_COUNTS, GYRO_RECHECK_WAIT_MS, GYRO_SOFT_RESET_DATA,
-    GYRO_S_OK, POWER_UP_WAIT_MS,
+    gyro_reg, GYRO_LOOPF_OK, GYRO_RECHECK_WAIT_MS, GYRO_SOFT_RESET_DATA, GYRO_S_OK,
+    POWER_UP_WAIT_MS,
 };
 use super::error::{Error, Slave, Word};
 use super::frame::{gyro_command, gyro_write_word, is_dead_word, is_odd_parity, GYRO_READ_WORD};
@@ -115,11 +115,11 @@ impl<SPI: SpiDevice> Gyro<SPI> {
     }
 
     /// Rate about the part's X axis in counts (18 LSB per deg/s). A count
-    /// beyond the specified +-300 deg/s ([`GYRO_RANGE_COUNTS`]) is reported
+    /// beyond the specified +-300 deg/s ([`sensor_units::GYRO_RANGE_COUNTS`]) is reported
     /// as saturation.
     pub fn read_rate_count(&mut self) -> Result<i16, Error> {
         let count = self.read_count(gyro_reg::RATE_X)?;
-        if is_saturated(count) {
+        if sensor_units::gyro_count_is_saturated(count) {
             return Err(Error::Saturated(Slave::Gyro));
         }
         Ok(count)
@@ -198,13 +198,6 @@ impl<SPI: SpiDevice> Gyro<SPI> {
             Err(Error::NotReady)
         }
     }
-}
-
-/// A rate count beyond the specified range (+-[`GYRO_RANGE_COUNTS`] =
-/// +-300 deg/s), the 14-bit limits included: the output is not specified
-/// there, and at the limits the true rate may be beyond it.
-pub const fn is_saturated(count: i16) -> bool {
-    count > GYRO_RANGE_COUNTS || count < -GYRO_RANGE_COUNTS
 }
 
 #[cfg(test)]
@@ -289,7 +282,7 @@ mod tests {
     #[test]
     fn rates_beyond_300_deg_s_are_out_of_range() {
         // Spec: 18 LSB per deg/s, range +-300 deg/s -> +-5400 counts.
-        assert_eq!(GYRO_RANGE_COUNTS, 5400);
+        assert_eq!(sensor_units::GYRO_RANGE_COUNTS, 5400);
         for (count, saturated) in [
             (0, false),
             (5400, false),
@@ -299,7 +292,11 @@ mod tests {
             (8191, true),
             (-8192, true),
         ] {
-            assert_eq!(is_saturated(count), saturated, "{count}");
+            assert_eq!(
+                sensor_units::gyro_count_is_saturated(count),
+                saturated,
+                "{count}"
+            );
         }
         // Over the bus: +5400 (0x5460 left-aligned, P = 0 with 5 ones) is
         // good, +5401 (0x5464, 6 ones, P = 1) is flagged.

@@ -10,7 +10,8 @@ use mwd_core::sensor_units;
 use super::accel::Accel;
 use super::datasheet::{gyro_reg, POWER_UP_WAIT_MS};
 use super::error::{Error, Slave};
-use super::gyro::{is_saturated, Gyro, Recovery};
+use super::gyro::{Gyro, Recovery};
+use mwd_core::sensor_units::gyro_count_is_saturated;
 
 /// One sample of a part: counts and flags ready for the raw-sample frame,
 /// plus the error of each slave, if any. Counts of a slave with an error
@@ -128,7 +129,7 @@ impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
         raw.flags |= raw_flags::GYRO_S_OK;
         raw.gyro_rate = sensor_units::word_to_count(rate.data);
         raw.gyro_temp = self.gyro.read_temperature_count()?;
-        if is_saturated(raw.gyro_rate) {
+        if gyro_count_is_saturated(raw.gyro_rate) {
             return Err(Error::Saturated(Slave::Gyro));
         }
         Ok(())

@@ -141,7 +141,7 @@ pub fn read_columns(path: &Path) -> Result<Columns> {
 }
 
 /// The raw-sample frames of a capture, converted to SI in body axes by the
-/// probe's own conversion (`firmware::app::navigation::body_sample`), in
+/// probe's own conversion (`mwd_core::probe::body_sample`), in
 /// columns named with their units: time_s, gyro_x_rad_s, gyro_z_rad_s,
 /// accel_{x,y,z}_m_s2. Samples with a faulty part are left out (and
 /// counted on standard error), as are CRC failures and other corrupt frames.
@@ -156,8 +156,7 @@ fn capture_columns(path: &Path) -> Result<Columns> {
             continue;
         };
         // The raw sensor, uncalibrated: noise analysis characterises it as it is.
-        let Some((gx, gz, f)) =
-            firmware::app::navigation::body_sample(&raw, &ProbeCalibration::default())
+        let Some((gx, gz, f)) = mwd_core::probe::body_sample(&raw, &ProbeCalibration::default())
         else {
             skipped += 1;
             continue;

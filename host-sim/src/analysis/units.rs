@@ -5,7 +5,7 @@
 use anyhow::{bail, Result};
 
 /// Standard gravity (m/s^2) for inputs given in g or mg (ISO 80000-3).
-pub const STANDARD_GRAVITY: f64 = 9.806_65;
+pub use mwd_core::sensor_units::STANDARD_GRAVITY;
 
 /// Unit of an input column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -4,7 +4,7 @@ use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::coarse;
 use host_sim::samples_csv;
 use host_sim::sim::{DeterministicErrors, SensorModelFile, SAMPLE_INTERVAL};
-use mwd_core::alignment::{AlignmentConfig, PROBE_GYROS};
+use mwd_core::alignment::AlignmentConfig;
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::sensor_noise::ImuNoise;
 use std::path::PathBuf;
@@ -89,12 +89,10 @@ pub fn run(args: Args) -> Result<()> {
         .map(|r| coarse::calibrated(r, &cal))
         .collect();
     let config = AlignmentConfig {
-        latitude: args.lat * DEG,
-        sample_interval: SAMPLE_INTERVAL,
-        gyro_axes: PROBE_GYROS,
         noise,
-        heading_prior: args.prior_heading.map(|h| h * DEG),
-    };
+        ..AlignmentConfig::probe(args.lat * DEG)
+    }
+    .with_heading_prior(args.prior_heading.map(|h| h * DEG));
     let spans = coarse::find_segments(&records);
     let report = coarse::align(&records, &spans, &config)?;
     print!("{}", report.render());

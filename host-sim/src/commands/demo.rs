@@ -6,8 +6,7 @@ use anyhow::Result;
 use host_sim::coarse;
 use host_sim::samples_csv::Record;
 use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, SAMPLE_INTERVAL};
-use mwd_core::alignment::{AlignmentConfig, PROBE_GYROS};
-use mwd_core::sensor_noise::ImuNoise;
+use mwd_core::alignment::AlignmentConfig;
 
 use super::simulate::TrajectoryArgs;
 
@@ -38,15 +37,10 @@ fn run_case(title: &str, records: &[Record], config: &AlignmentConfig) -> Result
 
 pub fn run(args: Args) -> Result<()> {
     let traj = args.trajectory.trajectory();
-    let config = AlignmentConfig {
-        latitude: traj.position.lat,
-        sample_interval: SAMPLE_INTERVAL,
-        gyro_axes: PROBE_GYROS,
-        noise: ImuNoise::scc1300(),
-        // The paper's heading is known to be south-westerly from the parent
-        // well: a prior within 90 deg resolves the north/south ambiguity.
-        heading_prior: Some(traj.start.heading + 30.0 * DEG),
-    };
+    // The paper's heading is known to be south-westerly from the parent
+    // well: a prior within 90 deg resolves the north/south ambiguity.
+    let config = AlignmentConfig::probe(traj.position.lat)
+        .with_heading_prior(Some(traj.start.heading + 30.0 * DEG));
     let simulate = |t: &host_sim::sim::Trajectory, seconds: f64| -> Vec<Record> {
         let n = (seconds / SAMPLE_INTERVAL).round() as usize;
         SensorSimulator::new(t.clone(), SensorModel::scc1300(args.seed), SAMPLE_INTERVAL)

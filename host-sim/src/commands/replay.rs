@@ -12,13 +12,13 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::Context;
-use firmware::app::Navigator;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::capture::Capture;
 use host_sim::live::{self, LiveOptions};
 use host_sim::replay::{self, ReplayRow, ReplaySummary};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
+use mwd_core::probe::Navigator;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {

@@ -2,7 +2,6 @@
 //! written as a sample CSV, or as the bytes the probe would send (`.bin`).
 use anyhow::{Context, Result};
 use clap::ValueEnum;
-use firmware::app::Navigator;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::sim::DeterministicErrors;
 use host_sim::sim::{
@@ -11,6 +10,7 @@ use host_sim::sim::{
 use host_sim::{capture, samples_csv};
 use mwd_core::conventions::Euler;
 use mwd_core::earth::Position;
+use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::NO_PART;
 use mwd_core::protocol::{Event, EventKind, Payload};
 use nalgebra::Vector3;

@@ -6,8 +6,9 @@ use super::sensor::{DeterministicErrors, SensorModel};
 use anyhow::{ensure, Context, Result};
 use mwd_core::ar::Ar4;
 use mwd_core::sensor_noise::{
-    arw_from_deg_per_sqrt_hour, rate_from_deg_per_hour, AxisNoise, ImuNoise, STANDARD_GRAVITY,
+    arw_from_deg_per_sqrt_hour, rate_from_deg_per_hour, AxisNoise, ImuNoise,
 };
+use mwd_core::sensor_units::STANDARD_GRAVITY;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 

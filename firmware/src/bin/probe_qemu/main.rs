@@ -28,8 +28,9 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception};
 use critical_section::{CriticalSection, Mutex};
-use firmware::app::{start_parts, Navigator, ProbeState, Recovery};
+use firmware::app::{start_parts, ProbeState, Recovery};
 use mwd_core::earth::Position;
+use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::{nav_mode, NO_PART};
 use mwd_core::protocol::{EventKind, Payload};
 

@@ -1,8 +1,9 @@
-//! The navigation work of the main loop (lower priority than acquisition):
+//! The probe's navigation, run by its main loop (lower priority than
+//! acquisition):
 //! raw samples in, navigation-solution frames out. The probe must first be
 //! still:
 //! 1. coarse alignment: the first 5 s of samples are averaged, levelled and
-//!    gyrocompassed (`mwd_core::alignment`);
+//!    gyrocompassed (`crate::alignment`);
 //! 2. fine alignment: the 39-state filter (33 AR-augmented states of the
 //!    paper plus six sensor biases) with zero-velocity and zero-position
 //!    updates, closed loop, until 60 s (the paper's test length), with the
@@ -14,71 +15,28 @@
 //!    filter's dynamics) and the reported uncertainties grow honestly.
 //!
 //! Every sample first goes through the probe's calibration (the host's
-//! six-position result, `mwd_core::calibration`). Uses only mwd-core: the
-//! host replays the same raw frames through this same code and must get
-//! the probe's solutions bit for bit.
+//! six-position result, [`crate::calibration`]). The host replays the same
+//! raw frames through this same code and must get the probe's solutions
+//! bit for bit.
 
-use mwd_core::alignment::{
-    gyrocompass, level_segment, AlignmentConfig, StaticSegment, PROBE_GYROS,
-};
-use mwd_core::attitude::ToolAxisRate;
-use mwd_core::calibration::ProbeCalibration;
-use mwd_core::conventions::{euler_from_quat, quat_from_euler, Euler};
-use mwd_core::earth::Position;
-use mwd_core::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
-use mwd_core::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
-use mwd_core::mechanization::{NavState, ProbeInput};
-use mwd_core::protocol::frame::{nav_flags, nav_mode, raw_flags};
-use mwd_core::protocol::{NavSolution, RawSample};
-use mwd_core::sensor_noise::ImuNoise;
-use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s, PART_MOUNTINGS};
+use super::raw::body_sample;
+use super::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
+use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, StaticSegment};
+use crate::attitude::ToolAxisRate;
+use crate::calibration::ProbeCalibration;
+use crate::conventions::{euler_from_quat, quat_from_euler, Euler};
+use crate::earth::Position;
+use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
+use crate::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
+use crate::mechanization::{NavState, ProbeInput};
+use crate::protocol::frame::nav_flags;
+use crate::protocol::frame::nav_mode;
+use crate::protocol::{NavSolution, RawSample};
+use crate::sensor_noise::ImuNoise;
 use nalgebra::{UnitQuaternion, Vector3};
-
-/// Sample interval of the probe (s).
-pub const SAMPLE_INTERVAL_S: f64 = 0.05;
-/// Still samples averaged for the coarse alignment: 5 s, as in the paper.
-pub const ALIGNMENT_SAMPLES: u32 = 100;
-/// Samples of fine alignment after the coarse one: to 60 s in all, the
-/// paper's static test.
-pub const FINE_ALIGNMENT_SAMPLES: u32 = 1100;
 
 /// The probe's filter: f32 (the M4F's FPU), 39 states.
 type Filter = FineAlignment<f32, STATES_WITH_BIASES>;
-
-/// Body-frame rates (x and z gyros) and specific force of one raw sample,
-/// corrected by `calibration`, or `None` when a part's reading is not
-/// valid.
-pub fn body_sample(
-    raw: &RawSample,
-    calibration: &ProbeCalibration,
-) -> Option<(f64, f64, Vector3<f64>)> {
-    let valid = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
-    if raw.parts.iter().any(|p| p.flags & valid != valid) {
-        return None;
-    }
-    let mut rate = [0.0f64; 3];
-    let mut force = Vector3::zeros();
-    for (((part, mounting), triad), gyro_cal) in raw
-        .parts
-        .iter()
-        .zip(PART_MOUNTINGS)
-        .zip(&calibration.accel)
-        .zip(&calibration.gyro)
-    {
-        let gyro = mounting.gyro_axis();
-        let value = f64::from(gyro_count_to_rad_s(part.gyro_rate));
-        let value = if gyro.negative { -value } else { value };
-        rate[gyro.axis as usize] = gyro_cal.apply(value);
-        // Each part's triad is corrected in body axes (the frame the host's
-        // calibration is fitted in); both then see the same body force, so
-        // they are averaged.
-        let body = mounting
-            .sensor_to_body(part.accel.map(accel_count_to_m_s2))
-            .map(f64::from);
-        force += 0.5 * Vector3::from(triad.apply(body));
-    }
-    Some((rate[0], rate[2], force))
-}
 
 /// The filter's settings for a still probe at `position` whose coarse
 /// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
@@ -212,14 +170,7 @@ impl Navigator {
     }
 
     fn finish_coarse_alignment(&mut self, segment: &StaticSegment) {
-        let noise = ImuNoise::scc1300();
-        let config = AlignmentConfig {
-            latitude: self.position.lat,
-            sample_interval: SAMPLE_INTERVAL_S,
-            gyro_axes: PROBE_GYROS,
-            noise,
-            heading_prior: None,
-        };
+        let config = AlignmentConfig::probe(self.position.lat);
         let (roll, pitch, roll_pitch_std) = match level_segment(segment, &config) {
             Ok(l) => (l.roll.value, l.pitch.value, [l.roll.sigma, l.pitch.sigma]),
             Err(_) => (0.0, 0.0, [f64::NAN; 2]),
@@ -302,9 +253,10 @@ impl Navigator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mwd_core::calibration::TriadCalibration;
-    use mwd_core::protocol::RawPart;
-    use mwd_core::sensor_units::{m_s2_to_accel_count, STANDARD_GRAVITY_M_S2};
+    use crate::calibration::TriadCalibration;
+    use crate::protocol::frame::raw_flags;
+    use crate::protocol::RawPart;
+    use crate::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
 
     /// A still probe feeling `force` (body axes, m/s^2), no rotation (the
     /// hil-mock generator's static probe, which has no earth rate).
