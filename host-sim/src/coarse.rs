@@ -5,15 +5,14 @@ use crate::samples_csv::Record;
 use anyhow::{bail, Result};
 use mwd_core::alignment::{
     analytical, gyrocompass, level_segment, AlignmentConfig, HeadingEstimate, LevelEstimate,
-    StaticSegment, COVERAGE_FACTOR, MAX_SEGMENTS,
+    SegmentSums, StaticSegment, COVERAGE_FACTOR, MAX_SEGMENTS,
 };
+use mwd_core::attitude::level;
 use mwd_core::calibration::ProbeCalibration;
-use mwd_core::conventions::{wrap_pi, DrillingAngles, Euler};
-use nalgebra::Vector3;
+use mwd_core::conventions::{wrap_pi, DrillingAngles, Euler, DEG};
 use std::fmt::Write as _;
 use std::ops::Range;
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Samples per block when looking for static segments (1 s at 20 Hz).
 const BLOCK: usize = 20;
 /// Blocks whose mean roll moves more than this from the previous block's
@@ -22,35 +21,26 @@ const TOOLFACE_CHANGE: f64 = 2.0 * DEG;
 /// Shortest static segment worth keeping (blocks).
 const MIN_SEGMENT_BLOCKS: usize = 3;
 
-/// Applies the probe's calibration to one record (body-frame triad of the
-/// first part; gyros on body x and z).
+/// Applies the probe's calibration to one record as the probe does
+/// ([`ProbeCalibration::correct`]): the file's one accelerometer triad
+/// stands for both parts' (each corrected with its own calibration, then
+/// averaged), the gyros on body x and z.
 pub fn calibrated(record: &Record, calibration: &ProbeCalibration) -> Record {
-    let f = calibration.accel[0].apply([record.accel.x, record.accel.y, record.accel.z]);
+    let s = &record.sample;
+    let triad: [f64; 3] = s.specific_force.into();
     Record {
-        gyro: Vector3::new(
-            calibration.gyro[0].apply(record.gyro.x),
-            f64::NAN,
-            calibration.gyro[1].apply(record.gyro.z),
-        ),
-        accel: Vector3::from(f),
+        sample: calibration.correct(s.rate_x(), s.rate_z(), &[triad; 2]),
         ..record.clone()
     }
 }
 
 /// The static segment of a run of records: their means.
 pub fn segment(records: &[Record]) -> StaticSegment {
-    let n = records.len().max(1) as f64;
-    let mut f = Vector3::zeros();
-    let mut w = Vector3::zeros();
+    let mut sums = SegmentSums::default();
     for r in records {
-        f += r.accel;
-        w += Vector3::new(r.gyro.x, 0.0, r.gyro.z);
+        sums.add(&r.sample);
     }
-    StaticSegment {
-        specific_force: f / n,
-        rate: w / n,
-        samples: records.len(),
-    }
+    sums.segment()
 }
 
 /// Finds the static segments of a run: 1 s blocks, split where the mean
@@ -60,10 +50,8 @@ pub fn find_segments(records: &[Record]) -> Vec<Range<usize>> {
     let blocks: Vec<Range<usize>> = (0..records.len() / BLOCK)
         .map(|b| b * BLOCK..(b + 1) * BLOCK)
         .collect();
-    let roll = |range: &Range<usize>| {
-        let f = segment(&records[range.clone()]).specific_force;
-        libm::atan2(-f.x, f.z)
-    };
+    let roll =
+        |range: &Range<usize>| level(&segment(&records[range.clone()]).mean.specific_force).roll;
     let mut runs: Vec<Range<usize>> = Vec::new();
     let mut start = 0;
     for b in 1..=blocks.len() {

@@ -14,8 +14,9 @@ use mwd_core::earth::Position;
 use mwd_core::error_model::{
     AugmentedModel, Coupling, ProcessNoise, NAV_STATES, STATES, STATES_WITH_BIASES, VEL,
 };
-use mwd_core::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
+use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use mwd_core::mechanization::NavState;
+use mwd_core::mechanization::{ProbeInput, ToolAxisSource};
 use mwd_core::sensor_noise::ImuNoise;
 use nalgebra::Vector3;
 
@@ -83,7 +84,11 @@ impl Settings {
 
     /// The filter settings on `model`'s AR and bias models (the paper's:
     /// [`AugmentedModel::paper`]; `--ar-models` loads fitted ones).
-    fn config(&self, model: &AugmentedModel, coarse_sigma: &[f64; 3]) -> FineAlignmentConfig {
+    fn config<const N: usize>(
+        &self,
+        model: &AugmentedModel,
+        coarse_sigma: &[f64; 3],
+    ) -> FineAlignmentConfig<N> {
         let mut model = *model;
         match self {
             Settings::PaperAsPublished => {
@@ -96,7 +101,6 @@ impl Settings {
                 &ImuNoise::scc1300(),
                 coarse_sigma,
                 Position::paper_site().lat,
-                *self == Settings::Physical,
             ),
         }
     }
@@ -173,27 +177,29 @@ pub fn fine_align(
     settings: Settings,
     model: &AugmentedModel,
 ) -> History {
-    let config = settings.config(model, coarse_sigma);
     if settings.states() == STATES_WITH_BIASES {
-        fine_align_with::<STATES_WITH_BIASES>(records, coarse, config)
+        fine_align_with::<STATES_WITH_BIASES>(records, coarse, settings.config(model, coarse_sigma))
     } else {
-        fine_align_with::<STATES>(records, coarse, config)
+        fine_align_with::<STATES>(records, coarse, settings.config(model, coarse_sigma))
     }
 }
 
 fn fine_align_with<const N: usize>(
     records: &[Record],
     coarse: &Euler,
-    config: FineAlignmentConfig,
+    config: FineAlignmentConfig<N>,
 ) -> History {
     let position = Position::paper_site();
     let start = NavState::at_rest(quat_from_euler(coarse), position);
     let mut fa = FineAlignment::<f32, N>::new(start, position, config);
     let t = truth();
     let mut h = History::default();
+    let mut input = ProbeInput::new();
+    let dt = SAMPLE_INTERVAL;
     for r in records {
         // The tool is at rest: its rate about the tool axis is the frame's.
-        fa.step(&at_rest_sample(fa.state(), r.gyro.x, r.gyro.z, r.accel));
+        let (imu, _) = input.imu_sample(fa.state(), &r.sample, ToolAxisSource::AtRest, dt);
+        fa.step(&imu);
         let e = euler_from_quat(&fa.state().attitude);
         let sigma = fa.euler_std() / DEG;
         let p = &fa.filter().p;

@@ -5,6 +5,7 @@
 use crate::sim::SimSample;
 use anyhow::{bail, Context, Result};
 use mwd_core::conventions::Euler;
+use mwd_core::probe_sample::ProbeSample;
 use nalgebra::Vector3;
 use std::io::{BufRead, Write};
 
@@ -22,9 +23,8 @@ const TRUTH: [&str; 3] = ["true_roll_rad", "true_pitch_rad", "true_heading_rad"]
 #[derive(Clone, Debug, PartialEq)]
 pub struct Record {
     pub time: f64,
-    /// Rates (rad/s); y is NaN (no tool-axis gyro).
-    pub gyro: Vector3<f64>,
-    pub accel: Vector3<f64>,
+    /// The x and z gyros and the specific force, body frame.
+    pub sample: ProbeSample,
     pub truth: Option<Euler>,
 }
 
@@ -32,8 +32,7 @@ impl From<&SimSample> for Record {
     fn from(s: &SimSample) -> Self {
         Self {
             time: s.time,
-            gyro: s.gyro,
-            accel: s.accel,
+            sample: ProbeSample::new(s.gyro.x, s.gyro.z, s.accel),
             truth: Some(s.truth),
         }
     }
@@ -132,8 +131,7 @@ pub fn read<R: BufRead>(input: R) -> Result<Vec<Record>> {
         };
         records.push(Record {
             time: m[0],
-            gyro: Vector3::new(m[1], f64::NAN, m[2]),
-            accel: Vector3::new(m[3], m[4], m[5]),
+            sample: ProbeSample::new(m[1], m[2], Vector3::new(m[3], m[4], m[5])),
             truth,
         });
     }
@@ -159,8 +157,9 @@ mod tests {
         let back = read(buf.as_slice()).unwrap();
         assert_eq!(back.len(), 10);
         for (r, s) in back.iter().zip(&samples) {
-            assert!((r.gyro.x - s.gyro.x).abs() <= 1e-5 * s.gyro.x.abs());
-            assert!((r.accel.z - s.accel.z).abs() <= 1e-5 * s.accel.z.abs());
+            assert!((r.sample.rate_x() - s.gyro.x).abs() <= 1e-5 * s.gyro.x.abs());
+            let f = r.sample.specific_force;
+            assert!((f.z - s.accel.z).abs() <= 1e-5 * s.accel.z.abs());
             assert!(r.truth.is_some());
         }
     }

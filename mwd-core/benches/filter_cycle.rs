@@ -5,10 +5,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
-use mwd_core::earth::{earth_rate_n, gravity_n, Position};
-use mwd_core::error_model::{
-    AugmentedModel, EarthTerms, LinearizationPoint, ProcessNoise, POS, STATES, VEL,
-};
+use mwd_core::earth::{earth_rate_n, gravity_n, LocalEarth, Position};
+use mwd_core::error_model::{AugmentedModel, LinearizationPoint, ProcessNoise, POS, STATES, VEL};
 use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use mwd_core::kalman::{dense, FilterScalar};
 use mwd_core::mechanization::{ImuSample, NavState, Strapdown};
@@ -51,7 +49,7 @@ struct DenseCycle<T: FilterScalar> {
     r: SMatrix<T, 6, 6>,
     reference: Position,
     /// Geodetic terms cached as in the fast cycle: compare filters, not caches.
-    earth: EarthTerms,
+    earth: LocalEarth,
 }
 
 impl<T: FilterScalar> DenseCycle<T> {
@@ -73,7 +71,7 @@ impl<T: FilterScalar> DenseCycle<T> {
             h,
             r: SMatrix::identity() * T::of(0.1),
             reference: state.position,
-            earth: EarthTerms::at(&state.position),
+            earth: LocalEarth::at(&state.position),
         }
     }
 

@@ -35,16 +35,13 @@
 use crate::attitude::level;
 use crate::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler};
 use crate::earth::{earth_rate_n, EARTH_RATE};
+use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::sensor_noise::ImuNoise;
 use core::f64::consts::{PI, TAU};
 use nalgebra::{Matrix3, Vector3};
 
 /// Most segments one alignment takes (toolface positions).
 pub const MAX_SEGMENTS: usize = 8;
-/// The probe's gyros: body x and z.
-pub const PROBE_GYROS: [bool; 3] = [true, false, true];
-/// A full three-gyro IMU (for comparison with the paper's formulas).
-pub const ALL_GYROS: [bool; 3] = [true, true, true];
 /// Heading is ill-conditioned when the earth-rate signal changes with
 /// heading by less than this fraction of the horizontal earth rate
 /// Omega cos(lat): gyro errors are then magnified more than about three
@@ -82,12 +79,44 @@ const NEWTON_STEP: f64 = 1e-5;
 /// Means of one static segment (one toolface position).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StaticSegment {
-    /// Mean specific force f_ib^b (m/s^2).
-    pub specific_force: Vector3<f64>,
-    /// Mean angular rate omega_ib^b (rad/s); axes without a gyro are ignored.
-    pub rate: Vector3<f64>,
+    /// Mean gyro rates and specific force.
+    pub mean: ProbeSample,
     /// Number of samples averaged.
     pub samples: usize,
+}
+
+/// Running sums of still samples, for their [`StaticSegment`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SegmentSums {
+    gyro: [f64; 2],
+    specific_force: Vector3<f64>,
+    samples: usize,
+}
+
+impl SegmentSums {
+    pub fn add(&mut self, sample: &ProbeSample) {
+        self.gyro[0] += sample.gyro[0];
+        self.gyro[1] += sample.gyro[1];
+        self.specific_force += sample.specific_force;
+        self.samples += 1;
+    }
+
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// The means (a segment of no samples, which the alignment rejects,
+    /// when nothing was added).
+    pub fn segment(&self) -> StaticSegment {
+        let n = self.samples.max(1) as f64;
+        StaticSegment {
+            mean: ProbeSample {
+                gyro: self.gyro.map(|sum| sum / n),
+                specific_force: self.specific_force / n,
+            },
+            samples: self.samples,
+        }
+    }
 }
 
 /// What the alignment needs to know besides the data.
@@ -97,8 +126,6 @@ pub struct AlignmentConfig {
     pub latitude: f64,
     /// Sample interval (s).
     pub sample_interval: f64,
-    /// Which body axes have a gyro.
-    pub gyro_axes: [bool; 3],
     /// The sensors' error budget.
     pub noise: ImuNoise,
     /// A heading known roughly (e.g. the parent well's survey), used only to
@@ -108,13 +135,11 @@ pub struct AlignmentConfig {
 
 impl AlignmentConfig {
     /// The probe's coarse alignment at `latitude` (rad): 20 Hz samples,
-    /// gyros across the tool axis only, the SCC1300's error budget, no
-    /// heading prior. The probe and the host's tools all start from this.
+    /// the SCC1300's error budget, no heading prior. The probe and the host's tools all start from this.
     pub fn probe(latitude: f64) -> Self {
         Self {
             latitude,
-            sample_interval: crate::probe::timing::SAMPLE_INTERVAL_S,
-            gyro_axes: PROBE_GYROS,
+            sample_interval: crate::timing::SAMPLE_INTERVAL_S,
             noise: ImuNoise::scc1300(),
             heading_prior: None,
         }
@@ -187,8 +212,6 @@ pub enum AlignmentError {
     InvalidData,
     /// The specific force is far from gravity: the tool is not at rest.
     NotStatic,
-    /// No gyro axis is configured.
-    NoGyro,
     /// The misfit does not change with heading: the gyros see no horizontal
     /// earth rate (at a pole, or with a single gyro along the vertical).
     NoHeadingInformation,
@@ -200,14 +223,14 @@ pub fn level_segment(
     config: &AlignmentConfig,
 ) -> Result<LevelEstimate, AlignmentError> {
     check_segment(segment)?;
-    let lev = level(&segment.specific_force);
+    let lev = level(&segment.mean.specific_force);
     let mut var = [0.0; 2];
     for axis in 0..3 {
         let noise = &config.noise.accel[axis];
         let sigma = noise.mean_sigma(segment.samples, config.sample_interval);
         let total = sigma * sigma + noise.residual_bias * noise.residual_bias;
         let h = step_size(sigma, noise.residual_bias, 1e-6);
-        let mut plus = segment.specific_force;
+        let mut plus = segment.mean.specific_force;
         let mut minus = plus;
         plus[axis] += h;
         minus[axis] -= h;
@@ -236,7 +259,7 @@ pub fn gyrocompass(
     segments: &[StaticSegment],
     config: &AlignmentConfig,
 ) -> Result<HeadingEstimate, AlignmentError> {
-    check_all(segments, config)?;
+    check_all(segments)?;
     let sigmas = MeanSigmas::new(segments, config);
     let model = Misfit::new(segments, config, &sigmas);
     let grid = model.grid();
@@ -301,21 +324,17 @@ pub fn analytical(
     segment: &StaticSegment,
     config: &AlignmentConfig,
 ) -> Result<HeadingEstimate, AlignmentError> {
-    check_all(core::slice::from_ref(segment), config)?;
+    check_all(core::slice::from_ref(segment))?;
     let solve = |seg: &StaticSegment, sign: f64| triad_heading(seg, config, sign);
     let plus = solve(segment, 1.0);
-    let (chosen_sign, alternative) = if config.gyro_axes[1] {
-        (1.0, None)
+    let minus = solve(segment, -1.0);
+    let prefer_minus = config
+        .heading_prior
+        .is_some_and(|p| wrap_pi(minus - p).abs() < wrap_pi(plus - p).abs());
+    let (chosen_sign, alternative) = if prefer_minus {
+        (-1.0, Some(plus))
     } else {
-        let minus = solve(segment, -1.0);
-        let prefer_minus = config
-            .heading_prior
-            .is_some_and(|p| wrap_pi(minus - p).abs() < wrap_pi(plus - p).abs());
-        if prefer_minus {
-            (-1.0, Some(plus))
-        } else {
-            (1.0, Some(minus))
-        }
+        (1.0, Some(minus))
     };
     let heading = solve(segment, chosen_sign);
     let sigmas = MeanSigmas::new(core::slice::from_ref(segment), config);
@@ -359,23 +378,16 @@ pub fn analytical(
 }
 
 fn triad_heading(segment: &StaticSegment, config: &AlignmentConfig, sign: f64) -> f64 {
-    let mut w_b = segment.rate;
-    for axis in 0..3 {
-        if !config.gyro_axes[axis] {
-            w_b[axis] = 0.0;
-        }
+    let (x, z) = (segment.mean.rate_x(), segment.mean.rate_z());
+    let rest = EARTH_RATE * EARTH_RATE - x * x - z * z;
+    if rest < 0.0 {
+        // The measured cross-axis rates exceed the whole earth rate:
+        // noise or bias dominates and the magnitude constraint has no
+        // solution. No heading (the caller reports it undetermined).
+        return f64::NAN;
     }
-    if !config.gyro_axes[1] {
-        let rest = EARTH_RATE * EARTH_RATE - w_b.x * w_b.x - w_b.z * w_b.z;
-        if rest < 0.0 {
-            // The measured cross-axis rates exceed the whole earth rate:
-            // noise or bias dominates and the magnitude constraint has no
-            // solution. No heading (the caller reports it undetermined).
-            return f64::NAN;
-        }
-        w_b.y = sign * libm::sqrt(rest);
-    }
-    let g_b = -segment.specific_force;
+    let w_b = segment.mean.rate_with_tool_axis(sign * libm::sqrt(rest));
+    let g_b = -segment.mean.specific_force;
     let g_n = Vector3::new(0.0, 0.0, g_b.norm());
     let w_n = earth_rate_n(config.latitude);
     // Orthonormal triads built from (g, g x w) in both frames: eq. 30's
@@ -427,26 +439,21 @@ fn ill_conditioned(
 }
 
 fn check_segment(segment: &StaticSegment) -> Result<(), AlignmentError> {
-    let finite = segment.specific_force.iter().all(|v| v.is_finite())
-        && segment.rate.iter().all(|v| v.is_finite());
-    if !finite || segment.samples == 0 {
+    if !segment.mean.is_finite() || segment.samples == 0 {
         return Err(AlignmentError::InvalidData);
     }
     // At rest the specific force is gravity (about 9.8 m/s^2 anywhere on
     // earth); 20 % off means the tool moved or a sensor failed.
-    let f = segment.specific_force.norm();
+    let f = segment.mean.specific_force.norm();
     if !(7.8..=11.8).contains(&f) {
         return Err(AlignmentError::NotStatic);
     }
     Ok(())
 }
 
-fn check_all(segments: &[StaticSegment], config: &AlignmentConfig) -> Result<(), AlignmentError> {
+fn check_all(segments: &[StaticSegment]) -> Result<(), AlignmentError> {
     if segments.is_empty() || segments.len() > MAX_SEGMENTS {
         return Err(AlignmentError::SegmentCount);
-    }
-    if !config.gyro_axes.iter().any(|&a| a) {
-        return Err(AlignmentError::NoGyro);
     }
     segments.iter().try_for_each(check_segment)
 }
@@ -501,8 +508,7 @@ where
     F: Fn(&[StaticSegment]) -> Option<f64>,
 {
     let mut work = [StaticSegment {
-        specific_force: Vector3::zeros(),
-        rate: Vector3::zeros(),
+        mean: ProbeSample::default(),
         samples: 1,
     }; MAX_SEGMENTS];
     let n = segments.len().min(MAX_SEGMENTS);
@@ -511,7 +517,8 @@ where
     // Inputs: 0..3 accelerometer axes, 3..6 rate axes.
     for input in 0..6 {
         let (axis, is_gyro) = (input % 3, input >= 3);
-        if is_gyro && !config.gyro_axes[axis] {
+        let gyro = GYRO_AXES.iter().position(|&a| a == axis);
+        if is_gyro && gyro.is_none() {
             continue;
         }
         let noise = if is_gyro {
@@ -533,12 +540,11 @@ where
             let h = step_size(sigma, noise.residual_bias, floor);
             let original = work[i];
             let mut shifted = |delta: f64| {
-                let target = if is_gyro {
-                    &mut work[i].rate
-                } else {
-                    &mut work[i].specific_force
-                };
-                target[axis] += delta;
+                let mean = &mut work[i].mean;
+                match gyro {
+                    Some(k) if is_gyro => mean.gyro[k] += delta,
+                    _ => mean.specific_force[axis] += delta,
+                }
                 let value = estimate(&work[..n]);
                 work[i] = original;
                 value
@@ -578,7 +584,7 @@ impl<'a> Misfit<'a> {
         let mut levelled = [Matrix3::identity(); MAX_SEGMENTS];
         let mut weights = [[0.0; 3]; MAX_SEGMENTS];
         for (i, seg) in segments.iter().take(MAX_SEGMENTS).enumerate() {
-            let lev = level(&seg.specific_force);
+            let lev = level(&seg.mean.specific_force);
             levelled[i] = dcm_from_euler(&Euler::new(lev.roll, lev.pitch, 0.0));
             for (weight, s) in weights[i].iter_mut().zip(sigmas.gyro[i]) {
                 // A noise-free axis still gets a finite weight so the
@@ -605,9 +611,10 @@ impl<'a> Misfit<'a> {
         (rz * self.levelled[i]).transpose() * earth_rate_n(self.config.latitude)
     }
 
-    /// Bias estimate of one axis at a heading, and the misfit it leaves.
-    fn axis_fit(&self, axis: usize, heading: f64) -> (f64, f64) {
-        self.axis_fit_with(axis, &self.all_predicted(heading))
+    /// Bias estimate of gyro `k` (about body axis `GYRO_AXES[k]`) at a
+    /// heading, and the misfit it leaves.
+    fn axis_fit(&self, k: usize, heading: f64) -> (f64, f64) {
+        self.axis_fit_with(k, &self.all_predicted(heading))
     }
 
     /// Predicted gyro means of every segment at a heading (computed once
@@ -620,14 +627,15 @@ impl<'a> Misfit<'a> {
         predicted
     }
 
-    fn axis_fit_with(&self, axis: usize, predicted: &[Vector3<f64>; MAX_SEGMENTS]) -> (f64, f64) {
+    fn axis_fit_with(&self, k: usize, predicted: &[Vector3<f64>; MAX_SEGMENTS]) -> (f64, f64) {
+        let axis = GYRO_AXES[k];
         let prior = self.config.noise.gyro[axis].residual_bias;
         let prior_weight = if prior > 0.0 {
             1.0 / (prior * prior)
         } else {
             f64::INFINITY
         };
-        let residual = |i: usize| self.segments[i].rate[axis] - predicted[i][axis];
+        let residual = |i: usize| self.segments[i].mean.gyro[k] - predicted[i][axis];
         let (mut num, mut den) = (0.0, prior_weight);
         for i in 0..self.count() {
             num += self.weights[i][axis] * residual(i);
@@ -648,16 +656,15 @@ impl<'a> Misfit<'a> {
 
     fn cost(&self, heading: f64) -> f64 {
         let predicted = self.all_predicted(heading);
-        (0..3)
-            .filter(|&a| self.config.gyro_axes[a])
-            .map(|a| self.axis_fit_with(a, &predicted).1)
+        (0..GYRO_AXES.len())
+            .map(|k| self.axis_fit_with(k, &predicted).1)
             .sum()
     }
 
     fn biases(&self, heading: f64) -> Vector3<f64> {
         let mut b = Vector3::zeros();
-        for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
-            b[axis] = self.axis_fit(axis, heading).0;
+        for (k, axis) in GYRO_AXES.into_iter().enumerate() {
+            b[axis] = self.axis_fit(k, heading).0;
         }
         b
     }
@@ -845,7 +852,7 @@ impl<'a> Misfit<'a> {
     /// of the predicted rate with heading).
     fn cramer_rao_sigma(&self, heading: f64) -> f64 {
         let mut information = 0.0;
-        for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
+        for axis in GYRO_AXES {
             let prior = self.config.noise.gyro[axis].residual_bias;
             let prior_weight = if prior > 0.0 {
                 1.0 / (prior * prior)
@@ -887,7 +894,7 @@ impl<'a> Misfit<'a> {
         let mut sum = 0.0;
         for i in 0..self.count() {
             let d = self.predicted_slope(i, heading);
-            for axis in (0..3).filter(|&a| self.config.gyro_axes[a]) {
+            for axis in GYRO_AXES {
                 sum += d[axis] * d[axis];
             }
         }

@@ -2,6 +2,7 @@
 //! and the probe's accelerometer-derived roll and tool-axis rate (paper
 //! section 2.2, eq. 1-10, with the errata in `shared/paper/mgwd.md`).
 use crate::conventions::wrap_pi;
+use crate::probe_sample::ProbeSample;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// Below this rotation angle (rad) the series forms are used; their
@@ -114,17 +115,15 @@ impl ToolAxisRateEstimator {
         Self::default()
     }
 
-    /// One sample: the current specific force, the x and z gyro rates, the
-    /// navigation frame's rate in body axes, and the sample interval.
+    /// One sample of the probe, the navigation frame's rate in body axes,
+    /// and the sample interval.
     pub fn update(
         &mut self,
-        specific_force: &Vector3<f64>,
-        gyro_x: f64,
-        gyro_z: f64,
+        sample: &ProbeSample,
         omega_in_b: &Vector3<f64>,
         dt: f64,
     ) -> ToolAxisRate {
-        let lev = level(specific_force);
+        let lev = level(&sample.specific_force);
         // Written so that a NaN interval is rejected too.
         let dt_valid = dt > 0.0;
         if !lev.roll_valid || !dt_valid {
@@ -137,8 +136,8 @@ impl ToolAxisRateEstimator {
         };
         let roll_rate = wrap_pi(lev.roll - previous) / dt;
         let (s, c) = (libm::sin(lev.roll), libm::cos(lev.roll));
-        let nb_x = gyro_x - omega_in_b.x;
-        let nb_z = gyro_z - omega_in_b.z;
+        let nb_x = sample.rate_x() - omega_in_b.x;
+        let nb_z = sample.rate_z() - omega_in_b.z;
         let nb_y = roll_rate - libm::tan(lev.pitch) * (nb_x * s - nb_z * c);
         ToolAxisRate::Valid(nb_y + omega_in_b.y)
     }
@@ -340,7 +339,7 @@ mod tests {
         for k in 0..5 {
             let e = Euler::new(0.1 + rate * dt * k as f64, pitch, heading);
             let f = specific_force_at_rest(&e, 9.8);
-            last = est.update(&f, 0.0, 0.0, &Vector3::zeros(), dt);
+            last = est.update(&ProbeSample::new(0.0, 0.0, f), &Vector3::zeros(), dt);
             if k == 0 {
                 assert_eq!(last, ToolAxisRate::Unavailable);
             }
@@ -365,7 +364,7 @@ mod tests {
             let c = dcm_from_euler(&e);
             let w_b = c.transpose() * omega_n;
             let f = specific_force_at_rest(&e, 9.8);
-            last = est.update(&f, w_b.x, w_b.z, &Vector3::zeros(), dt);
+            last = est.update(&ProbeSample::new(w_b.x, w_b.z, f), &Vector3::zeros(), dt);
             if k == 2 {
                 let ToolAxisRate::Valid(r) = last else {
                     panic!("expected a rate")
@@ -382,7 +381,7 @@ mod tests {
         let f = specific_force_at_rest(&Euler::new(0.0, -1.56, 0.0), 9.8);
         for _ in 0..3 {
             assert_eq!(
-                est.update(&f, 0.0, 0.0, &Vector3::zeros(), 0.05),
+                est.update(&ProbeSample::new(0.0, 0.0, f), &Vector3::zeros(), 0.05),
                 ToolAxisRate::Unavailable
             );
         }
@@ -390,7 +389,7 @@ mod tests {
         // A NaN sample never produces a rate either.
         let nan = Vector3::new(f64::NAN, 0.0, 9.8);
         assert_eq!(
-            est.update(&nan, 0.0, 0.0, &Vector3::zeros(), 0.05),
+            est.update(&ProbeSample::new(0.0, 0.0, nan), &Vector3::zeros(), 0.05),
             ToolAxisRate::Unavailable
         );
     }

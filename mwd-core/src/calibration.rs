@@ -6,6 +6,9 @@
 //! that a calibration file means the same thing everywhere. No heap, no
 //! transcendental functions: the correction is an affine map.
 
+use crate::probe_sample::ProbeSample;
+use nalgebra::Vector3;
+
 /// Correction of one accelerometer triad: `corrected = M (raw - bias)`.
 ///
 /// `bias` is in the sensor's output units (m/s^2 for accelerometers);
@@ -99,6 +102,25 @@ pub struct ProbeCalibration {
     pub accel: [TriadCalibration; 2],
     /// Gyros sensing body x and body z.
     pub gyro: [GyroCalibration; 2],
+}
+
+impl ProbeCalibration {
+    /// The probe's sample from its readings in body axes: the x and z gyro
+    /// rates and each part's accelerometer triad. Each is corrected with
+    /// its own calibration (fitted in body axes); both triads feel the same
+    /// body force, so they are then averaged. The probe and the host's
+    /// tools all go through here.
+    pub fn correct(&self, rate_x: f64, rate_z: f64, accel_body: &[[f64; 3]; 2]) -> ProbeSample {
+        let mut force = Vector3::zeros();
+        for (triad, calibration) in accel_body.iter().zip(&self.accel) {
+            force += 0.5 * Vector3::from(calibration.apply(*triad));
+        }
+        ProbeSample::new(
+            self.gyro[0].apply(rate_x),
+            self.gyro[1].apply(rate_z),
+            force,
+        )
+    }
 }
 
 #[cfg(test)]

@@ -55,47 +55,112 @@ impl Position {
 
     /// This position moved by a small north-east-down offset in metres.
     pub fn displaced(&self, ned: &Vector3<f64>) -> Self {
-        self.displaced_with_trig(ned, &LatitudeTrig::new(self.lat))
-    }
-
-    /// [`displaced`](Self::displaced) with the sine and cosine of this
-    /// position's latitude already at hand (one square root, no
-    /// trigonometry).
-    pub fn displaced_with_trig(&self, ned: &Vector3<f64>, trig: &LatitudeTrig) -> Self {
-        let r = radii_from_trig(trig);
-        Self {
-            lat: self.lat + ned.x / (r.meridian + self.height),
-            lon: self.lon + ned.y / ((r.transverse + self.height) * trig.cos),
-            height: self.height - ned.z,
-        }
+        LocalEarth::at(self).displaced(ned)
     }
 
     /// North-east-down offset in metres of this position from `origin`, to
     /// first order (good to millimetres over the kilometres of a well).
     pub fn ned_from(&self, origin: &Position) -> Vector3<f64> {
-        let r = radii(origin.lat);
-        Vector3::new(
-            (self.lat - origin.lat) * (r.meridian + origin.height),
-            (self.lon - origin.lon) * (r.transverse + origin.height) * libm::cos(origin.lat),
-            origin.height - self.height,
-        )
+        LocalEarth::at(origin).offset_to(self)
     }
 }
 
-/// Sine and cosine of a geodetic latitude. The latitude-dependent terms
-/// below (radii, normal gravity, earth and transport rate) all derive from
-/// them: a caller that needs several terms at one latitude computes this
-/// once (one `libm::sincos`) and passes it to the `*_from_trig` functions.
+/// The earth around one position: everything the navigation needs of the
+/// ellipsoid there, from one sine and cosine of the latitude. The
+/// mechanization builds one per step; the filter keeps one while the
+/// solution stays near it ([`is_near`](Self::is_near)), since on the probe
+/// the geodetic terms cost ~15 000 instructions of software f64 and change
+/// by parts per million over a kilometre.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LatitudeTrig {
-    pub sin: f64,
-    pub cos: f64,
+pub struct LocalEarth {
+    pub position: Position,
+    pub sin_lat: f64,
+    pub cos_lat: f64,
+    /// Meridian radius of curvature plus height, R_M + h (m).
+    pub meridian: f64,
+    /// Transverse radius of curvature plus height, R_N + h (m).
+    pub transverse: f64,
+    /// Normal gravity (m/s^2).
+    pub gravity: f64,
+    /// Free-air gravity gradient dg/dh = -2 g / R, R the Gaussian mean
+    /// radius sqrt((R_M + h)(R_N + h)) (s^-2).
+    pub gravity_gradient: f64,
 }
 
-impl LatitudeTrig {
-    pub fn new(lat: f64) -> Self {
-        let (sin, cos) = libm::sincos(lat);
-        Self { sin, cos }
+impl LocalEarth {
+    pub fn at(position: &Position) -> Self {
+        let (sin_lat, cos_lat) = libm::sincos(position.lat);
+        Self::with_latitude_trig(position, sin_lat, cos_lat)
+    }
+
+    /// The same with the sine and cosine of `position.lat` already at hand
+    /// (the mechanization carries them across a step by series).
+    pub fn with_latitude_trig(position: &Position, sin_lat: f64, cos_lat: f64) -> Self {
+        let r = radii_from_sin(sin_lat);
+        let meridian = r.meridian + position.height;
+        let transverse = r.transverse + position.height;
+        let gravity = normal_gravity_from_sin(sin_lat, position.height);
+        Self {
+            position: *position,
+            sin_lat,
+            cos_lat,
+            meridian,
+            transverse,
+            gravity,
+            gravity_gradient: -2.0 * gravity / libm::sqrt(meridian * transverse),
+        }
+    }
+
+    /// Earth rate in NED, omega_ie^n = Omega (cos L, 0, -sin L).
+    pub fn earth_rate_n(&self) -> Vector3<f64> {
+        earth_rate_from_trig(self.sin_lat, self.cos_lat)
+    }
+
+    /// Transport rate omega_en^n: the turning of the NED frame as the probe
+    /// moves at `velocity_n` over the curved earth (tan L = sin L / cos L).
+    pub fn transport_rate_n(&self, velocity_n: &Vector3<f64>) -> Vector3<f64> {
+        let east_over_rn = velocity_n.y / self.transverse;
+        Vector3::new(
+            east_over_rn,
+            -velocity_n.x / self.meridian,
+            -east_over_rn * (self.sin_lat / self.cos_lat),
+        )
+    }
+
+    /// Gravity in NED: normal gravity along the ellipsoid normal (the
+    /// deflection of the vertical is below the probe's accuracy).
+    pub fn gravity_n(&self) -> Vector3<f64> {
+        Vector3::new(0.0, 0.0, self.gravity)
+    }
+
+    /// This position moved by a small north-east-down offset (m).
+    pub fn displaced(&self, ned: &Vector3<f64>) -> Position {
+        let p = &self.position;
+        Position {
+            lat: p.lat + ned.x / self.meridian,
+            lon: p.lon + ned.y / (self.transverse * self.cos_lat),
+            height: p.height - ned.z,
+        }
+    }
+
+    /// North-east-down offset (m) of `other` from this position, to first
+    /// order.
+    pub fn offset_to(&self, other: &Position) -> Vector3<f64> {
+        let p = &self.position;
+        Vector3::new(
+            (other.lat - p.lat) * self.meridian,
+            (other.lon - p.lon) * self.transverse * self.cos_lat,
+            p.height - other.height,
+        )
+    }
+
+    /// True while `position` is within about 10 m of this one (cheap
+    /// comparisons, no trigonometry).
+    pub fn is_near(&self, position: &Position) -> bool {
+        const ANGLE: f64 = 1.5e-6; // rad, ~10 m of latitude
+        (position.lat - self.position.lat).abs() < ANGLE
+            && (position.lon - self.position.lon).abs() * self.cos_lat < ANGLE
+            && (position.height - self.position.height).abs() < 10.0
     }
 }
 
@@ -110,11 +175,6 @@ pub struct Radii {
 
 pub fn radii(lat: f64) -> Radii {
     radii_from_sin(libm::sin(lat))
-}
-
-/// [`radii`] from the sine and cosine of the latitude.
-pub fn radii_from_trig(trig: &LatitudeTrig) -> Radii {
-    radii_from_sin(trig.sin)
 }
 
 fn radii_from_sin(s: f64) -> Radii {
@@ -133,11 +193,6 @@ pub fn normal_gravity(lat: f64, height: f64) -> f64 {
     normal_gravity_from_sin(libm::sin(lat), height)
 }
 
-/// [`normal_gravity`] from the sine and cosine of the latitude.
-pub fn normal_gravity_from_trig(trig: &LatitudeTrig, height: f64) -> f64 {
-    normal_gravity_from_sin(trig.sin, height)
-}
-
 fn normal_gravity_from_sin(s: f64, height: f64) -> f64 {
     let s2 = s * s;
     let on_ellipsoid =
@@ -148,50 +203,26 @@ fn normal_gravity_from_sin(s: f64, height: f64) -> f64 {
             + 3.0 * height * height / (a * a))
 }
 
-/// Gravity vector in NED (m/s^2): normal gravity along the ellipsoid normal
-/// (the deflection of the vertical is below the probe's accuracy).
+/// Gravity vector in NED at a position ([`LocalEarth::gravity_n`] without
+/// the rest of the local terms).
 pub fn gravity_n(pos: &Position) -> Vector3<f64> {
     Vector3::new(0.0, 0.0, normal_gravity(pos.lat, pos.height))
 }
 
-/// [`gravity_n`] from the sine and cosine of the position's latitude.
-pub fn gravity_n_from_trig(trig: &LatitudeTrig, height: f64) -> Vector3<f64> {
-    Vector3::new(0.0, 0.0, normal_gravity_from_trig(trig, height))
-}
-
-/// Earth rate in NED, omega_ie^n = Omega (cos L, 0, -sin L).
+/// Earth rate in NED at a latitude ([`LocalEarth::earth_rate_n`]).
 pub fn earth_rate_n(lat: f64) -> Vector3<f64> {
-    earth_rate_n_from_trig(&LatitudeTrig::new(lat))
+    let (sin, cos) = libm::sincos(lat);
+    earth_rate_from_trig(sin, cos)
 }
 
-/// [`earth_rate_n`] from the sine and cosine of the latitude.
-pub fn earth_rate_n_from_trig(trig: &LatitudeTrig) -> Vector3<f64> {
-    Vector3::new(EARTH_RATE * trig.cos, 0.0, -EARTH_RATE * trig.sin)
+fn earth_rate_from_trig(sin_lat: f64, cos_lat: f64) -> Vector3<f64> {
+    Vector3::new(EARTH_RATE * cos_lat, 0.0, -EARTH_RATE * sin_lat)
 }
 
-/// Transport rate omega_en^n: the turning of the NED frame as the probe moves
-/// over the curved earth.
+/// Transport rate in NED at a position and velocity
+/// ([`LocalEarth::transport_rate_n`]).
 pub fn transport_rate_n(pos: &Position, vel_n: &Vector3<f64>) -> Vector3<f64> {
-    let trig = LatitudeTrig::new(pos.lat);
-    transport_rate_n_from_trig(&trig, &radii_from_trig(&trig), pos.height, vel_n)
-}
-
-/// [`transport_rate_n`] from the sine and cosine of the latitude and the
-/// radii there (tan L = sin L / cos L).
-pub fn transport_rate_n_from_trig(
-    trig: &LatitudeTrig,
-    radii: &Radii,
-    height: f64,
-    vel_n: &Vector3<f64>,
-) -> Vector3<f64> {
-    let rn = radii.transverse + height;
-    let rm = radii.meridian + height;
-    let east_over_rn = vel_n.y / rn;
-    Vector3::new(
-        east_over_rn,
-        -vel_n.x / rm,
-        -east_over_rn * (trig.sin / trig.cos),
-    )
+    LocalEarth::at(pos).transport_rate_n(vel_n)
 }
 
 #[cfg(test)]
@@ -238,26 +269,47 @@ mod tests {
     }
 
     #[test]
-    fn terms_from_precomputed_trig_match_the_latitude_forms() {
+    fn local_terms_match_the_latitude_forms() {
         let vel = Vector3::new(3.0, -2.0, 0.5);
         for lat in [-1.3, -0.4, 0.0, 0.798_968, 1.5] {
-            let trig = LatitudeTrig::new(lat);
-            assert_eq!((trig.sin, trig.cos), (libm::sin(lat), libm::cos(lat)));
-            assert_eq!(radii_from_trig(&trig), radii(lat));
-            assert_eq!(
-                normal_gravity_from_trig(&trig, 123.0),
-                normal_gravity(lat, 123.0)
-            );
             let pos = Position::new(lat, 0.3, 123.0);
-            assert_eq!(gravity_n_from_trig(&trig, 123.0), gravity_n(&pos));
-            assert_eq!(earth_rate_n_from_trig(&trig), earth_rate_n(lat));
-            let w = transport_rate_n_from_trig(&trig, &radii(lat), 123.0, &vel);
+            let earth = LocalEarth::at(&pos);
+            // One sincos gives the bits of libm's sine and cosine.
+            assert_eq!(
+                (earth.sin_lat, earth.cos_lat),
+                (libm::sin(lat), libm::cos(lat))
+            );
+            let r = radii(lat);
+            assert_eq!(earth.meridian, r.meridian + 123.0);
+            assert_eq!(earth.transverse, r.transverse + 123.0);
+            assert_eq!(earth.gravity_n(), gravity_n(&pos));
+            assert_eq!(earth.earth_rate_n(), earth_rate_n(lat));
+            let w = earth.transport_rate_n(&vel);
             assert_eq!(w, transport_rate_n(&pos, &vel));
             // tan L as sin L / cos L: libm's tangent to rounding.
-            let r = radii(lat);
             let with_tan = -vel.y * libm::tan(lat) / (r.transverse + 123.0);
             assert!((w.z - with_tan).abs() <= 1e-15 * with_tan.abs().max(1e-300));
         }
+    }
+
+    #[test]
+    fn gravity_gradient_is_the_free_air_gradient() {
+        let pos = Position::paper_site();
+        let earth = LocalEarth::at(&pos);
+        let numeric = (normal_gravity(pos.lat, pos.height + 1.0)
+            - normal_gravity(pos.lat, pos.height - 1.0))
+            / 2.0;
+        assert!((earth.gravity_gradient - numeric).abs() < 0.005 * numeric.abs());
+    }
+
+    #[test]
+    fn nearness_is_about_ten_metres() {
+        let reference = Position::paper_site();
+        let earth = LocalEarth::at(&reference);
+        assert!(earth.is_near(&reference.displaced(&Vector3::new(5.0, -4.0, 2.0))));
+        assert!(!earth.is_near(&reference.displaced(&Vector3::new(50.0, 0.0, 0.0))));
+        assert!(!earth.is_near(&reference.displaced(&Vector3::new(0.0, 20.0, 0.0))));
+        assert!(!earth.is_near(&reference.displaced(&Vector3::new(0.0, 0.0, 11.0))));
     }
 
     #[test]

@@ -9,15 +9,15 @@
 //! so they stay in the state; so do the bias estimates (the mechanization
 //! takes raw samples: the filter's dynamics carry the bias's effect).
 
-use crate::conventions::{dcm_from_quat, euler_error_jacobian};
-use crate::earth::{gravity_n, normal_gravity, Position, EARTH_RATE};
+use crate::aid_sources::{ZeroPosition, ZeroVelocity};
+use crate::conventions::{dcm_from_quat, euler_error_jacobian, DEG};
+use crate::earth::{gravity_n, normal_gravity, LocalEarth, Position, EARTH_RATE};
 use crate::error_model::{
-    AugmentedModel, AugmentedTransition, EarthTerms, LinearizationPoint, ProcessNoise, ACCEL_BIAS,
-    ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
+    is_model_size, AugmentedModel, AugmentedTransition, LinearizationPoint, ProcessNoise,
+    ACCEL_BIAS, ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
 };
 use crate::kalman::{FilterScalar, KalmanFilter, UpdateReport};
-use crate::measurement::{ZeroPosition, ZeroVelocity};
-use crate::mechanization::{frame_rate_in_body, ImuSample, NavState, Strapdown};
+use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -61,9 +61,12 @@ pub enum SpecificForceInModel {
     GravityAtRest,
 }
 
-/// Settings of the fine alignment.
+/// Settings of the fine alignment of a filter with `N` states (33,
+/// [`STATES`], or 39, [`STATES_WITH_BIASES`]): the settings that depend on
+/// the sensor-bias states follow from `N`, so they cannot disagree with
+/// the filter they are given to.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FineAlignmentConfig {
+pub struct FineAlignmentConfig<const N: usize = STATES> {
     pub model: AugmentedModel,
     pub process_noise: ProcessNoise,
     /// Initial variances of the navigation errors (rad^2, (m/s)^2, m^2).
@@ -83,7 +86,7 @@ pub struct FineAlignmentConfig {
     pub specific_force: SpecificForceInModel,
 }
 
-impl FineAlignmentConfig {
+impl<const N: usize> FineAlignmentConfig<N> {
     /// The paper's section 4 settings: P0 = 0.01 I, Q = I, R = 0.1 I, the
     /// AR models of Tables 4-5. "Q = I" is read as unit white noise on
     /// every state per second (paper's Gamma = G dt, eq. 16, with G = I:
@@ -112,18 +115,18 @@ impl FineAlignmentConfig {
     /// `coarse_sigma` (roll, pitch, heading; rad) at `latitude`: P0 from the
     /// coarse sigmas, AR blocks at their stationary covariance, process
     /// noise from the white-noise densities of `noise`, tight ZUPT and
-    /// zero-position noise. With `with_biases` (the 39-state form, which
-    /// must then be the filter's size) the tilt-bias correlation of
-    /// levelling and f^n = -g^n in F21 (derivation sections 3b and 6).
-    /// The one place the probe and the host tool take these settings from.
+    /// zero-position noise. With the sensor-bias states (`N` = 39) the
+    /// tilt-bias correlation of levelling and f^n = -g^n in F21 (derivation
+    /// sections 3b and 6). The one place the probe and the host tool take
+    /// these settings from.
     pub fn physical(
         mut model: AugmentedModel,
         noise: &ImuNoise,
         coarse_sigma: &[f64; 3],
         latitude: f64,
-        with_biases: bool,
     ) -> Self {
-        const DEG: f64 = core::f64::consts::PI / 180.0;
+        const { assert!(is_model_size(N), "the filter has 33 or 39 states") };
+        let with_biases = N == STATES_WITH_BIASES;
         let square = |v: f64| v * v;
         let mut p0 = [1e-4; NAV_STATES];
         p0[ATT] = square(coarse_sigma[0].max(0.05 * DEG));
@@ -148,7 +151,7 @@ impl FineAlignmentConfig {
         let attitude_density = square(noise.gyro[0].white_density) + square(drift) * 60.0;
         let velocity_density = square(noise.accel[2].white_density);
         // At rest the tool-axis rate fed to the mechanization is the
-        // frame's (see `at_rest_sample`): its error is that same misplaced
+        // frame's (`ToolAxisSource::AtRest`): its error is that same misplaced
         // earth rate, not the accelerometer-derived rate's noise model.
         model.gyro[1].noise_variance = model.gyro[1].noise_variance.max(square(drift));
         Self {
@@ -179,26 +182,6 @@ impl FineAlignmentConfig {
     }
 }
 
-/// The sample a still tool gives the mechanization: the x and z gyros and
-/// the accelerometers as measured, and for the tool axis (y), which has no
-/// gyro, the rate the navigation frame turns at (earth and transport rate
-/// in body axes at the current solution). The rate derived from
-/// accelerometer roll (eq. 1-2) differences two single-sample rolls: with
-/// Table 4's accelerometer noise (0.058 m/s^2 on x) that is ~0.17 rad/s per
-/// sample, far above Table 5's model, and its sum is the last sample's roll
-/// noise; a static alignment does better without it.
-pub fn at_rest_sample(
-    state: &NavState,
-    rate_x: f64,
-    rate_z: f64,
-    specific_force: Vector3<f64>,
-) -> ImuSample {
-    ImuSample {
-        rate: Vector3::new(rate_x, frame_rate_in_body(state).y, rate_z),
-        specific_force,
-    }
-}
-
 /// What one fine-alignment step did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepReport {
@@ -216,12 +199,13 @@ pub struct StepReport {
 pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     strapdown: Strapdown,
     filter: KalmanFilter<T, N>,
-    config: FineAlignmentConfig,
+    config: FineAlignmentConfig<N>,
     q: SVector<T, N>,
     /// Geodetic terms of F, refreshed when the solution has moved.
-    earth: EarthTerms,
-    /// Radii at the reference position, for the zero-position update.
-    reference_terms: EarthTerms,
+    earth: LocalEarth,
+    /// The local earth at the reference position, for the zero-position
+    /// update.
+    reference: LocalEarth,
     steps: u32,
     rejected_samples: u32,
 }
@@ -229,14 +213,14 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Starts from a coarse alignment `initial` (attitude, zero velocity,
     /// known position) and the known position `reference` of the tool.
-    pub fn new(initial: NavState, reference: Position, config: FineAlignmentConfig) -> Self {
+    pub fn new(initial: NavState, reference: Position, config: FineAlignmentConfig<N>) -> Self {
         let mut alignment = Self {
             strapdown: Strapdown::new(initial, config.model.dt),
             filter: KalmanFilter::new(SMatrix::zeros()),
             config,
             q: SVector::zeros(),
-            earth: EarthTerms::at(&initial.position),
-            reference_terms: EarthTerms::at(&reference),
+            earth: LocalEarth::at(&initial.position),
+            reference: LocalEarth::at(&reference),
             steps: 0,
             rejected_samples: 0,
         };
@@ -247,7 +231,12 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Starts again, in place, as [`new`](Self::new) would: the probe keeps
     /// one filter for its whole run (moving a 39-state filter costs 6 KiB
     /// of stack per copy).
-    pub fn restart(&mut self, initial: NavState, reference: Position, config: FineAlignmentConfig) {
+    pub fn restart(
+        &mut self,
+        initial: NavState,
+        reference: Position,
+        config: FineAlignmentConfig<N>,
+    ) {
         let model = &config.model;
         let p0 = &mut self.filter.p;
         model.write_initial_covariance(&config.initial_nav_variance, p0);
@@ -273,8 +262,8 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.filter.gate = config.gate.map(T::of);
         self.strapdown = Strapdown::new(initial, model.dt);
         self.config = config;
-        self.earth = EarthTerms::at(&initial.position);
-        self.reference_terms = EarthTerms::at(&reference);
+        self.earth = LocalEarth::at(&initial.position);
+        self.reference = LocalEarth::at(&reference);
         self.steps = 0;
         self.rejected_samples = 0;
     }
@@ -316,7 +305,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             },
         };
         if !self.earth.is_near(&state.position) {
-            self.earth = EarthTerms::at(&state.position);
+            self.earth = LocalEarth::at(&state.position);
         }
         let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
         self.filter.predict(&phi, &self.q);
@@ -328,9 +317,9 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             None => UpdateReport::default(),
         };
         let zero_position = match self.config.zero_position_variance {
-            Some(r) => self.filter.update(&ZeroPosition::with_earth_terms(
+            Some(r) => self.filter.update(&ZeroPosition::new(
                 &state.position,
-                &self.reference_terms,
+                &self.reference,
                 T::of(r),
             )),
             None => UpdateReport::default(),

@@ -11,6 +11,7 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod aid_sources;
 pub mod alignment;
 pub mod ar;
 pub mod attitude;
@@ -20,11 +21,12 @@ pub mod earth;
 pub mod error_model;
 pub mod fine_alignment;
 pub mod kalman;
-pub mod measurement;
 pub mod mechanization;
 #[cfg(feature = "std")]
 pub mod observability;
 pub mod probe;
+pub mod probe_sample;
 pub mod protocol;
 pub mod sensor_noise;
 pub mod sensor_units;
+pub mod timing;

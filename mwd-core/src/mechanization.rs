@@ -12,10 +12,8 @@
 use crate::attitude::{
     coning_rotation_vector, quat_from_rotation_vector, ToolAxisRate, ToolAxisRateEstimator,
 };
-use crate::earth::{
-    earth_rate_n_from_trig, gravity_n_from_trig, radii_from_trig, transport_rate_n_from_trig,
-    LatitudeTrig, Position,
-};
+use crate::earth::{LocalEarth, Position};
+use crate::probe_sample::ProbeSample;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// One sample of the probe's inertial sensors in the body frame, averaged
@@ -108,10 +106,13 @@ impl Strapdown {
         self.previous = Some((dtheta, dv));
 
         let pos = s.position;
-        let trig = LatitudeTrig::new(pos.lat);
-        let r = radii_from_trig(&trig);
-        let omega_ie = earth_rate_n_from_trig(&trig);
-        let omega_en = transport_rate_n_from_trig(&trig, &r, pos.height, &s.velocity);
+        let earth = LocalEarth::at(&pos);
+        let trig = LatitudeTrig {
+            sin: earth.sin_lat,
+            cos: earth.cos_lat,
+        };
+        let omega_ie = earth.earth_rate_n();
+        let omega_en = earth.transport_rate_n(&s.velocity);
         let zeta = (omega_ie + omega_en) * dt; // eq. 5, rates held over the interval
 
         // Velocity: the specific-force increment with the rotation and
@@ -123,8 +124,7 @@ impl Strapdown {
         let dv_start = s.attitude.transform_vector(&dv_body);
         let dv_nav = dv_start - zeta.cross(&dv_start) * 0.5;
         let coriolis = (omega_ie * 2.0 + omega_en).cross(&s.velocity);
-        let velocity =
-            s.velocity + dv_nav + (gravity_n_from_trig(&trig, pos.height) - coriolis) * dt;
+        let velocity = s.velocity + dv_nav + (earth.gravity_n() - coriolis) * dt;
 
         // Attitude, eq. 3-7.
         let body_rotation =
@@ -135,13 +135,13 @@ impl Strapdown {
         // Position by the trapezoidal rule in f64, the longitude with the
         // cosine of the mid-latitude.
         let mean_v = (s.velocity + velocity) * 0.5;
-        let lat = pos.lat + mean_v.x / (r.meridian + pos.height) * dt;
+        let lat = pos.lat + mean_v.x / earth.meridian * dt;
         let half_step = 0.5 * (lat - pos.lat);
         let cos_mid = match shifted_trig(&trig, half_step) {
             Some(t) => t.cos,
             None => libm::cos(pos.lat + half_step),
         };
-        let lon = pos.lon + mean_v.y / ((r.transverse + pos.height) * cos_mid) * dt;
+        let lon = pos.lon + mean_v.y / (earth.transverse * cos_mid) * dt;
         let height = pos.height - mean_v.z * dt;
 
         *s = NavState {
@@ -167,15 +167,22 @@ impl Strapdown {
         s.velocity -= velocity_error_n;
         // The sine and cosine of the latitude from the last step, if the
         // latitude has not been changed since.
-        let trig = match self.latitude_trig {
-            Some((lat, trig)) if lat == s.position.lat => trig,
-            _ => LatitudeTrig::new(s.position.lat),
+        let earth = match self.latitude_trig {
+            Some((lat, trig)) if lat == s.position.lat => {
+                LocalEarth::with_latitude_trig(&s.position, trig.sin, trig.cos)
+            }
+            _ => LocalEarth::at(&s.position),
         };
-        s.position = s
-            .position
-            .displaced_with_trig(&-position_error_ned_m, &trig);
+        s.position = earth.displaced(&-position_error_ned_m);
         self.latitude_trig = None;
     }
+}
+
+/// Sine and cosine of a latitude.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LatitudeTrig {
+    sin: f64,
+    cos: f64,
 }
 
 /// Largest latitude shift (rad) that [`shifted_trig`] takes by series:
@@ -220,18 +227,33 @@ fn renormalized(q: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
 /// rate), in body axes at the solution `state`: what a tool at rest senses,
 /// and the reference of the accelerometer-derived tool-axis rate.
 pub fn frame_rate_in_body(state: &NavState) -> Vector3<f64> {
-    let pos = &state.position;
-    let trig = LatitudeTrig::new(pos.lat);
-    let omega_in_n = earth_rate_n_from_trig(&trig)
-        + transport_rate_n_from_trig(&trig, &radii_from_trig(&trig), pos.height, &state.velocity);
+    let earth = LocalEarth::at(&state.position);
+    let omega_in_n = earth.earth_rate_n() + earth.transport_rate_n(&state.velocity);
     state.attitude.inverse_transform_vector(&omega_in_n)
 }
 
-/// Builds the mechanization's input from the probe's sensors: the x and z
-/// gyros, the accelerometers, and the tool-axis rate derived from
-/// accelerometer roll (eq. 1-2). Where that rate is unavailable (first
-/// sample, tool near vertical) the tool is taken as not turning about its
-/// axis relative to the navigation frame, and the caller is told.
+/// Where the mechanization's tool-axis (y) rate comes from: no gyro senses
+/// it on the probe.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToolAxisSource {
+    /// The tool is still: it turns with the navigation frame (earth and
+    /// transport rate in body axes at the current solution). The rate
+    /// derived from accelerometer roll (eq. 1-2) differences two
+    /// single-sample rolls: with Table 4's accelerometer noise (0.058 m/s^2
+    /// on x) that is ~0.17 rad/s per sample, far above Table 5's model, and
+    /// its sum is the last sample's roll noise; a static alignment does
+    /// better without it.
+    AtRest,
+    /// The tool may move: the rate derived from successive accelerometer
+    /// rolls (eq. 1-2); where that is unavailable (first sample, tool near
+    /// vertical) the tool is taken as not turning about its axis relative
+    /// to the navigation frame, and the caller is told.
+    AccelerometerRoll,
+}
+
+/// Builds the mechanization's input from the probe's samples: the x and z
+/// gyros and the accelerometers as they are, and the tool-axis rate from
+/// the chosen [`ToolAxisSource`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ProbeInput {
     tool_axis: ToolAxisRateEstimator,
@@ -242,30 +264,33 @@ impl ProbeInput {
         Self::default()
     }
 
-    /// The sample for the next mechanization step, from calibrated sensor
-    /// readings, given the current solution (for the navigation frame's
-    /// rate in body axes).
-    pub fn sample(
+    /// The sample for the next mechanization step from a calibrated probe
+    /// sample, given the current solution (for the navigation frame's rate
+    /// in body axes), and the tool-axis rate used: `Unavailable` when the
+    /// accelerometer roll gave none and the frame's rate stood in.
+    /// At rest the estimator of the roll-derived rate is left as it is.
+    pub fn imu_sample(
         &mut self,
         state: &NavState,
-        gyro_x: f64,
-        gyro_z: f64,
-        specific_force: &Vector3<f64>,
+        sample: &ProbeSample,
+        source: ToolAxisSource,
         dt: f64,
     ) -> (ImuSample, ToolAxisRate) {
         let omega_in_b = frame_rate_in_body(state);
-        let derived = self
-            .tool_axis
-            .update(specific_force, gyro_x, gyro_z, &omega_in_b, dt);
-        let rate_y = match derived {
-            ToolAxisRate::Valid(rate) => rate,
-            ToolAxisRate::Unavailable => omega_in_b.y,
+        let (rate_y, used) = match source {
+            ToolAxisSource::AtRest => (omega_in_b.y, ToolAxisRate::Valid(omega_in_b.y)),
+            ToolAxisSource::AccelerometerRoll => {
+                match self.tool_axis.update(sample, &omega_in_b, dt) {
+                    ToolAxisRate::Valid(rate) => (rate, ToolAxisRate::Valid(rate)),
+                    ToolAxisRate::Unavailable => (omega_in_b.y, ToolAxisRate::Unavailable),
+                }
+            }
         };
-        let sample = ImuSample {
-            rate: Vector3::new(gyro_x, rate_y, gyro_z),
-            specific_force: *specific_force,
+        let imu = ImuSample {
+            rate: sample.rate_with_tool_axis(rate_y),
+            specific_force: sample.specific_force,
         };
-        (sample, derived)
+        (imu, used)
     }
 }
 
@@ -336,21 +361,26 @@ mod tests {
         }
     }
 
+    fn latitude_trig(lat: f64) -> LatitudeTrig {
+        let (sin, cos) = libm::sincos(lat);
+        LatitudeTrig { sin, cos }
+    }
+
     #[test]
     fn shifted_latitude_trig_is_libm_to_rounding() {
         for lat in [-1.4, -0.8, 0.0, 0.3, 0.798_968, 1.2, 1.55] {
-            let trig = LatitudeTrig::new(lat);
+            let trig = latitude_trig(lat);
             for d in [-1e-6, -3.1e-7, -2e-9, 0.0, 5e-12, 8.8e-9, 4.4e-7, 1e-6] {
                 let shifted = shifted_trig(&trig, d).unwrap();
-                let exact = LatitudeTrig::new(lat + d);
+                let exact = latitude_trig(lat + d);
                 // lat + d itself is rounded: half an ulp of lat.
                 let tol = 4.5e-16;
                 assert!((shifted.sin - exact.sin).abs() <= tol, "{lat} {d}");
                 assert!((shifted.cos - exact.cos).abs() <= tol, "{lat} {d}");
             }
         }
-        assert!(shifted_trig(&LatitudeTrig::new(0.5), 1.1e-6).is_none());
-        assert!(shifted_trig(&LatitudeTrig::new(0.5), f64::NAN).is_none());
+        assert!(shifted_trig(&latitude_trig(0.5), 1.1e-6).is_none());
+        assert!(shifted_trig(&latitude_trig(0.5), f64::NAN).is_none());
     }
 
     #[test]

@@ -114,7 +114,7 @@ fn truth() -> NavState {
 /// Physically scaled 39-state settings. `levelling_sigma`: 1-sigma of the
 /// coarse tilt without the bias share (the filter adds that share and its
 /// correlation, `TiltPrior::LevelledWithSameAccelerometers`).
-fn config(levelling_sigma: [f64; 2]) -> FineAlignmentConfig {
+fn config(levelling_sigma: [f64; 2]) -> FineAlignmentConfig<STATES_WITH_BIASES> {
     let model = AugmentedModel::paper();
     let mut p0 = [1e-4; NAV_STATES];
     p0[0] = levelling_sigma[0].powi(2);

@@ -15,7 +15,7 @@ use mwd_core::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
 use mwd_core::attitude::quat_from_rotation_vector;
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{earth_rate_n, gravity_n, Position};
-use mwd_core::error_model::{AugmentedModel, ProcessNoise, NAV_STATES, POS, VEL};
+use mwd_core::error_model::{AugmentedModel, ProcessNoise, NAV_STATES, POS, STATES, VEL};
 use mwd_core::fine_alignment::{
     ArInitialCovariance, FineAlignment, FineAlignmentConfig, SpecificForceInModel, TiltPrior,
 };
@@ -78,7 +78,7 @@ fn truth() -> NavState {
 
 /// Physically scaled settings: P0 from a coarse alignment's errors, the AR
 /// blocks at their stationary covariance, small white noise, tight R.
-fn physical() -> FineAlignmentConfig {
+fn physical<const N: usize>() -> FineAlignmentConfig<N> {
     let model = AugmentedModel::paper();
     let mut p0 = [0.0; NAV_STATES];
     p0[..3].copy_from_slice(&[
@@ -176,7 +176,7 @@ fn tilt_errors_are_within_three_sigma_in_95_percent_of_seeded_runs() {
     for seed in 0..runs {
         // Coarse errors drawn from P0 itself, so the filter's prior is true.
         let mut rng = Normal(1000 + seed);
-        let p0 = physical().initial_nav_variance;
+        let p0 = physical::<STATES>().initial_nav_variance;
         let phi0 = Vector3::new(
             rng.sample() * p0[0].sqrt(),
             rng.sample() * p0[1].sqrt(),
@@ -283,7 +283,7 @@ fn zupt_alone_converges_the_tilt_and_leaves_position_unaided() {
         block_variances(&fa, POS),
         block_variances(&both, POS),
     );
-    let p0 = physical().initial_nav_variance[POS];
+    let p0 = physical::<STATES>().initial_nav_variance[POS];
     for i in 0..3 {
         assert!(
             p_end[i] >= p0,
@@ -315,7 +315,7 @@ fn zero_position_alone_converges_the_tilt_and_bounds_velocity() {
     let (unaided, ..) = align::<f32>(1, phi0, aided_by(None, None), 1200);
     assert_tilt_converged("zero position only", &phi, &phi0, &sigma, &sigma0);
     let (v_early, v_end) = (block_variances(&early, VEL), block_variances(&fa, VEL));
-    let p0 = physical().initial_nav_variance[VEL];
+    let p0 = physical::<STATES>().initial_nav_variance[VEL];
     for i in 0..3 {
         assert!(v_end[i] < p0, "axis {i}: velocity variance {v_end}");
         assert!(
@@ -340,9 +340,9 @@ fn zero_position_alone_converges_the_tilt_and_bounds_velocity() {
 /// 39-state form with the settings the probe uses.
 #[test]
 fn restart_in_place_is_the_same_filter_as_a_new_one() {
-    use mwd_core::error_model::{STATES, STATES_WITH_BIASES};
+    use mwd_core::error_model::STATES_WITH_BIASES;
     use mwd_core::sensor_noise::ImuNoise;
-    fn check<const N: usize>(config: FineAlignmentConfig) {
+    fn check<const N: usize>(config: FineAlignmentConfig<N>) {
         let start = truth();
         let mut used = FineAlignment::<f32, N>::new(start, start.position, physical());
         let mut sensors = StaticSensors::new(&start, 7);
@@ -368,13 +368,11 @@ fn restart_in_place_is_the_same_filter_as_a_new_one() {
         &noise,
         &sigma,
         lat,
-        false,
     ));
     check::<STATES_WITH_BIASES>(FineAlignmentConfig::physical(
         AugmentedModel::paper(),
         &noise,
         &sigma,
         lat,
-        true,
     ));
 }

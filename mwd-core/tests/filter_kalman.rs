@@ -2,6 +2,7 @@
 //! the 33-state model and the 39-state one with sensor biases, and the
 //! rejection paths of the measurement update.
 
+use mwd_core::aid_sources::{ZeroPosition, ZeroVelocity};
 use mwd_core::ar::ArModel;
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{
@@ -9,9 +10,7 @@ use mwd_core::error_model::{
     STATES_WITH_BIASES, VEL,
 };
 use mwd_core::kalman::{dense, KalmanFilter, ScalarOutcome, Transition};
-use mwd_core::measurement::{
-    Measurement, ScalarMeasurement, SparseRow, ZeroPosition, ZeroVelocity,
-};
+use mwd_core::kalman::{Measurement, ScalarMeasurement, SparseRow};
 use nalgebra::{Rotation3, SMatrix, SVector, Vector3};
 use proptest::prelude::*;
 

@@ -8,13 +8,13 @@
 //! The full-rate run is `#[ignore]`d: run it with
 //! `cargo test -p mwd-core --release --test filter_long_run -- --ignored`.
 
+use mwd_core::aid_sources::{ZeroPosition, ZeroVelocity};
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{
     AugmentedModel, LinearizationPoint, ProcessNoise, ATT, NAV_STATES, STATES,
 };
 use mwd_core::kalman::{FilterScalar, KalmanFilter};
-use mwd_core::measurement::{ZeroPosition, ZeroVelocity};
 use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
 fn lp() -> LinearizationPoint {

@@ -12,7 +12,7 @@ use mwd_core::protocol::{EventKind, Payload};
 use system_tests::workspace_root;
 
 const SAMPLES: u64 = 6 * 20;
-use mwd_core::probe::timing::ALIGNMENT_SAMPLES;
+use mwd_core::timing::ALIGNMENT_SAMPLES;
 
 #[test]
 fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {

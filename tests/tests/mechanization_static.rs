@@ -4,7 +4,8 @@
 //! 1e-6 m/s over 60 s).
 use host_sim::sim::{SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
 use mwd_core::conventions::{quat_from_euler, Euler};
-use mwd_core::mechanization::{NavState, ProbeInput, Strapdown};
+use mwd_core::mechanization::{NavState, ProbeInput, Strapdown, ToolAxisSource};
+use mwd_core::probe_sample::ProbeSample;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
@@ -22,8 +23,9 @@ fn simulated_static_probe_stays_put_for_a_minute() {
         let mut input = ProbeInput::new();
         for s in SensorSimulator::new(trajectory, SensorModel::ideal(), SAMPLE_INTERVAL).take(1200)
         {
-            let (sample, _) =
-                input.sample(nav.state(), s.gyro.x, s.gyro.z, &s.accel, SAMPLE_INTERVAL);
+            let probe = ProbeSample::new(s.gyro.x, s.gyro.z, s.accel);
+            let source = ToolAxisSource::AccelerometerRoll;
+            let (sample, _) = input.imu_sample(nav.state(), &probe, source, SAMPLE_INTERVAL);
             nav.step(&sample);
         }
         let end = nav.state();

@@ -21,18 +21,19 @@ use std::time::Duration;
 
 use hil_mock::StillProbe;
 use mwd_core::earth::Position;
-use mwd_core::probe::{timing, Navigator};
+use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::{nav_mode, raw_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{
     encode_body, Decoder, DecoderStats, Event, EventKind, Frame, NavSolution, Payload, RawSample,
 };
 use mwd_core::sensor_units::{accel_count_to_m_s2, PART_MOUNTINGS};
+use mwd_core::timing;
 use system_tests::{build_firmware, require_qemu, summary_value, wait_or_kill};
 
 /// The firmware's default run length (`PROBE_QEMU_RUN_SECONDS`).
 const RUN_SECONDS: u64 = 60;
 const RATE_HZ: u64 = 20;
-/// Samples of the coarse and of the fine alignment (mwd_core::probe::timing).
+/// Samples of the coarse and of the fine alignment (mwd_core::timing).
 const ALIGNMENT_SAMPLES: usize = timing::ALIGNMENT_SAMPLES as usize;
 const FINE_ALIGNMENT_SAMPLES: usize = timing::FINE_ALIGNMENT_SAMPLES as usize;
 /// Far above the ~1 s the run takes; only a hang reaches it.

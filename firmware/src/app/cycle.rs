@@ -14,7 +14,7 @@ use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
 use super::frame_queue::FrameQueue;
 use crate::scc1300::{Error, PartReading};
 
-use mwd_core::probe::timing::SAMPLE_PERIOD_US;
+use mwd_core::timing::SAMPLE_PERIOD_US;
 
 /// What one cycle asks of its caller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -125,9 +125,13 @@ impl CalibrationFile {
 
     /// The probe's whole correction: the first two triads (x-gyro part,
     /// z-gyro part) and the gyros on body x and z; identity where absent.
+    /// A file of one triad was fitted on the body-frame force both parts
+    /// share (the simulator's CSV and the host's tools carry one): it
+    /// corrects both parts, so the probe's average of the two corrected
+    /// triads is that triad corrected.
     pub fn to_probe(&self) -> ProbeCalibration {
         let mut p = ProbeCalibration::default();
-        for (slot, t) in p.accel.iter_mut().zip(&self.accel) {
+        for (slot, t) in p.accel.iter_mut().zip(self.accel.iter().cycle()) {
             *slot = t.to_core();
         }
         for g in &self.gyro {
@@ -170,6 +174,8 @@ mod tests {
         assert_eq!(back, file);
         let probe = back.to_probe();
         assert_eq!(probe.accel[0].bias, [0.01, -0.02, 0.003]);
+        // One triad (the body frame's) corrects both parts.
+        assert_eq!(probe.accel[1], probe.accel[0]);
         assert_eq!(probe.gyro[1].bias, 1e-5);
         assert_eq!(probe.gyro[0], GyroCalibration::IDENTITY);
         assert!(CalibrationFile::parse(&text.replace("\"scale\":1.0", "\"scale\":0.0")).is_err());

@@ -156,12 +156,13 @@ fn capture_columns(path: &Path) -> Result<Columns> {
             continue;
         };
         // The raw sensor, uncalibrated: noise analysis characterises it as it is.
-        let Some((gx, gz, f)) = mwd_core::probe::body_sample(&raw, &ProbeCalibration::default())
-        else {
+        let Some(sample) = mwd_core::probe::body_sample(&raw, &ProbeCalibration::default()) else {
             skipped += 1;
             continue;
         };
-        let row = [raw.time_us as f64 * 1e-6, gx, gz, f.x, f.y, f.z];
+        let f = sample.specific_force;
+        let time = raw.time_us as f64 * 1e-6;
+        let row = [time, sample.rate_x(), sample.rate_z(), f.x, f.y, f.z];
         for (column, value) in data.iter_mut().zip(row) {
             column.push(value);
         }

@@ -8,4 +8,4 @@ pub use sensor::{DeterministicErrors, SensorModel, SensorSimulator, SimSample};
 pub use trajectory::{Motion, Trajectory};
 
 /// The probe's sample interval (s): 20 Hz.
-pub use mwd_core::probe::timing::SAMPLE_INTERVAL_S as SAMPLE_INTERVAL;
+pub use mwd_core::timing::SAMPLE_INTERVAL_S as SAMPLE_INTERVAL;

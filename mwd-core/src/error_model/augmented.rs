@@ -17,13 +17,15 @@
 //! the measurements.
 
 use super::{
-    is_model_size, navigation_error_dynamics_with, EarthTerms, LinearizationPoint, SensorBiases,
-    ACCEL_AR, ACCEL_BIAS, AR_ORDER, ATT, GYRO_AR, GYRO_BIAS, NAV_STATES, POS, STATES,
-    STATES_WITH_BIASES, VEL,
+    is_model_size, navigation_error_dynamics_with, LinearizationPoint, SensorBiases, ACCEL_AR,
+    ACCEL_BIAS, AR_ORDER, ATT, GYRO_AR, GYRO_BIAS, NAV_STATES, POS, STATES, STATES_WITH_BIASES,
+    VEL,
 };
 use crate::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
+use crate::earth::LocalEarth;
 use crate::kalman::{FilterScalar, Transition};
 use crate::sensor_noise::ImuNoise;
+use crate::timing::SAMPLE_INTERVAL_S;
 use nalgebra::{Matrix3, SMatrix, SVector};
 
 /// Whether the coloured sensor errors drive the navigation errors.
@@ -79,7 +81,7 @@ impl AugmentedModel {
     /// The paper's AR(4) models (Tables 4-5) at 20 Hz, coupled; bias
     /// statistics from the SCC1300 budget (`sensor_noise`).
     pub fn paper() -> Self {
-        let dt = 0.05;
+        let dt = SAMPLE_INTERVAL_S;
         Self {
             accel: ACCEL_DEFAULTS,
             gyro: GYRO_DEFAULTS,
@@ -95,13 +97,13 @@ impl AugmentedModel {
         &self,
         lp: &LinearizationPoint,
     ) -> AugmentedTransition<T, N> {
-        self.transition_with(&EarthTerms::at(&lp.position), lp)
+        self.transition_with(&LocalEarth::at(&lp.position), lp)
     }
 
     /// The same with the geodetic scalars given (cached by the caller).
     pub fn transition_with<T: FilterScalar, const N: usize>(
         &self,
-        earth: &EarthTerms,
+        earth: &LocalEarth,
         lp: &LinearizationPoint,
     ) -> AugmentedTransition<T, N> {
         const { assert!(is_model_size(N), "the augmented model has 33 or 39 states") };

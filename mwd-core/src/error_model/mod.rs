@@ -18,7 +18,7 @@ mod bias;
 pub use augmented::{AugmentedModel, AugmentedTransition, Coupling, ProcessNoise};
 pub use bias::{BiasState, SensorBiases};
 
-use crate::earth::{normal_gravity, radii, Position, EARTH_RATE};
+use crate::earth::{LocalEarth, Position, EARTH_RATE};
 use crate::kalman::FilterScalar;
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
@@ -68,59 +68,17 @@ pub struct LinearizationPoint {
     pub specific_force_n: Vector3<f64>,
 }
 
-/// The geodetic scalars F needs at a position. They cost ~15 000
-/// instructions in software f64 on the probe and change by parts per
-/// million over a kilometre: compute them when the position has moved
-/// ([`EarthTerms::is_near`]), not every cycle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EarthTerms {
-    pub position: Position,
-    /// R_M + h and R_N + h (m).
-    pub meridian: f64,
-    pub transverse: f64,
-    pub sin_lat: f64,
-    pub cos_lat: f64,
-    /// Free-air gravity gradient dg/dh = -2 g / R, R the Gaussian mean
-    /// radius (s^-2).
-    pub gravity_gradient: f64,
-}
-
-impl EarthTerms {
-    pub fn at(position: &Position) -> Self {
-        let r = radii(position.lat);
-        let meridian = r.meridian + position.height;
-        let transverse = r.transverse + position.height;
-        let g = normal_gravity(position.lat, position.height);
-        Self {
-            position: *position,
-            meridian,
-            transverse,
-            sin_lat: libm::sin(position.lat),
-            cos_lat: libm::cos(position.lat),
-            gravity_gradient: -2.0 * g / libm::sqrt(meridian * transverse),
-        }
-    }
-
-    /// True while `position` is within about 10 m of where these terms
-    /// were computed (cheap comparisons, no trigonometry).
-    pub fn is_near(&self, position: &Position) -> bool {
-        const ANGLE: f64 = 1.5e-6; // rad, ~10 m of latitude
-        (position.lat - self.position.lat).abs() < ANGLE
-            && (position.lon - self.position.lon).abs() * self.cos_lat < ANGLE
-            && (position.height - self.position.height).abs() < 10.0
-    }
-}
-
 /// Continuous-time navigation-error dynamics F (9 x 9, eq. 11-12 for NED
 /// with metres): `d/dt [phi dv dp] = F [phi dv dp] + (sensor error terms)`.
 pub fn navigation_error_dynamics<T: FilterScalar>(lp: &LinearizationPoint) -> SMatrix<T, 9, 9> {
-    navigation_error_dynamics_with(&EarthTerms::at(&lp.position), lp)
+    navigation_error_dynamics_with(&LocalEarth::at(&lp.position), lp)
 }
 
-/// F with the geodetic scalars given (see [`EarthTerms`]); the matrix
-/// arithmetic runs in the filter's scalar (hardware f32 on the probe).
+/// F with the local earth given (the filter keeps one while the solution
+/// stays near it, [`LocalEarth::is_near`]); the matrix arithmetic runs in
+/// the filter's scalar (hardware f32 on the probe).
 pub fn navigation_error_dynamics_with<T: FilterScalar>(
-    earth: &EarthTerms,
+    earth: &LocalEarth,
     lp: &LinearizationPoint,
 ) -> SMatrix<T, 9, 9> {
     let (rm, rn) = (earth.meridian, earth.transverse);
@@ -129,11 +87,8 @@ pub fn navigation_error_dynamics_with<T: FilterScalar>(
     let omega = EARTH_RATE;
     let v64 = lp.velocity_n;
 
-    // omega_ie^n and omega_en^n as in `earth::earth_rate_n` and
-    // `earth::transport_rate_n` (a test checks they agree), from the sines
-    // and radii already at hand.
-    let w_ie = Vector3::new(omega * cos_l, 0.0, -omega * sin_l);
-    let w_en = Vector3::new(v64.y / rn, -v64.x / rm, -v64.y * tan_l / rn);
+    let w_ie = earth.earth_rate_n();
+    let w_en = earth.transport_rate_n(&v64);
     let dg_dh = earth.gravity_gradient;
 
     let t = T::of;

@@ -182,19 +182,3 @@ fn initial_covariance_holds_the_stationary_ar_blocks() {
     );
     assert_eq!(q[ACCEL_AR], 0.0);
 }
-
-#[test]
-fn cached_zero_position_offset_matches_the_earth_module() {
-    use crate::measurement::ZeroPosition;
-    let reference = Position::paper_site();
-    let moved = reference.displaced(&Vector3::new(12.0, -7.5, 3.25));
-    let terms = EarthTerms::at(&reference);
-    let fast = ZeroPosition::<f64>::with_earth_terms(&moved, &terms, 1.0);
-    let slow = ZeroPosition::<f64>::new(&moved, &reference, 1.0);
-    for i in 0..3 {
-        assert!((fast.position_error_ned_m[i] - slow.position_error_ned_m[i]).abs() < 1e-9);
-    }
-    let near = reference.displaced(&Vector3::new(5.0, -4.0, 2.0));
-    let far = reference.displaced(&Vector3::new(50.0, 0.0, 0.0));
-    assert!(terms.is_near(&near) && !terms.is_near(&far));
-}

@@ -16,9 +16,10 @@
 //!   chi-square gate on the normalised innovation squared rejects outliers.
 
 pub mod dense;
+mod measurement;
 mod scalar;
 
-use crate::measurement::{Measurement, ScalarMeasurement};
+pub use measurement::{Measurement, ScalarMeasurement, SparseRow, MAX_ROW_NONZEROS};
 use nalgebra::{RealField, SMatrix, SVector};
 
 /// The filter's scalar: f32 or f64.
@@ -183,12 +184,6 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
         report
     }
 
-    /// Closed-loop reset: after the estimate has been fed back into the
-    /// navigation solution, the error estimate is zero.
-    pub fn reset_state(&mut self) {
-        self.x = SVector::zeros();
-    }
-
     /// Trace of P.
     pub fn trace(&self) -> T {
         self.p.trace()
@@ -208,20 +203,6 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
 // The triangle loops below are index loops running down the columns (i
 // outer): the cheapest form on the M4F (measured, ~4.8 instructions per f32
 // entry at N = 33; the iterator forms cost up to 60 % more).
-
-/// Makes `p` exactly symmetric by averaging mirrored entries.
-#[allow(clippy::needless_range_loop)]
-pub fn symmetrize<T: FilterScalar, const N: usize>(p: &mut SMatrix<T, N, N>) {
-    let half = T::of(0.5);
-    let d = &mut p.data.0; // d[column][row]
-    for i in 0..N {
-        for j in i + 1..N {
-            let v = (d[j][i] + d[i][j]) * half;
-            d[j][i] = v;
-            d[i][j] = v;
-        }
-    }
-}
 
 /// Copies the lower triangle of `p` onto its upper triangle.
 #[allow(clippy::needless_range_loop)]

@@ -1,7 +1,7 @@
 //! Scalar measurement update with a sparse row, Joseph form (eq. 19-21).
 
+use super::measurement::ScalarMeasurement;
 use super::{FilterScalar, ScalarOutcome};
-use crate::measurement::ScalarMeasurement;
 use nalgebra::{SMatrix, SVector};
 
 /// Updates `x` and `p` with one scalar; on any rejection both are left as

@@ -2,13 +2,11 @@
 //! on the probe's Cortex-M4F and in the host's replay (which must reproduce
 //! the probe's solutions bit for bit).
 //!
-//! * [`timing`]: the 20 Hz clock and the phases' lengths in samples.
 //! * [`raw`]: a raw sample's counts to calibrated body-frame rates and force.
 //! * [`navigator`]: coarse alignment, fine alignment, navigation.
 
 pub mod navigator;
 pub mod raw;
-pub mod timing;
 
 pub use navigator::Navigator;
 pub use raw::body_sample;

@@ -20,47 +20,46 @@
 //! bit for bit.
 
 use super::raw::body_sample;
-use super::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
-use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, StaticSegment};
+use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::ToolAxisRate;
 use crate::calibration::ProbeCalibration;
 use crate::conventions::{euler_from_quat, quat_from_euler, Euler};
 use crate::earth::Position;
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
-use crate::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
-use crate::mechanization::{NavState, ProbeInput};
+use crate::fine_alignment::{FineAlignment, FineAlignmentConfig};
+use crate::mechanization::{NavState, ProbeInput, ToolAxisSource};
+use crate::probe_sample::ProbeSample;
 use crate::protocol::frame::nav_flags;
 use crate::protocol::frame::nav_mode;
 use crate::protocol::{NavSolution, RawSample};
 use crate::sensor_noise::ImuNoise;
-use nalgebra::{UnitQuaternion, Vector3};
+use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
+use nalgebra::UnitQuaternion;
 
 /// The probe's filter: f32 (the M4F's FPU), 39 states.
 type Filter = FineAlignment<f32, STATES_WITH_BIASES>;
 
 /// The filter's settings for a still probe at `position` whose coarse
 /// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
-fn filter_config(position: &Position, coarse_sigma: &[f64; 3]) -> FineAlignmentConfig {
+fn filter_config(
+    position: &Position,
+    coarse_sigma: &[f64; 3],
+) -> FineAlignmentConfig<STATES_WITH_BIASES> {
     FineAlignmentConfig::physical(
         AugmentedModel::paper(),
         &ImuNoise::scc1300(),
         coarse_sigma,
         position.lat,
-        true,
     )
 }
 
 enum Phase {
     /// Summing still samples.
-    Coarse {
-        force: Vector3<f64>,
-        rate: Vector3<f64>,
-        samples: u32,
-    },
+    Coarse(SegmentSums),
     /// The filter with zero updates; `samples` taken so far.
     Fine { samples: u32 },
     /// The filter without zero updates.
-    Navigating { input: ProbeInput },
+    Navigating,
 }
 
 /// The probe's navigation, one raw sample at a time.
@@ -72,6 +71,8 @@ pub struct Navigator {
     /// it: the filter is the probe's largest object (6 KiB of covariance),
     /// and every move of it would be another copy on the stack.
     filter: Filter,
+    /// The mechanization's input (the tool-axis rate's estimator).
+    input: ProbeInput,
     /// 1-sigma of roll, pitch, heading from the coarse alignment (rad),
     /// reported until the filter has its own. An infinite heading sigma
     /// (no heading found) stays in the frames afterwards: the filter then
@@ -93,12 +94,9 @@ impl Navigator {
         Self {
             position,
             calibration,
-            phase: Phase::Coarse {
-                force: Vector3::zeros(),
-                rate: Vector3::zeros(),
-                samples: 0,
-            },
+            phase: Phase::Coarse(SegmentSums::default()),
             filter: Filter::new(idle, position, filter_config(&position, &[0.0; 3])),
+            input: ProbeInput::new(),
             coarse_std: [f32::NAN; 3],
             flags: 0,
         }
@@ -106,56 +104,56 @@ impl Navigator {
 
     /// Takes one raw sample and returns the solution after it.
     pub fn step(&mut self, raw: &RawSample) -> NavSolution {
-        let body = body_sample(raw, &self.calibration);
-        self.flags = if body.is_none() {
+        let sample = body_sample(raw, &self.calibration);
+        self.flags = if sample.is_none() {
             nav_flags::SENSOR_DEGRADED
         } else {
             0
         };
         // A sample without valid data: the alignment waits, the navigation
         // coasts (the state is left as it is and flagged).
-        if let Some((gx, gz, f)) = body {
-            self.use_sample(gx, gz, f);
+        if let Some(sample) = sample {
+            self.use_sample(&sample);
         }
         self.solution(raw)
     }
 
-    fn use_sample(&mut self, gx: f64, gz: f64, f: Vector3<f64>) {
+    fn use_sample(&mut self, sample: &ProbeSample) {
         let mut coarse_done = None;
         let mut fine_done = false;
         let filter = &mut self.filter;
         match &mut self.phase {
-            Phase::Coarse {
-                force,
-                rate,
-                samples,
-            } => {
-                *force += f;
-                *rate += Vector3::new(gx, 0.0, gz);
-                *samples += 1;
-                if *samples >= ALIGNMENT_SAMPLES {
-                    let n = f64::from(*samples);
-                    coarse_done = Some(StaticSegment {
-                        specific_force: *force / n,
-                        rate: *rate / n,
-                        samples: *samples as usize,
-                    });
+            Phase::Coarse(sums) => {
+                sums.add(sample);
+                if sums.samples() >= ALIGNMENT_SAMPLES as usize {
+                    coarse_done = Some(sums.segment());
                 }
             }
             Phase::Fine { samples } => {
-                let report = filter.step(&at_rest_sample(filter.state(), gx, gz, f));
+                let (imu, _) = self.input.imu_sample(
+                    filter.state(),
+                    sample,
+                    ToolAxisSource::AtRest,
+                    SAMPLE_INTERVAL_S,
+                );
+                let report = filter.step(&imu);
                 if report.zero_velocity.accepted > 0 {
                     self.flags |= nav_flags::ZUPT_APPLIED;
                 }
                 *samples += 1;
                 fine_done = *samples >= FINE_ALIGNMENT_SAMPLES;
             }
-            Phase::Navigating { input } => {
-                let (sample, derived) = input.sample(filter.state(), gx, gz, &f, SAMPLE_INTERVAL_S);
-                if derived == ToolAxisRate::Unavailable {
+            Phase::Navigating => {
+                let (imu, tool_axis) = self.input.imu_sample(
+                    filter.state(),
+                    sample,
+                    ToolAxisSource::AccelerometerRoll,
+                    SAMPLE_INTERVAL_S,
+                );
+                if tool_axis == ToolAxisRate::Unavailable {
                     self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
                 }
-                filter.step(&sample);
+                filter.step(&imu);
             }
         }
         if let Some(segment) = coarse_done {
@@ -163,9 +161,9 @@ impl Navigator {
         }
         if fine_done {
             self.filter.start_navigation();
-            self.phase = Phase::Navigating {
-                input: ProbeInput::new(),
-            };
+            // The roll-derived tool-axis rate starts from this sample on.
+            self.input = ProbeInput::new();
+            self.phase = Phase::Navigating;
         }
     }
 
@@ -213,9 +211,9 @@ impl Navigator {
             ..NavSolution::default()
         };
         solution.mode = match self.phase {
-            Phase::Coarse { .. } => return solution,
+            Phase::Coarse(_) => return solution,
             Phase::Fine { .. } => nav_mode::FINE_ALIGNMENT,
-            Phase::Navigating { .. } => nav_mode::NAVIGATING,
+            Phase::Navigating => nav_mode::NAVIGATING,
         };
         let filter = &self.filter;
         let state = filter.state();
@@ -241,12 +239,12 @@ impl Navigator {
 
     /// True once the coarse alignment is done.
     pub fn is_aligned(&self) -> bool {
-        !matches!(self.phase, Phase::Coarse { .. })
+        !matches!(self.phase, Phase::Coarse(_))
     }
 
     /// True once the fine alignment is done too.
     pub fn is_navigating(&self) -> bool {
-        matches!(self.phase, Phase::Navigating { .. })
+        matches!(self.phase, Phase::Navigating)
     }
 }
 

@@ -1,5 +1,5 @@
-//! The probe's clock: one sample every 50 ms (20 Hz, the paper's rate), and
-//! how its navigation phases are counted in samples.
+//! The probe's clock: one sample every 50 ms (20 Hz, the paper's rate),
+//! and how its navigation phases are counted in samples.
 
 /// Sample period of the probe (us): 20 Hz.
 pub const SAMPLE_PERIOD_US: u64 = 50_000;

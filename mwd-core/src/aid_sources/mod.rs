@@ -1,0 +1,16 @@
+//! Aiding sources of the error-state filter, one file each (as PX4's
+//! `aid_sources/`): each builds a [`crate::kalman::Measurement`] from what
+//! the probe knows at that instant.
+//!
+//! The error states are computed - true, so a measurement's `z` is the
+//! computed quantity minus its reference: for a zero-velocity update
+//! `z = v_computed - 0 = dv` (paper eq. 47) and the row selects the
+//! velocity error. Eq. 48 prints "H12, H13" as the unit blocks; the
+//! velocity and position blocks are H12 and H23 (erratum 5,
+//! docs/paper-errata.md).
+
+mod zero_position;
+mod zero_velocity;
+
+pub use zero_position::ZeroPosition;
+pub use zero_velocity::ZeroVelocity;
