@@ -1,4 +1,4 @@
-//! The whole chain the probe will run (issue 6 binds it for real): two
+//! The whole chain the probe will run (the board binaries bind it for real): two
 //! mocked parts fed by one body-frame motion, the driver's 20 Hz samples,
 //! raw-sample frames on the "UART", the host's decoder, and the counts
 //! turned back into body-frame SI through `sensor_units`. Checks that the

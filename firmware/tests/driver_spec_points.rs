@@ -1,4 +1,4 @@
-//! The driver against hil-mock on the points of `shared/spec/scc1300.md`
+//! The driver against hil-mock on the points of `docs/scc1300.md`
 //! where the two could share a wrong assumption: what the accelerometer's
 //! dPAR covers (both readings), the gyro loop failure of TN92 step 4, the
 //! gyro's specified range, SAT acknowledgement through INT_STATUS in every

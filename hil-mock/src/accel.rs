@@ -4,8 +4,8 @@
 //! registers decrementing from the address (burst).
 //!
 //! The status byte is the state before this frame's command takes effect;
-//! FRME speaks about the previous frame [spec: "FRME = the previous frame had
-//! an error"]. dPAR is the odd-parity bit over the data bytes of the
+//! FRME speaks about the previous frame [spec, "Accelerometer part": FRME
+//! flags an error in it]. dPAR is the odd-parity bit over the data bytes of the
 //! previous frame or of this frame, as [`Scc1300::dpar_scope`] says: the spec
 //! does not tell which (see [`DparScope`] and the driver's
 //! `datasheet::ACCEL_DPAR_SCOPE`).

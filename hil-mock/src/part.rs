@@ -10,13 +10,13 @@ use crate::source::{PhysicalSample, SampleSource};
 /// [TN92 step 1: the host waits 800 ms].
 pub const START_UP_NS: u64 = 800_000_000;
 /// The values the mock's ID registers answer. UNVERIFIED on the real part
-/// (spec: "ID and REVID values: unknown"); the driver does not check them.
+/// (`docs/scc1300.md`: ID and REVID unknown); the driver does not check them.
 pub const MOCK_GYRO_IC_ID: u16 = 0x0130;
 pub const MOCK_ACCEL_ID: u8 = 0x13;
 pub const MOCK_ACCEL_REVID: u8 = 0x01;
 
 /// Which frame's data the accelerometer's dPAR status bit covers. The spec
-/// (`shared/spec/scc1300.md`, "Accelerometer part") names the bit but not
+/// (`docs/scc1300.md`, "Accelerometer part") names the bit but not
 /// its coverage, so the mock can model either; the driver's single switch
 /// is `firmware::scc1300::datasheet::ACCEL_DPAR_SCOPE`, and the firmware
 /// tests check that [`DEFAULT_DPAR_SCOPE`] agrees with it.

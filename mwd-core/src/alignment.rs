@@ -2,7 +2,7 @@
 //! averaged accelerometers, then heading from the earth rate the gyros see,
 //! adapted to the probe's gyros (body x and z only).
 //!
-//! Physics the results respect (see `shared/DESIGN.md`): with gyros across
+//! Physics the results respect, by design: with gyros across
 //! the tool axis, the heading signal is mainly the cross-axis earth rate
 //! Omega cos(lat) sin(heading), plus a pitch-dependent share of the
 //! along-axis component. Heading is well determined for a tool heading north

@@ -9,7 +9,7 @@
 //! `x_k = [z_{k-p+1}, ..., z_{k-1}, z_k]` (the paper's Upsilon_1 = df_{k-3} ..
 //! Upsilon_4 = df_k, eq. 33-36). With that ordering the last row of the
 //! companion matrix is `[-a_p ... -a_1]`; the paper's eq. 41-42 print
-//! `[-a_1 ... -a_p]`, which is erratum 1 in `shared/paper/mgwd.md`.
+//! `[-a_1 ... -a_p]`, which is erratum 1 in `docs/paper-errata.md`.
 
 use nalgebra::{SMatrix, SVector};
 

@@ -1,6 +1,6 @@
 //! Attitude kinematics: rotation vectors, the two-sample coning correction,
 //! and the probe's accelerometer-derived roll and tool-axis rate (paper
-//! section 2.2, eq. 1-10, with the errata in `shared/paper/mgwd.md`).
+//! section 2.2, eq. 1-10, with errata 4, 9, 13 of `docs/paper-errata.md`).
 use crate::conventions::wrap_pi;
 use crate::probe_sample::ProbeSample;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
@@ -12,7 +12,7 @@ const SMALL_ANGLE: f64 = 1e-4;
 /// The quaternion of a rotation vector (paper eq. 4 and 6, with eq. 6's
 /// misprinted sin||0.5 zeta|| read as sin||0.5 Lambda||).
 ///
-/// Below [`SMALL_ANGLE`] (every increment of the 20 Hz cycle) both parts
+/// Below `SMALL_ANGLE` (every increment of the 20 Hz cycle) both parts
 /// come from series in a^2 = |v|^2, with no square root or trigonometry:
 /// cos(a/2) = 1 - a^2/8 + a^4/384, truncation <= a^6/46080 = 2.2e-29, and
 /// sin(a/2)/a = 1/2 - a^2/48, truncation <= a^4/3840 = 2.6e-20 (5.2e-20

@@ -6,7 +6,7 @@
 //! * Sensors: [`sensor_units`] (SCC1300 counts), [`sensor_noise`] (error
 //!   budget), [`calibration`] (correction step), [`ar`] (AR(p) noise).
 //! * The filter: [`error_model`], [`kalman`], [`measurement`],
-//!   [`fine_alignment`]; [`observability`] on the host (`std` feature).
+//!   [`fine_alignment`]; `observability` on the host (`std` feature).
 //! * The wire protocol: [`protocol`].
 #![no_std]
 #![forbid(unsafe_code)]

@@ -3,9 +3,9 @@
 //! word formats, sensitivities, count <-> SI conversions, and how each of the
 //! probe's two parts is mounted in the body frame.
 //!
-//! Sources: `shared/spec/scc1300.md` (Murata TN92 and the D04 datasheet front
-//! page). Values the spec marks as unverified carry `UNVERIFIED` in their doc
-//! comment; correct them here and every crate follows.
+//! Sources: `docs/scc1300.md`, "the spec" (Murata TN92 and the D04 datasheet
+//! front page). Values the spec marks as unverified carry `UNVERIFIED` in their
+//! doc comment; correct them here and every crate follows.
 
 /// Standard gravity, the "g" of the datasheet's LSB/g sensitivity (the
 /// conventional value of ISO 80000-3, not the local gravity of the earth
@@ -15,7 +15,7 @@ pub const STANDARD_GRAVITY: f64 = 9.806_65;
 pub const STANDARD_GRAVITY_M_S2: f32 = STANDARD_GRAVITY as f32;
 
 /// Both slaves deliver 14-bit two's complement values, left-aligned in a
-/// 16-bit word: `(word as i16) >> 2` [TN92]. Smallest count.
+/// 16-bit word: `(word as i16) >> 2` \[TN92\]. Smallest count.
 pub const COUNT_MIN: i16 = -8192;
 /// Largest 14-bit count.
 pub const COUNT_MAX: i16 = 8191;
@@ -39,7 +39,7 @@ pub const fn gyro_count_is_saturated(count: i16) -> bool {
     count > GYRO_RANGE_COUNTS || count < -GYRO_RANGE_COUNTS
 }
 
-/// Accelerometer sensitivity of the D04 variant: 650 LSB/g [TN92].
+/// Accelerometer sensitivity of the D04 variant: 650 LSB/g \[TN92\].
 pub const ACCEL_LSB_PER_G: f32 = 650.0;
 /// Specified accelerometer range, 6 g [datasheet front page]; the part flags
 /// SAT beyond it (behaviour taken from the SCA3100 family, see the spec).
@@ -67,7 +67,7 @@ pub const GYRO_TEMPERATURE: TemperatureScale = TemperatureScale {
 pub const ACCEL_TEMPERATURE: TemperatureScale = GYRO_TEMPERATURE;
 
 /// Converts a left-aligned 16-bit output word into its 14-bit count
-/// (arithmetic shift keeps the sign) [TN92].
+/// (arithmetic shift keeps the sign) \[TN92\].
 pub const fn word_to_count(word: u16) -> i16 {
     (word as i16) >> 2
 }
@@ -215,7 +215,7 @@ impl Mounting {
 /// The probe's two parts, in the order of the raw-sample frame.
 pub const PART_COUNT: usize = 2;
 
-/// Mounting of the two parts (project decision, issue 5): part 1 ("azimuth
+/// Mounting of the two parts (project decision, `docs/scc1300.md`): part 1 ("azimuth
 /// gyro board") has its X, Y, Z along body x, y, z, so its gyro senses +x;
 /// part 2 ("pitch gyro board") is turned so that its X, Y, Z sense body
 /// z, y, -x, so its gyro senses +z. Correct a mounting here, nowhere else.

@@ -1,4 +1,4 @@
-//! Coarse alignment against the simulated SCC1300 (issue 2): the printed
+//! Coarse alignment against the simulated SCC1300: the printed
 //! 2-sigma bounds must cover the actual errors in at least 90 % of 200
 //! seeded trials, and must not be vacuous where the data determine the
 //! answer.

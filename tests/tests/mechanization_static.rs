@@ -1,6 +1,6 @@
 //! A noise-free simulated probe at rest, through the probe's own input path
 //! (x and z gyros, tool-axis rate derived from accelerometer roll) and the
-//! strapdown mechanization: it must stay put (issue 2: under 1 mm and
+//! strapdown mechanization: it must stay put (requirement: under 1 mm and
 //! 1e-6 m/s over 60 s).
 use host_sim::sim::{SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
 use mwd_core::conventions::{quat_from_euler, Euler};

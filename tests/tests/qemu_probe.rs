@@ -1,4 +1,4 @@
-//! The probe's firmware in QEMU, end to end (issue 6): the `probe-qemu`
+//! The probe's firmware in QEMU, end to end: the `probe-qemu`
 //! binary is cross-built, runs on the emulated mps2-an386 board for a
 //! simulated minute with the two SCC1300 parts simulated by hil-mock behind
 //! the real driver, and its UART bytes (QEMU `-serial file:`) are decoded

@@ -1,4 +1,4 @@
-//! The QEMU probe read live over a serial port (issue 6, test b): QEMU puts
+//! The QEMU probe read live over a serial port: QEMU puts
 //! the probe's UART on a pseudo-terminal (`-serial pty`) and
 //! `host-sim replay --port /dev/pts/N --baud 115200` reads it through the
 //! serialport crate, the way an engineer connects to a real probe, until

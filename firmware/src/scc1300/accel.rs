@@ -10,7 +10,7 @@
 //! sample is three frames: the axes, the temperature (whose status vouches
 //! for the axes) and STATUS (whose status vouches for the temperature).
 //!
-//! SAT means "output saturated, invalid until INT_STATUS is read" [spec,
+//! SAT means output saturated, invalid until INT_STATUS is read [spec,
 //! from the SCA3100 family]: whichever frame shows it, and whatever other
 //! flag comes with it, the sample is invalid and INT_STATUS is read before
 //! the driver returns.

@@ -1,5 +1,5 @@
 //! Register map, bit positions, timings and the datasheet values that are
-//! not verified, in one place. Source: `shared/spec/scc1300.md`, which
+//! not verified, in one place. Source: `docs/scc1300.md` ("the spec"), which
 //! condenses Murata TN92 "SPI communication with SCC1300" (Rev. 1.1), the
 //! SCC1300-D04 datasheet front pages (doc 82 1131 00) and third-party
 //! drivers. Sensitivities and count conversions live in
@@ -91,11 +91,11 @@ pub enum DparScope {
 /// driver-against-mock tests configure hil-mock's `Scc1300::dpar_scope`
 /// from it (they also check that the mock's default agrees).
 ///
-/// What the spec says (`shared/spec/scc1300.md`, "Accelerometer part"):
-/// only "MISO byte 1 = status `[-, FRME, PORST, ST, SAT, 0, 1, dPAR]`;
-/// byte 2 = data", and "No CRC: odd parity only" (section "Bus"). The
-/// SCA3100-derived meanings it lists cover SAT, ST, FRME ("the previous
-/// frame had an error") and PORST, not dPAR. So neither the frame nor the
+/// What the spec says (`docs/scc1300.md`, "Accelerometer part"): only the
+/// status byte `[-, FRME, PORST, ST, SAT, 0, 1, dPAR]` ahead of the data,
+/// and odd parity as the bus's only check, no CRC (section "Bus"). Its
+/// meanings from the SCA3100 family cover SAT, ST, FRME (an error in the
+/// previous frame) and PORST, not dPAR. So neither the frame nor the
 /// bytes dPAR covers is documented; the full datasheet (Murata doc
 /// 82 1131 00) was not available.
 ///

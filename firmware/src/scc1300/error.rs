@@ -1,5 +1,5 @@
 //! What can go wrong on the sensor bus, told apart so the firmware can
-//! count, flag and recover (DESIGN.md: no panics on data).
+//! count, flag and recover (design rule: no panics on data).
 
 use embedded_hal::spi::ErrorKind;
 use mwd_core::protocol::frame::{raw_flags, Event, EventKind};

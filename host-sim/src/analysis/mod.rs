@@ -1,4 +1,4 @@
-//! Sensor-noise analysis and calibration (issue 4): what the paper's team
+//! Sensor-noise analysis and calibration: what the paper's team
 //! did in MATLAB to characterise the SCC1300 (MGWD paper section 3.2),
 //! done in the host tool.
 //!

@@ -112,7 +112,7 @@ pub mod nav_flags {
     /// A zero-velocity update was applied in this cycle.
     pub const ZUPT_APPLIED: u16 = 1 << 0;
     /// The tool axis is near vertical: the tool-axis rate from accelerometer
-    /// roll is invalid (DESIGN.md, "Sensors and their geometry").
+    /// roll is invalid (within `attitude::NEAR_VERTICAL`, 5 deg, of vertical).
     pub const TOOL_AXIS_RATE_INVALID: u16 = 1 << 1;
     /// Some sensor input of this cycle was flagged invalid.
     pub const SENSOR_DEGRADED: u16 = 1 << 2;
