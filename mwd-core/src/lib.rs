@@ -1,12 +1,17 @@
 //! Navigation core of the gyro MWD probe: no_std, no heap, no unsafe. The
 //! same code runs on the probe's Cortex-M4F and on the host.
 //!
-//! * Frames and angles: [`conventions`]; the earth: [`earth`].
+//! * Frames and angles: [`conventions`]; the earth: [`earth`]; the 20 Hz
+//!   clock: [`timing`].
+//! * Sensors: [`probe_sample`] (what the probe senses), [`sensor_units`]
+//!   (SCC1300 counts), [`sensor_noise`] (error budget), [`calibration`]
+//!   (correction step), [`ar`] (AR(p) noise).
 //! * Navigation: [`attitude`], [`mechanization`], coarse [`alignment`].
-//! * Sensors: [`sensor_units`] (SCC1300 counts), [`sensor_noise`] (error
-//!   budget), [`calibration`] (correction step), [`ar`] (AR(p) noise).
-//! * The filter: [`error_model`], [`kalman`], [`measurement`],
-//!   [`fine_alignment`]; `observability` on the host (`std` feature).
+//! * The filter: [`kalman`] (the generic machinery, a leaf),
+//!   [`error_model`] (the 33/39-state model), [`aid_sources`] (one file per
+//!   measurement), [`fine_alignment`] (the closed loop);
+//!   `observability` on the host (`std` feature).
+//! * The probe's navigation, raw sample to solution: [`probe`].
 //! * The wire protocol: [`protocol`].
 #![no_std]
 #![forbid(unsafe_code)]
