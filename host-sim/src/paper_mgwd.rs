@@ -198,7 +198,8 @@ fn fine_align_with<const N: usize>(
     let dt = SAMPLE_INTERVAL;
     for r in records {
         // The tool is at rest: its rate about the tool axis is the frame's.
-        let (imu, _) = input.imu_sample(fa.state(), &r.sample, ToolAxisSource::AtRest, dt);
+        let frame_rate = fa.frame_rate_in_body();
+        let (imu, _) = input.imu_sample(&frame_rate, &r.sample, ToolAxisSource::AtRest, dt);
         fa.step(&imu);
         let e = euler_from_quat(&fa.state().attitude);
         let sigma = fa.euler_std() / DEG;

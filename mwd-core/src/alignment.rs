@@ -33,7 +33,7 @@
 //! is raised when the geometry is weak anywhere in that interval, not only
 //! at the estimate, which noise can pull away from east/west.
 use crate::attitude::level;
-use crate::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler};
+use crate::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler, DEG};
 use crate::earth::{earth_rate_n, EARTH_RATE};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::sensor_noise::ImuNoise;
@@ -50,7 +50,7 @@ pub const ILL_CONDITIONED_SENSITIVITY: f64 = 0.3;
 /// Beyond this 1-sigma (rad) the heading is reported as undetermined: the
 /// headings the data allow span more than 2 x 40 deg, or the linearised
 /// uncertainty no longer describes the error.
-pub const MAX_DETERMINED_SIGMA: f64 = 20.0 * PI / 180.0;
+pub const MAX_DETERMINED_SIGMA: f64 = 20.0 * DEG;
 /// A second heading candidate whose misfit exceeds the best one's by less
 /// than this (chi-square, 1 degree of freedom, 99 %) explains the data as
 /// well: the heading is ambiguous.

@@ -11,6 +11,7 @@
 //! companion matrix is `[-a_p ... -a_1]`; the paper's eq. 41-42 print
 //! `[-a_1 ... -a_p]`, which is erratum 1 in `docs/paper-errata.md`.
 
+use crate::conventions::DEG;
 use nalgebra::{SMatrix, SVector};
 
 /// An AR(p) model in the `aryule` convention.
@@ -26,7 +27,7 @@ pub struct ArModel<const P: usize> {
 pub type Ar4 = ArModel<4>;
 
 /// Converts a variance in (deg/s)^2 to (rad/s)^2.
-const DEG2_TO_RAD2: f64 = (core::f64::consts::PI / 180.0) * (core::f64::consts::PI / 180.0);
+const DEG2_TO_RAD2: f64 = DEG * DEG;
 
 /// Paper Table 4, accelerometer X (body x, right). Beta in (m/s^2)^2.
 pub const ACCEL_X: Ar4 = ArModel::new([0.3308, -0.0995, 0.2036, 0.3347], 0.0034);

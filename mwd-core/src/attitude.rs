@@ -1,7 +1,7 @@
 //! Attitude kinematics: rotation vectors, the two-sample coning correction,
 //! and the probe's accelerometer-derived roll and tool-axis rate (paper
 //! section 2.2, eq. 1-10, with errata 4, 9, 13 of `docs/paper-errata.md`).
-use crate::conventions::wrap_pi;
+use crate::conventions::{wrap_pi, DEG};
 use crate::probe_sample::ProbeSample;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
@@ -73,7 +73,7 @@ pub struct Levelling {
 /// accelerometer roll, and everything derived from it, is declared invalid:
 /// 5 deg, where the cross-axis gravity is g sin 5 deg = 0.085 g, about
 /// 55 times the accelerometer's 1.5 mg LSB.
-pub const NEAR_VERTICAL: f64 = 5.0 * core::f64::consts::PI / 180.0;
+pub const NEAR_VERTICAL: f64 = 5.0 * DEG;
 
 pub fn level(specific_force: &Vector3<f64>) -> Levelling {
     let f = specific_force;

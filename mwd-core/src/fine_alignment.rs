@@ -357,6 +357,12 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.config.specific_force = SpecificForceInModel::MeasuredSample;
     }
 
+    /// The navigation frame's rate in body axes at the current solution
+    /// (the tool-axis rate of a still tool; [`Strapdown::frame_rate_in_body`]).
+    pub fn frame_rate_in_body(&mut self) -> Vector3<f64> {
+        self.strapdown.frame_rate_in_body()
+    }
+
     /// The corrected navigation solution.
     pub fn state(&self) -> &NavState {
         self.strapdown.state()

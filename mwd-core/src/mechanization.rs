@@ -58,16 +58,21 @@ pub struct Strapdown {
     /// Sine and cosine of the latitude the last step ended at, and that
     /// latitude: they spare `apply_correction` its trigonometry.
     latitude_trig: Option<(f64, LatitudeTrig)>,
+    /// The local earth at `state`, once asked for: the input of a step
+    /// (the navigation frame's rate) and the step itself share it.
+    earth: Option<LocalEarth>,
 }
 
 impl Strapdown {
-    /// `dt` is the sample interval (s), 0.05 on the probe.
+    /// `dt` is the sample interval (s): `timing::SAMPLE_INTERVAL_S` on the
+    /// probe.
     pub fn new(state: NavState, dt: f64) -> Self {
         Self {
             state,
             dt,
             previous: None,
             latitude_trig: None,
+            earth: None,
         }
     }
 
@@ -85,6 +90,21 @@ impl Strapdown {
         self.state = state;
         self.previous = None;
         self.latitude_trig = None;
+        self.earth = None;
+    }
+
+    /// The local earth at the current solution (computed once per state).
+    pub fn local_earth(&mut self) -> LocalEarth {
+        *self
+            .earth
+            .get_or_insert_with(|| LocalEarth::at(&self.state.position))
+    }
+
+    /// The navigation frame's rate in body axes at the current solution
+    /// ([`frame_rate_in_body`], with the local earth the next step uses).
+    pub fn frame_rate_in_body(&mut self) -> Vector3<f64> {
+        let earth = self.local_earth();
+        frame_rate_in_body_with(&self.state, &earth)
     }
 
     /// Advances the solution by one sample interval.
@@ -97,6 +117,8 @@ impl Strapdown {
     /// latitude increment, exact to f64 rounding.
     pub fn step(&mut self, sample: &ImuSample) {
         let dt = self.dt;
+        let earth = self.local_earth();
+        self.earth = None;
         let s = &mut self.state;
         let dtheta = sample.rate * dt;
         let dv = sample.specific_force * dt;
@@ -106,7 +128,6 @@ impl Strapdown {
         self.previous = Some((dtheta, dv));
 
         let pos = s.position;
-        let earth = LocalEarth::at(&pos);
         let trig = LatitudeTrig {
             sin: earth.sin_lat,
             cos: earth.cos_lat,
@@ -174,6 +195,7 @@ impl Strapdown {
             _ => LocalEarth::at(&s.position),
         };
         s.position = earth.displaced(&-position_error_ned_m);
+        self.earth = None;
         self.latitude_trig = None;
     }
 }
@@ -227,7 +249,11 @@ fn renormalized(q: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
 /// rate), in body axes at the solution `state`: what a tool at rest senses,
 /// and the reference of the accelerometer-derived tool-axis rate.
 pub fn frame_rate_in_body(state: &NavState) -> Vector3<f64> {
-    let earth = LocalEarth::at(&state.position);
+    frame_rate_in_body_with(state, &LocalEarth::at(&state.position))
+}
+
+/// [`frame_rate_in_body`] with the local earth at `state` at hand.
+fn frame_rate_in_body_with(state: &NavState, earth: &LocalEarth) -> Vector3<f64> {
     let omega_in_n = earth.earth_rate_n() + earth.transport_rate_n(&state.velocity);
     state.attitude.inverse_transform_vector(&omega_in_n)
 }
@@ -265,22 +291,24 @@ impl ProbeInput {
     }
 
     /// The sample for the next mechanization step from a calibrated probe
-    /// sample, given the current solution (for the navigation frame's rate
-    /// in body axes), and the tool-axis rate used: `Unavailable` when the
-    /// accelerometer roll gave none and the frame's rate stood in.
-    /// At rest the estimator of the roll-derived rate is left as it is.
+    /// sample, given the navigation frame's rate in body axes at the
+    /// current solution ([`frame_rate_in_body`], or the
+    /// [`Strapdown::frame_rate_in_body`] of the filter that will take the
+    /// sample), and the tool-axis rate used: `Unavailable` when the
+    /// accelerometer roll gave none and the frame's rate stood in. At rest
+    /// the estimator of the roll-derived rate is left as it is.
     pub fn imu_sample(
         &mut self,
-        state: &NavState,
+        frame_rate_in_body: &Vector3<f64>,
         sample: &ProbeSample,
         source: ToolAxisSource,
         dt: f64,
     ) -> (ImuSample, ToolAxisRate) {
-        let omega_in_b = frame_rate_in_body(state);
+        let omega_in_b = frame_rate_in_body;
         let (rate_y, used) = match source {
             ToolAxisSource::AtRest => (omega_in_b.y, ToolAxisRate::Valid(omega_in_b.y)),
             ToolAxisSource::AccelerometerRoll => {
-                match self.tool_axis.update(sample, &omega_in_b, dt) {
+                match self.tool_axis.update(sample, omega_in_b, dt) {
                     ToolAxisRate::Valid(rate) => (rate, ToolAxisRate::Valid(rate)),
                     ToolAxisRate::Unavailable => (omega_in_b.y, ToolAxisRate::Unavailable),
                 }
@@ -299,6 +327,7 @@ mod tests {
     use super::*;
     use crate::conventions::{dcm_from_quat, quat_from_euler, Euler};
     use crate::earth::{earth_rate_n, gravity_n, transport_rate_n};
+    use crate::timing::SAMPLE_INTERVAL_S;
     use nalgebra::Matrix3;
     use proptest::prelude::*;
 
@@ -326,7 +355,7 @@ mod tests {
                 Position::from_degrees(lat_deg, 126.7, height),
             );
             let sample = ideal_static_sample(&start);
-            let mut nav = Strapdown::new(start, 0.05);
+            let mut nav = Strapdown::new(start, SAMPLE_INTERVAL_S);
             for _ in 0..1200 {
                 nav.step(&sample);
             }
@@ -407,9 +436,9 @@ mod tests {
         );
         let mut moving = start;
         moving.velocity = Vector3::new(3.0, -2.0, 0.5);
-        let mut nav = Strapdown::new(moving, 0.05);
+        let mut nav = Strapdown::new(moving, SAMPLE_INTERVAL_S);
         nav.step(&ideal_static_sample(&start));
-        let mut fresh = Strapdown::new(*nav.state(), 0.05);
+        let mut fresh = Strapdown::new(*nav.state(), SAMPLE_INTERVAL_S);
         let dp = Vector3::new(0.02, -0.03, 0.01);
         nav.apply_correction(&Vector3::zeros(), &Vector3::zeros(), &dp);
         fresh.apply_correction(&Vector3::zeros(), &Vector3::zeros(), &dp);
@@ -424,7 +453,7 @@ mod tests {
         // it eastward by micrometres only over one second).
         let pos = Position::paper_site();
         let start = NavState::at_rest(quat_from_euler(&Euler::default()), pos);
-        let mut nav = Strapdown::new(start, 0.05);
+        let mut nav = Strapdown::new(start, SAMPLE_INTERVAL_S);
         let sample = ImuSample {
             rate: dcm_from_quat(&start.attitude).transpose() * earth_rate_n(pos.lat),
             specific_force: Vector3::zeros(),
@@ -447,7 +476,7 @@ mod tests {
         let attitude = quat_from_euler(&Euler::default());
         let mut state = NavState::at_rest(attitude, pos);
         state.velocity = Vector3::new(1.0, 0.0, 0.0);
-        let mut nav = Strapdown::new(state, 0.05);
+        let mut nav = Strapdown::new(state, SAMPLE_INTERVAL_S);
         for _ in 0..2000 {
             let s = *nav.state();
             let omega_ie = earth_rate_n(s.position.lat);
@@ -480,7 +509,7 @@ mod tests {
             velocity: truth.velocity + dv,
             position: truth.position.displaced(&dp),
         };
-        let mut nav = Strapdown::new(computed, 0.05);
+        let mut nav = Strapdown::new(computed, SAMPLE_INTERVAL_S);
         nav.apply_correction(&phi, &dv, &dp);
         let s = nav.state();
         assert!(s.attitude.angle_to(&truth.attitude) < 1e-12);

@@ -95,7 +95,8 @@ fn quantise(value_in_counts: f32) -> i16 {
     clamp_count(rounded as i32)
 }
 
-const RAD_PER_DEG: f32 = core::f32::consts::PI / 180.0;
+/// One degree in radians, single precision (the bits of f32 pi / 180).
+const RAD_PER_DEG: f32 = crate::conventions::DEG as f32;
 
 /// Gyro count -> rate in rad/s.
 pub fn gyro_count_to_rad_s(count: i16) -> f32 {
@@ -231,6 +232,11 @@ pub const PART_MOUNTINGS: [Mounting; PART_COUNT] = [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn single_precision_degree_is_f32_pi_over_180() {
+        assert_eq!(RAD_PER_DEG, core::f32::consts::PI / 180.0);
+    }
 
     #[test]
     fn single_precision_gravity_is_the_literal() {

@@ -14,6 +14,7 @@ mod common;
 use common::Normal;
 use mwd_core::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
 use mwd_core::attitude::level;
+use mwd_core::conventions::DEG;
 use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{earth_rate_n, gravity_n, normal_gravity, Position};
 use mwd_core::error_model::{AugmentedModel, ProcessNoise, NAV_STATES, STATES_WITH_BIASES};
@@ -22,12 +23,14 @@ use mwd_core::fine_alignment::{
 };
 use mwd_core::mechanization::{ImuSample, NavState};
 use mwd_core::sensor_noise::{AxisNoise, ImuNoise};
+use mwd_core::sensor_units::STANDARD_GRAVITY;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
 
-const DT: f64 = 0.05;
+const DT: f64 = SAMPLE_INTERVAL_S;
 const SAMPLES: usize = 1200; // the paper's 60 s
 const COARSE_SAMPLES: usize = 100; // its 5 s of coarse alignment
-const AZIMUTH_SIGMA: f64 = 2.0 * core::f64::consts::PI / 180.0;
+const AZIMUTH_SIGMA: f64 = 2.0 * DEG;
 
 /// One sensor channel: AR(4) noise + constant residual bias + first-order
 /// Gauss-Markov bias instability (started in its stationary state).
@@ -220,7 +223,7 @@ fn tilt_sigma_converges_and_azimuth_sigma_does_not() {
     let r = run(3, [0.5f64.to_radians(); 2]);
     let (start, end) = (r.sigma[0], r.sigma[SAMPLES]);
     let ten_s_before = r.sigma[SAMPLES - 200];
-    let floor = 1e-3 * 9.80665 / normal_gravity(truth().position.lat, 0.0);
+    let floor = 1e-3 * STANDARD_GRAVITY / normal_gravity(truth().position.lat, 0.0);
     for i in 0..2 {
         assert!(end[i] < 0.2 * start[i], "axis {i}: {start} -> {end}");
         assert!(end[i] > 0.9 * floor, "axis {i}: {end} below the bias floor");

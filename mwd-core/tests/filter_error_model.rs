@@ -13,7 +13,7 @@ use mwd_core::error_model::{
 use mwd_core::mechanization::{ImuSample, NavState, Strapdown};
 use nalgebra::{SMatrix, SVector, Vector3};
 
-const DT: f64 = 0.05;
+const DT: f64 = mwd_core::timing::SAMPLE_INTERVAL_S;
 const SUBSTEPS: usize = 20;
 
 fn truth() -> NavState {

@@ -25,7 +25,8 @@ fn simulated_static_probe_stays_put_for_a_minute() {
         {
             let probe = ProbeSample::new(s.gyro.x, s.gyro.z, s.accel);
             let source = ToolAxisSource::AccelerometerRoll;
-            let (sample, _) = input.imu_sample(nav.state(), &probe, source, SAMPLE_INTERVAL);
+            let frame_rate = nav.frame_rate_in_body();
+            let (sample, _) = input.imu_sample(&frame_rate, &probe, source, SAMPLE_INTERVAL);
             nav.step(&sample);
         }
         let end = nav.state();

@@ -131,7 +131,7 @@ impl Navigator {
             }
             Phase::Fine { samples } => {
                 let (imu, _) = self.input.imu_sample(
-                    filter.state(),
+                    &filter.frame_rate_in_body(),
                     sample,
                     ToolAxisSource::AtRest,
                     SAMPLE_INTERVAL_S,
@@ -145,7 +145,7 @@ impl Navigator {
             }
             Phase::Navigating => {
                 let (imu, tool_axis) = self.input.imu_sample(
-                    filter.state(),
+                    &filter.frame_rate_in_body(),
                     sample,
                     ToolAxisSource::AccelerometerRoll,
                     SAMPLE_INTERVAL_S,

@@ -6,6 +6,7 @@ use super::frame::{
     nav_flags, nav_mode, raw_flags, Event, EventKind, NavSolution, Payload, RawPart, RawSample,
     NO_PART,
 };
+use crate::earth::Position;
 
 /// Sequence number of the worked raw-sample example.
 pub const EXAMPLE_SEQ: u16 = 0x0102;
@@ -49,8 +50,8 @@ pub fn nav_solution() -> Payload {
         flags: nav_flags::ZUPT_APPLIED,
         attitude: [-0.014_069, 0.009_374, -2.634_808],
         velocity_ned: [0.001, -0.002, 0.0],
-        latitude: 45.777_55_f64.to_radians(),
-        longitude: 126.687_898_f64.to_radians(),
+        latitude: Position::paper_site().lat,
+        longitude: Position::paper_site().lon,
         height: 124.0,
         attitude_std: [0.000_607, 0.000_182, 0.1],
         velocity_std: [0.0277, 0.0292, 0.027],
