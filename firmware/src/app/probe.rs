@@ -7,13 +7,14 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
+use mwd_core::probe::timing::sample_time_us;
 use mwd_core::protocol::frame::NO_PART;
 use mwd_core::protocol::{Event, EventKind, Payload};
 
 use super::cycle::AcquisitionCycle;
 use super::frame_queue::{FrameQueue, TX_QUEUE_LEN};
 use super::sample_inbox::{SampleInbox, NAV_INBOX_LEN};
-use super::start_up::reset_event_code;
+use super::sensor_wire::reset_event_code;
 use crate::scc1300::{Part, PartReading};
 
 /// The probe's two parts.
@@ -70,7 +71,7 @@ impl<G, A> ProbeState<G, A> {
     /// An event frame stamped with the time of the next sample.
     pub fn event(&self, kind: EventKind, part: u8, code: u16, value: u32) -> Payload {
         Payload::Event(Event {
-            time_us: AcquisitionCycle::sample_time_us(self.cycle.samples()),
+            time_us: sample_time_us(self.cycle.samples()),
             kind,
             part,
             code,
@@ -137,7 +138,10 @@ mod tests {
     use super::*;
     use crate::app::start_parts;
     use core::cell::RefCell;
-    use hil_mock::{AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, Window};
+    use hil_mock::{
+        AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, Window,
+        SAMPLE_PERIOD_NS,
+    };
     use mwd_core::protocol::Decoder;
     use std::vec::Vec;
 
@@ -157,7 +161,7 @@ mod tests {
         assert!(probe.nav_inbox.is_empty(), "not streaming yet");
         probe.start_streaming(parts);
         for _ in 0..10 {
-            clock.advance_ms(50);
+            clock.advance_ns(SAMPLE_PERIOD_NS);
             probe.acquire();
         }
         assert!(probe.take_recovery().is_none());
@@ -169,20 +173,20 @@ mod tests {
             start_ns: now,
             end_ns: now + 100_000_000,
         });
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire();
         let Some(mut job) = probe.take_recovery() else {
             panic!("part 1 asks for recovery")
         };
         assert!(probe.sensors.is_none());
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire(); // a sample while the parts are away
         let mut resets = Vec::new();
         job.run(&mut delay, |part, code| resets.push((part, code)));
         assert_eq!(resets, [(1, 0)], "a transient: the part came back");
         let resync = probe.end_recovery(job);
         assert!(matches!(resync, Payload::Event(e) if e.kind == EventKind::Resync && e.value == 1));
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire();
         assert!(probe.sensors.is_some() && probe.take_recovery().is_none());
 
