@@ -13,12 +13,10 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::scc1300::Part;
 use hil_mock::{
-    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe, TimeSource, Window,
+    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe, TimeSource,
+    Window, SAMPLE_PERIOD_NS,
 };
 use mwd_core::sensor_units::PART_MOUNTINGS;
-
-/// The acquisition timer's period.
-pub const PERIOD_NS: u64 = 50_000_000;
 
 /// Timer periods since boot, counted by the SysTick interrupt.
 pub static TICKS: AtomicU32 = AtomicU32::new(0);
@@ -28,7 +26,7 @@ pub struct BoardClock;
 
 impl TimeSource for BoardClock {
     fn now_ns(&self) -> u64 {
-        u64::from(TICKS.load(Ordering::Relaxed)) * PERIOD_NS
+        u64::from(TICKS.load(Ordering::Relaxed)) * SAMPLE_PERIOD_NS
     }
 }
 
@@ -38,7 +36,7 @@ pub struct TickDelay;
 
 impl DelayNs for TickDelay {
     fn delay_ns(&mut self, ns: u32) {
-        let periods = u64::from(ns).div_ceil(PERIOD_NS) as u32;
+        let periods = u64::from(ns).div_ceil(SAMPLE_PERIOD_NS) as u32;
         let target = TICKS.load(Ordering::Relaxed).wrapping_add(periods);
         // Wrapping comparison: correct across the counter's overflow.
         while (TICKS.load(Ordering::Relaxed).wrapping_sub(target) as i32) < 0 {
@@ -126,7 +124,7 @@ pub fn power_up() -> Sensors {
 /// The fault run (feature `qemu-fault-demo`): faults injected into the
 /// simulated parts at fixed samples, so the end-to-end test sees each one
 /// come back as event frames while the stream goes on. Times are samples
-/// since streaming started (20 per second).
+/// since streaming started.
 pub fn inject_scheduled_faults(sample: u32) {
     if !cfg!(feature = "qemu-fault-demo") {
         return;
