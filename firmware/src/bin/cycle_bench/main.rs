@@ -7,8 +7,12 @@
 //! SysTick runs from the 25 MHz board clock, so it ticks every 40
 //! instructions. The loop calibration below measures that ratio instead of
 //! trusting it.
+//!
+//! Run it with `scripts/qemu-cycle-bench.sh` (feature `qemu-cycle-bench`,
+//! profile `cycle-bench`); the figures are in docs/filter-benchmarks.md.
 #![no_std]
 #![no_main]
+#![deny(unsafe_code)]
 
 use core::panic::PanicInfo;
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
