@@ -9,6 +9,10 @@
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
 //!   raw sample (navigation frames); feeds the watchdog; sleeps otherwise.
 //!
+//! What the contexts share and do is `firmware::app::SharedProbe`, as on
+//! the real board; this file adds UART0 as its `Transmitter`, SysTick, the
+//! watchdog and the run's measurements.
+//!
 //! The run ends after `PROBE_QEMU_RUN_SECONDS` simulated seconds (a
 //! compile-time setting, default 60): the queue is drained, a summary is
 //! printed through semihosting, and QEMU exits with success.
@@ -37,7 +41,11 @@ use registers::SYSTEM_CLOCK_HZ;
 
 /// Simulated seconds of streaming before the probe exits.
 const RUN_SECONDS: u32 = parse_seconds(option_env!("PROBE_QEMU_RUN_SECONDS"), 60);
-const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLE_RATE_HZ as u32;
+const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
+/// The sample rate, for counting seconds in samples.
+const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
+/// When the watchdog run (feature `qemu-stall-demo`) hangs its main loop.
+const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
@@ -162,7 +170,9 @@ fn main() -> ! {
                 mode = solution.mode;
             },
         );
-        if cfg!(feature = "qemu-stall-demo") && PROBE.with(|s| s.probe().cycle().samples()) >= 200 {
+        if cfg!(feature = "qemu-stall-demo")
+            && PROBE.with(|s| s.probe().cycle().samples()) >= STALL_AT_SAMPLE
+        {
             // A hung main loop (the watchdog run): interrupts go on.
             loop {
                 cortex_m::asm::wfi();

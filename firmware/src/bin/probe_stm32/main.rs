@@ -9,6 +9,10 @@
 //! - USART1 (TX empty): moves the next queued byte into the transmitter;
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
 //!   raw sample (navigation frames); feeds the watchdog; sleeps otherwise.
+//!
+//! What the contexts share and do is `firmware::app::SharedProbe`, as on
+//! the QEMU board; this file adds USART1 as its `Transmitter`, TIM2, the
+//! NVIC and the watchdog.
 #![no_std]
 #![no_main]
 
@@ -33,6 +37,8 @@ use stm32f4xx_hal::timer::{Event as TimerEvent, Flag};
 
 use board::{Device, Timer, Uart};
 
+/// The acquisition timer's rate: one interrupt per sample.
+const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// NVIC priorities (upper 4 bits on the F411; lower number = more urgent).
 const PRIORITY_ACQUISITION: u8 = 0x10;
 const PRIORITY_UART: u8 = 0x20;
@@ -103,7 +109,7 @@ fn main() -> ! {
         mut watchdog,
     } = board;
     defmt::info!("probe-stm32 v{=u16}: booting", FIRMWARE_VERSION);
-    if timer.start((SAMPLE_RATE_HZ as u32).Hz()).is_err() {
+    if timer.start(SAMPLES_PER_SECOND.Hz()).is_err() {
         defmt::panic!("TIM2 cannot run at the sample rate");
     }
     timer.listen(TimerEvent::Update);
@@ -123,7 +129,7 @@ fn main() -> ! {
     PROBE.announce_boot();
     watchdog.start(WATCHDOG_TIMEOUT_MS.millis());
     PROBE.start_streaming(sensors, &mut delay);
-    defmt::info!("streaming at {=u32} Hz", SAMPLE_RATE_HZ as u32);
+    defmt::info!("streaming at {=u32} Hz", SAMPLES_PER_SECOND);
 
     // The probe's site: the MGWD paper's test site until it is configurable.
     let mut navigator = Navigator::new(Position::paper_site());
