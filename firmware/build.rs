@@ -1,4 +1,4 @@
-//! Linker set-up of the board binaries only: the host build of the library
+//! Linker set-up of the target binaries only: the host build of the library
 //! (and its tests) gets no linker script at all.
 //!
 //! The QEMU board links with its own complete script, `link-qemu.x` (with
