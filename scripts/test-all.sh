@@ -26,6 +26,10 @@ cargo build -p firmware --profile probe --target thumbv7em-none-eabihf --feature
 # memory.x, so a build that outgrows the probe's budget fails here.
 cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features board-stm32 --bin probe-stm32 -- -D warnings
 cargo build -p firmware --profile probe --target thumbv7em-none-eabihf --features board-stm32 --bin probe-stm32
+# The filter-cycle bench (scripts/qemu-cycle-bench.sh runs it in QEMU):
+# linted and built, so it keeps up with the filters' API.
+cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features qemu-cycle-bench --bin qemu-cycle-bench -- -D warnings
+cargo build -p firmware --profile cycle-bench --target thumbv7em-none-eabihf --features qemu-cycle-bench --bin qemu-cycle-bench
 cargo test --workspace
 # The full-rate 24 h covariance check (1,728,000 cycles at 20 Hz, f32 stays
 # symmetric PSD and agrees with f64) is #[ignore]d in the debug test build;

@@ -6,10 +6,11 @@
 
 use core::cell::RefCell;
 
+use firmware::app::raw_part;
 use firmware::scc1300::Part;
 use hil_mock::{
     AccelSpi, BodySource, Chance, Generator, GyroSpi, MountedSource, Scc1300, SimClock, SimDelay,
-    TimeSource,
+    TimeSource, SAMPLE_PERIOD_NS,
 };
 use mwd_core::protocol::frame::raw_flags;
 use mwd_core::protocol::{Decoder, FrameEncoder, Payload, RawSample, MAX_WIRE_LEN};
@@ -40,7 +41,7 @@ fn driver_samples_travel_as_frames_and_come_back_in_body_axes() {
     let mut uart = Vec::new();
     let mut truths = Vec::new();
     for n in 0..200u32 {
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         if n == 100 {
             // One corrupted gyro answer on part 2: flagged, not hidden.
             mocks[1].borrow_mut().faults.gyro.miso_parity = Chance::next(1);
@@ -49,7 +50,7 @@ fn driver_samples_travel_as_frames_and_come_back_in_body_axes() {
         let sample = RawSample {
             time_us: clock.now_ns() / 1000,
             sample_counter: n,
-            parts: readings.map(|r| r.raw),
+            parts: readings.map(|r| raw_part(&r)),
         };
         let mut buf = [0u8; MAX_WIRE_LEN];
         let len = encoder.encode(&Payload::Raw(sample), &mut buf).unwrap();

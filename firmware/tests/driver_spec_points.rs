@@ -10,9 +10,9 @@ use core::cell::{Cell, RefCell};
 
 use common::*;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
-use firmware::app::{AcquisitionCycle, FrameQueue};
+use firmware::app::{fault_code, raw_part, AcquisitionCycle, FrameQueue};
 use firmware::scc1300::datasheet::{DparScope, ACCEL_DPAR_SCOPE, ACCEL_SETTLE_MS};
-use firmware::scc1300::{Accel, Error, Gyro, Part, PartReading, Recovery, Slave, Word};
+use firmware::scc1300::{Accel, Error, Gyro, GyroRecovery, Part, PartReading, Slave, Word};
 use hil_mock::{
     AccelSpi, Chance, Constant, Faults, GyroSpi, MockBusError, PhysicalSample, Scc1300, SimClock,
     SimDelay, TimeSource, Window, ACCEL_SETTLE_NS, DEFAULT_DPAR_SCOPE, START_UP_NS,
@@ -111,14 +111,14 @@ fn loop_failure_is_reported_with_reset_seen_after_the_soft_reset() {
         let r = part.sample();
         assert_eq!(r.gyro_error, Some(Error::NotReady));
         let report = part.recover(&mut SimDelay::new(clock), &r).unwrap();
-        assert_eq!(report.gyro, Some(Recovery::SoftReset));
+        assert_eq!(report.gyro, Some(GyroRecovery::SoftReset));
         assert_eq!(mock.borrow().stats().soft_resets, 1);
 
         clock.advance_ms(PERIOD_MS);
         let r = part.sample();
         assert_eq!(r.gyro_error, Some(Error::LoopFailure));
-        assert_ne!(r.raw.flags & raw_flags::RESET_SEEN, 0);
-        assert_eq!(r.raw.flags & raw_flags::GYRO_VALID, 0);
+        assert_ne!(raw_part(&r).flags & raw_flags::RESET_SEEN, 0);
+        assert_eq!(raw_part(&r).flags & raw_flags::GYRO_VALID, 0);
         assert_eq!(r.rate_rad_s(), None);
         assert!(!r.needs_recovery(), "the recovery has been run");
         assert_eq!(r.accel_error, None);
@@ -127,7 +127,7 @@ fn loop_failure_is_reported_with_reset_seen_after_the_soft_reset() {
         clock.advance_ms(PERIOD_MS);
         let r = part.sample();
         assert_eq!((r.gyro_error, r.accel_error), (None, None));
-        assert_eq!(r.raw.flags & raw_flags::RESET_SEEN, 0);
+        assert_eq!(raw_part(&r).flags & raw_flags::RESET_SEEN, 0);
         assert_matches_truth(&r, &mock.borrow_mut().truth());
     });
 }
@@ -170,7 +170,13 @@ fn loop_failure_reaches_the_raw_frame_and_an_event() {
                 _ => None,
             })
             .collect();
-        assert_eq!(codes, [Error::NotReady.code(), Error::LoopFailure.code()]);
+        assert_eq!(
+            codes,
+            [
+                fault_code(&Error::NotReady),
+                fault_code(&Error::LoopFailure)
+            ]
+        );
     });
 }
 
@@ -184,11 +190,11 @@ fn a_transient_s_ok_drop_is_not_a_loop_failure() {
         });
         let r = part.sample();
         let report = part.recover(&mut SimDelay::new(clock), &r).unwrap();
-        assert_eq!(report.gyro, Some(Recovery::Transient));
+        assert_eq!(report.gyro, Some(GyroRecovery::Transient));
         clock.advance_ms(PERIOD_MS);
         let r = part.sample();
         assert_eq!(r.gyro_error, None);
-        assert_eq!(r.raw.flags & raw_flags::RESET_SEEN, 0);
+        assert_eq!(raw_part(&r).flags & raw_flags::RESET_SEEN, 0);
     });
 }
 
@@ -199,15 +205,15 @@ fn a_power_cycled_part_is_not_reported_as_a_gyro_loop_failure() {
         let r = part.sample();
         assert_eq!(r.gyro_error, Some(Error::NotReady));
         assert_eq!(r.accel_error, Some(Error::PowerOnReset));
-        assert_ne!(r.raw.flags & raw_flags::RESET_SEEN, 0, "PORST tells");
+        assert_ne!(raw_part(&r).flags & raw_flags::RESET_SEEN, 0, "PORST tells");
         let report = part.recover(&mut SimDelay::new(clock), &r).unwrap();
         // The gyro was still in its start-up (LOOPF_OK clear): TN92 step 4
         // soft-resets it, but the cause was the power cycle.
-        assert_eq!(report.gyro, Some(Recovery::SoftReset));
+        assert_eq!(report.gyro, Some(GyroRecovery::SoftReset));
         clock.advance_ms(PERIOD_MS);
         let r = part.sample();
         assert_eq!((r.gyro_error, r.accel_error), (None, None));
-        assert_eq!(r.raw.flags & raw_flags::RESET_SEEN, 0);
+        assert_eq!(raw_part(&r).flags & raw_flags::RESET_SEEN, 0);
     });
 }
 
@@ -241,15 +247,15 @@ fn gyro_rates_beyond_the_specified_300_deg_s_are_flagged_saturated() {
         mock.borrow_mut().source_mut().0.rate_rad_s = deg_s.to_radians();
         clock.advance_ms(PERIOD_MS);
         let r = part.sample();
-        assert_eq!(r.raw.gyro_rate, count, "{deg_s} deg/s: count kept");
+        assert_eq!(r.gyro.rate, count, "{deg_s} deg/s: count kept");
         if flagged {
             assert_eq!(r.gyro_error, Some(Error::Saturated(Slave::Gyro)), "{deg_s}");
-            assert_ne!(r.raw.flags & raw_flags::GYRO_SATURATED, 0);
-            assert_eq!(r.raw.flags & raw_flags::GYRO_VALID, 0);
+            assert_ne!(raw_part(&r).flags & raw_flags::GYRO_SATURATED, 0);
+            assert_eq!(raw_part(&r).flags & raw_flags::GYRO_VALID, 0);
             assert_eq!(r.rate_rad_s(), None);
         } else {
             assert_eq!(r.gyro_error, None, "{deg_s}");
-            assert_eq!(r.raw.flags & raw_flags::GYRO_SATURATED, 0);
+            assert_eq!(raw_part(&r).flags & raw_flags::GYRO_SATURATED, 0);
         }
     }
 }
@@ -319,11 +325,11 @@ fn check_acknowledged(what: &str, plan: fn(u32, &mut Faults), error: Error) {
     let (r, acks, next) = sample_with(plan);
     assert_eq!(r.accel_error, Some(error), "{what}");
     assert_ne!(
-        r.raw.flags & raw_flags::ACCEL_SATURATED,
+        raw_part(&r).flags & raw_flags::ACCEL_SATURATED,
         0,
         "{what}: SAT flagged"
     );
-    assert_eq!(r.raw.flags & raw_flags::ACCEL_VALID, 0, "{what}");
+    assert_eq!(raw_part(&r).flags & raw_flags::ACCEL_VALID, 0, "{what}");
     assert_eq!(acks, 1, "{what}: INT_STATUS read once");
     assert_eq!(next.accel_error, None, "{what}: latch cleared");
 }

@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use firmware::scc1300::{Error, PartReading, Recovery, Slave, Word};
+use firmware::scc1300::{Error, GyroRecovery, PartReading, Slave, Word};
 use hil_mock::{Chance, DeadLevel, SimClock, SimDelay, Window};
 
 #[test]
@@ -159,7 +159,7 @@ fn s_ok_drop_is_a_transient() {
         let r = part.sample();
         assert_eq!(r.gyro_error, Some(Error::NotReady));
         let report = part.recover(&mut SimDelay::new(clock), &r).unwrap();
-        assert_eq!(report.gyro, Some(Recovery::Transient));
+        assert_eq!(report.gyro, Some(GyroRecovery::Transient));
         assert_eq!(mock.borrow().stats().soft_resets, 0);
         recovers(clock, mock, part, &PartReading::default());
     });
@@ -172,7 +172,7 @@ fn loop_failure_leads_to_a_soft_reset() {
         let r = part.sample();
         assert_eq!(r.gyro_error, Some(Error::NotReady));
         let report = part.recover(&mut SimDelay::new(clock), &r).unwrap();
-        assert_eq!(report.gyro, Some(Recovery::SoftReset));
+        assert_eq!(report.gyro, Some(GyroRecovery::SoftReset));
         assert_eq!(mock.borrow().stats().soft_resets, 1);
         recovers(clock, mock, part, &PartReading::default());
     });
@@ -185,7 +185,7 @@ fn saturation_and_self_test() {
         mock.borrow_mut().faults.accel_saturated = true;
         let r = part.sample();
         assert_eq!(r.gyro_error, Some(Error::Saturated(Slave::Gyro)));
-        assert_eq!(r.raw.gyro_rate, 8191, "the clipped count is kept");
+        assert_eq!(r.gyro.rate, 8191, "the clipped count is kept");
         assert_eq!(r.accel_error, Some(Error::Saturated(Slave::Accel)));
         assert_eq!(mock.borrow().stats().sat_acknowledged, 2, "start + SAT");
         mock.borrow_mut().faults.gyro_saturated = false;
@@ -206,7 +206,7 @@ fn a_part_that_resets_mid_run_is_restarted() {
         assert_eq!(r.gyro_error, Some(Error::NotReady));
         assert_eq!(r.accel_error, Some(Error::PowerOnReset));
         let report = part.recover(&mut SimDelay::new(clock), &r).unwrap();
-        assert_eq!(report.gyro, Some(Recovery::SoftReset));
+        assert_eq!(report.gyro, Some(GyroRecovery::SoftReset));
         assert!(report.accel_restarted);
         recovers(clock, mock, part, &PartReading::default());
     });

@@ -4,6 +4,10 @@
 
 use core::cell::Cell;
 use embedded_hal::delay::DelayNs;
+use mwd_core::timing::SAMPLE_PERIOD_US;
+
+/// The probe's sample period on the simulated clock.
+pub const SAMPLE_PERIOD_NS: u64 = SAMPLE_PERIOD_US * 1_000;
 
 /// Where the part reads the time, in nanoseconds since its power-up.
 pub trait TimeSource {
@@ -29,10 +33,6 @@ impl SimClock {
 
     pub fn advance_ms(&self, ms: u64) {
         self.advance_ns(ms.saturating_mul(1_000_000));
-    }
-
-    pub fn set_ns(&self, ns: u64) {
-        self.now_ns.set(ns);
     }
 }
 

@@ -27,6 +27,14 @@ impl spi::Error for MockBusError {
     }
 }
 
+impl core::fmt::Display for MockBusError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("the simulated SCC1300 part was already in use (re-entrant SPI transaction)")
+    }
+}
+
+impl core::error::Error for MockBusError {}
+
 #[derive(Clone, Copy)]
 enum Which {
     Gyro,
@@ -237,6 +245,19 @@ mod tests {
             "STATUS: latched S_OK clear, LOOPF_OK set"
         );
         assert_eq!(part.borrow().stats().gyro_mosi_errors, 0);
+    }
+
+    #[test]
+    fn a_part_in_use_is_a_bus_error_that_says_so() {
+        extern crate std;
+        use std::string::ToString;
+        let clock = SimClock::new();
+        let part = RefCell::new(Scc1300::new(&clock, Constant::default(), 1));
+        let _held = part.borrow_mut();
+        let mut buf = [0x08, 0x00];
+        let error = AccelSpi::new(&part).transfer_in_place(&mut buf);
+        assert_eq!(error, Err(MockBusError));
+        assert!(MockBusError.to_string().contains("already in use"));
     }
 
     #[test]

@@ -8,15 +8,14 @@
 //! within one sample period sees the same value, and a run repeats exactly
 //! on the host and on the target (libm throughout).
 
-use mwd_core::conventions::{quat_from_euler, Euler};
+use mwd_core::conventions::{quat_from_euler, Euler, DEG};
 use mwd_core::earth::{earth_rate_n, gravity_n, Position};
 use mwd_core::sensor_noise::{rate_from_deg_per_hour, ImuNoise};
 use mwd_core::sensor_units::STANDARD_GRAVITY;
+use mwd_core::timing::SAMPLE_RATE_HZ;
 
+use crate::clock::SAMPLE_PERIOD_NS;
 use crate::source::{BodySample, BodySource};
-
-/// The sample period the noise is drawn for (the probe's 20 Hz).
-const PERIOD_NS: u64 = 50_000_000;
 
 /// A still probe: truth, errors and noise.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,13 +50,12 @@ impl StillProbe {
     /// VRW 0.052 m/s/sqrt(h)), and residual biases of one budget sigma
     /// (2.1 deg/h, 1 mg) with fixed signs.
     pub fn paper_test(seed: u64) -> Self {
-        let deg = core::f64::consts::PI / 180.0;
         let noise = ImuNoise::scc1300();
-        let per_sample = |density: f64| (density * libm::sqrt(20.0)) as f32;
+        let per_sample = |density: f64| (density * libm::sqrt(SAMPLE_RATE_HZ)) as f32;
         let gyro_bias = rate_from_deg_per_hour(2.1) as f32;
         let accel_bias = (1e-3 * STANDARD_GRAVITY) as f32;
         Self {
-            attitude: Euler::new(-0.8061 * deg, 0.5371 * deg, -150.9636 * deg),
+            attitude: Euler::new(-0.8061 * DEG, 0.5371 * DEG, -150.9636 * DEG),
             position: Position::paper_site(),
             gyro_bias_rad_s: [gyro_bias, 0.0, -gyro_bias],
             accel_bias_m_s2: [accel_bias, -accel_bias, 0.5 * accel_bias],
@@ -90,7 +88,7 @@ impl StillProbe {
 
 impl BodySource for StillProbe {
     fn body_sample(&mut self, time_ns: u64) -> BodySample {
-        let k = time_ns / PERIOD_NS;
+        let k = time_ns / SAMPLE_PERIOD_NS;
         if let Some((period, sample)) = self.last {
             if period == k {
                 return sample;
@@ -153,14 +151,14 @@ mod tests {
     #[test]
     fn noise_is_repeatable_per_period_and_has_the_stated_spread() {
         let mut probe = StillProbe::paper_test(7);
-        let a = probe.body_sample(3 * PERIOD_NS);
-        let b = probe.body_sample(3 * PERIOD_NS + PERIOD_NS / 2);
+        let a = probe.body_sample(3 * SAMPLE_PERIOD_NS);
+        let b = probe.body_sample(3 * SAMPLE_PERIOD_NS + SAMPLE_PERIOD_NS / 2);
         assert_eq!(a, b, "one period, one sample");
         let (rate, _) = probe.true_body();
         let n = 4000;
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
         for k in 0..n {
-            let s = probe.body_sample(k * PERIOD_NS);
+            let s = probe.body_sample(k * SAMPLE_PERIOD_NS);
             let e = f64::from(s.rate_rad_s[0]) - rate[0] - f64::from(probe.gyro_bias_rad_s[0]);
             sum += e;
             sum_sq += e * e;

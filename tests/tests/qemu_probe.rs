@@ -299,7 +299,7 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     // reset event says what the recovery did: 0 for part 1's transient
     // S_OK drop, the loop-failure code for part 0, whose gyro came back
     // from the power cycle with its loop off and was soft-reset.
-    let loop_failure = firmware::scc1300::Error::LoopFailure.code();
+    let loop_failure = firmware::app::fault_code(&firmware::scc1300::Error::LoopFailure);
     for (part, at_s, code) in [(1, 20, 0), (0, 30, loop_failure)] {
         assert!(
             events.iter().any(|e| e.kind == EventKind::SensorReset

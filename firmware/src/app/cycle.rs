@@ -9,12 +9,12 @@
 //! with no valid flags, so the sample counter and the 20 Hz rate stay
 //! intact and the host sees exactly which samples were skipped.
 
-use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
+use mwd_core::protocol::{Payload, RawSample};
+use mwd_core::timing::sample_time_us;
 
 use super::frame_queue::FrameQueue;
-use crate::scc1300::{Error, PartReading};
-
-use mwd_core::timing::SAMPLE_PERIOD_US;
+use super::sensor_wire::{raw_part, sensor_fault_event};
+use crate::scc1300::PartReading;
 
 /// What one cycle asks of its caller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -50,12 +50,6 @@ impl AcquisitionCycle {
         }
     }
 
-    /// Time stamp of sample `n` (the timer's n-th period since streaming
-    /// started); the timer, not the code's progress, fixes the instant.
-    pub fn sample_time_us(n: u32) -> u64 {
-        u64::from(n) * SAMPLE_PERIOD_US
-    }
-
     /// Runs one cycle: `readings` is `None` when the parts are away for
     /// recovery (the sample is skipped). Queues the raw frame and one event
     /// frame per faulty slave.
@@ -66,7 +60,8 @@ impl AcquisitionCycle {
     ) -> CycleReport {
         let n = self.samples;
         self.samples = self.samples.wrapping_add(1);
-        let time_us = Self::sample_time_us(n);
+        // The timer, not the code's progress, fixes the sample's instant.
+        let time_us = sample_time_us(n);
         let mut report = CycleReport {
             sample: RawSample {
                 time_us,
@@ -80,7 +75,7 @@ impl AcquisitionCycle {
             queue.push(&Payload::Raw(report.sample));
             return report;
         };
-        report.sample.parts = readings.map(|r| r.raw);
+        report.sample.parts = readings.map(|r| raw_part(&r));
         queue.push(&Payload::Raw(report.sample));
         for (index, reading) in readings.iter().enumerate() {
             for error in [reading.gyro_error, reading.accel_error]
@@ -89,7 +84,7 @@ impl AcquisitionCycle {
             {
                 report.faults += 1;
                 let count = self.count_fault(index);
-                queue.push(&fault_event(time_us, index, &error, count));
+                queue.push(&sensor_fault_event(time_us, index as u8, &error, count));
             }
             if let Some(flag) = report.recovery_needed.get_mut(index) {
                 *flag = reading.needs_recovery();
@@ -124,31 +119,20 @@ impl AcquisitionCycle {
     }
 }
 
-/// The event frame of one sensor fault: the driver's error code and the
-/// part's running fault count.
-pub fn fault_event(time_us: u64, part: usize, error: &Error, count: u32) -> Payload {
-    Payload::Event(Event {
-        time_us,
-        kind: EventKind::SensorFault,
-        part: part as u8,
-        code: error.code(),
-        value: count,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     extern crate std;
     use super::*;
-    use crate::scc1300::Slave;
+    use crate::app::sensor_wire::fault_code;
+    use crate::scc1300::{Error, Slave};
     use mwd_core::protocol::frame::raw_flags;
-    use mwd_core::protocol::{Decoder, Frame};
+    use mwd_core::protocol::{Decoder, EventKind, Frame};
+    use mwd_core::timing::SAMPLE_PERIOD_US;
     use std::vec::Vec;
 
+    /// A reading with both slaves valid (no error, zero counts).
     fn good() -> PartReading {
-        let mut r = PartReading::default();
-        r.raw.flags = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
-        r
+        PartReading::default()
     }
 
     fn frames(queue: &mut FrameQueue<1024>) -> Vec<Frame> {
@@ -168,7 +152,10 @@ mod tests {
         let report = cycle.run(Some([good(), good()]), &mut queue);
         assert!(!report.any_recovery());
         assert_eq!(report.faults, 0);
-        assert_eq!(report.sample.parts[1], good().raw);
+        assert_eq!(
+            report.sample.parts[1].flags,
+            raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID
+        );
 
         let mut faulty = good();
         faulty.gyro_error = Some(Error::NotReady);
@@ -195,7 +182,7 @@ mod tests {
         assert_eq!((e.kind, e.part), (EventKind::SensorFault, 1));
         assert_eq!(
             (e.code, e.value),
-            (Error::Saturated(Slave::Accel).code(), 2)
+            (fault_code(&Error::Saturated(Slave::Accel)), 2)
         );
         assert_eq!(e.time_us, SAMPLE_PERIOD_US);
         let Payload::Raw(skipped) = got[4].payload else {

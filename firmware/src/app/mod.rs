@@ -1,17 +1,24 @@
 //! The probe's application core, independent of the board: what happens in
-//! each 20 Hz cycle, how frames wait for the UART, and how sensor faults
-//! become event frames. Pure code (no registers, no interrupts, no heap), so
-//! the host tests it and every board binary runs the same logic; a board
-//! only supplies the timer interrupt, the UART and the sensors' SPI.
+//! each 20 Hz cycle, how frames wait for the UART, how the driver's readings
+//! and faults become frames, and the glue between the board's contexts.
+//! Pure code (no registers, no heap), so the host tests it and every board
+//! binary runs the same logic; a board only supplies the timer interrupt,
+//! its UART ([`Transmitter`]), the sensors' SPI and the watchdog.
 
 pub mod cycle;
 pub mod frame_queue;
 pub mod probe;
 pub mod sample_inbox;
+pub mod sensor_wire;
+pub mod shared;
 pub mod start_up;
+pub mod transmitter;
 
 pub use cycle::{AcquisitionCycle, CycleReport};
 pub use frame_queue::{FrameQueue, TX_QUEUE_LEN};
-pub use probe::{ProbeState, Recovery, Sensors};
+pub use probe::{ProbeState, RecoveryJob, Sensors};
 pub use sample_inbox::{SampleInbox, NAV_INBOX_LEN};
-pub use start_up::{reset_event_code, start_parts, START_ATTEMPTS};
+pub use sensor_wire::{fault_code, raw_part, reset_event_code, sensor_fault_event};
+pub use shared::{Shared, SharedProbe, FIRMWARE_VERSION, WATCHDOG_TIMEOUT_MS};
+pub use start_up::{start_parts, START_ATTEMPTS};
+pub use transmitter::Transmitter;

@@ -1,19 +1,21 @@
-//! What the probe's contexts share, the same on every board: the two parts
-//! (while the acquisition has them), the cycle's bookkeeping, the transmit
-//! queue and the navigation inbox. A board keeps one [`ProbeState`] behind
-//! a critical section, calls [`ProbeState::acquire`] from its 20 Hz timer
-//! interrupt and runs a [`Recovery`] from its main loop; it adds only its
-//! timer, UART and watchdog.
+//! The probe's state, the same on every board: the two parts (while the
+//! acquisition has them), the cycle's bookkeeping, the transmit queue and
+//! the navigation inbox. A board keeps it inside a
+//! [`SharedProbe`](super::SharedProbe) behind a critical section, calls
+//! [`ProbeState::acquire`] from its 20 Hz timer interrupt and runs a
+//! [`RecoveryJob`] from its main loop; it adds only its timer, UART and
+//! watchdog.
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
 use mwd_core::protocol::frame::NO_PART;
-use mwd_core::protocol::{Event, EventKind, Payload};
+use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
+use mwd_core::timing::sample_time_us;
 
 use super::cycle::AcquisitionCycle;
 use super::frame_queue::{FrameQueue, TX_QUEUE_LEN};
 use super::sample_inbox::{SampleInbox, NAV_INBOX_LEN};
-use super::start_up::reset_event_code;
+use super::sensor_wire::reset_event_code;
 use crate::scc1300::{Part, PartReading};
 
 /// The probe's two parts.
@@ -21,14 +23,14 @@ pub type Sensors<G, A> = [Part<G, A>; 2];
 
 /// Parts taken from the acquisition for their blocking recovery, with the
 /// readings that asked for it.
-pub struct Recovery<G, A> {
+pub struct RecoveryJob<G, A> {
     sensors: Sensors<G, A>,
     readings: [PartReading; 2],
     /// Samples skipped before the recovery began (for the Resync event).
     skipped_before: u32,
 }
 
-impl<G: SpiDevice, A: SpiDevice> Recovery<G, A> {
+impl<G: SpiDevice, A: SpiDevice> RecoveryJob<G, A> {
     /// Runs the recovery of each part that asked for it (this waits: call
     /// it outside any critical section); `report` gets one SensorReset event
     /// per part, stamped by the caller.
@@ -44,15 +46,15 @@ impl<G: SpiDevice, A: SpiDevice> Recovery<G, A> {
 /// The shared state of one probe.
 pub struct ProbeState<G, A> {
     /// False until the parts are started: the timer then does nothing.
-    pub streaming: bool,
+    streaming: bool,
     /// The parts, while they are the acquisition's (None during recovery).
-    pub sensors: Option<Sensors<G, A>>,
+    sensors: Option<Sensors<G, A>>,
     /// Parts waiting for the main loop to recover them.
-    pub recovery: Option<Recovery<G, A>>,
-    pub cycle: AcquisitionCycle,
-    pub queue: FrameQueue<TX_QUEUE_LEN>,
+    recovery: Option<RecoveryJob<G, A>>,
+    cycle: AcquisitionCycle,
+    queue: FrameQueue<TX_QUEUE_LEN>,
     /// Samples from the acquisition to the navigation.
-    pub nav_inbox: SampleInbox<NAV_INBOX_LEN>,
+    nav_inbox: SampleInbox<NAV_INBOX_LEN>,
 }
 
 impl<G, A> ProbeState<G, A> {
@@ -67,10 +69,56 @@ impl<G, A> ProbeState<G, A> {
         }
     }
 
+    /// True once the parts are started and the timer samples them.
+    pub fn is_streaming(&self) -> bool {
+        self.streaming
+    }
+
+    /// True while the acquisition has the parts (false during a recovery).
+    pub fn has_parts(&self) -> bool {
+        self.sensors.is_some()
+    }
+
+    /// The acquisition's counters (samples, skipped, faults).
+    pub fn cycle(&self) -> &AcquisitionCycle {
+        &self.cycle
+    }
+
+    /// The transmit queue, for its counters (queued, dropped, waiting).
+    pub fn queue(&self) -> &FrameQueue<TX_QUEUE_LEN> {
+        &self.queue
+    }
+
+    /// The transmit queue, for the board's transmitter to drain.
+    pub(super) fn queue_mut(&mut self) -> &mut FrameQueue<TX_QUEUE_LEN> {
+        &mut self.queue
+    }
+
+    /// The navigation inbox, for its counters.
+    pub fn nav_inbox(&self) -> &SampleInbox<NAV_INBOX_LEN> {
+        &self.nav_inbox
+    }
+
+    /// Numbers, encodes and queues one frame for the UART; false (and
+    /// counted) when the queue had no room.
+    pub fn push(&mut self, payload: &Payload) -> bool {
+        self.queue.push(payload)
+    }
+
+    /// The next byte for the UART.
+    pub fn next_byte(&mut self) -> Option<u8> {
+        self.queue.pop()
+    }
+
+    /// The oldest sample waiting for the navigation.
+    pub fn next_sample(&mut self) -> Option<RawSample> {
+        self.nav_inbox.pop()
+    }
+
     /// An event frame stamped with the time of the next sample.
     pub fn event(&self, kind: EventKind, part: u8, code: u16, value: u32) -> Payload {
         Payload::Event(Event {
-            time_us: AcquisitionCycle::sample_time_us(self.cycle.samples()),
+            time_us: sample_time_us(self.cycle.samples()),
             kind,
             part,
             code,
@@ -85,13 +133,13 @@ impl<G, A> ProbeState<G, A> {
     }
 
     /// The parts that asked for recovery, for the main loop.
-    pub fn take_recovery(&mut self) -> Option<Recovery<G, A>> {
+    pub fn take_recovery(&mut self) -> Option<RecoveryJob<G, A>> {
         self.recovery.take()
     }
 
     /// The recovered parts go back to the acquisition; returns the Resync
     /// event, which says how many samples the recovery cost.
-    pub fn end_recovery(&mut self, job: Recovery<G, A>) -> Payload {
+    pub fn end_recovery(&mut self, job: RecoveryJob<G, A>) -> Payload {
         self.sensors = Some(job.sensors);
         let skipped = self.cycle.skipped().saturating_sub(job.skipped_before);
         self.event(EventKind::Resync, NO_PART, 0, skipped)
@@ -115,7 +163,7 @@ impl<G: SpiDevice, A: SpiDevice> ProbeState<G, A> {
         self.nav_inbox.push(report.sample);
         if report.any_recovery() {
             if let (Some(readings), Some(sensors)) = (readings, self.sensors.take()) {
-                self.recovery = Some(Recovery {
+                self.recovery = Some(RecoveryJob {
                     sensors,
                     readings,
                     skipped_before: self.cycle.skipped(),
@@ -137,7 +185,10 @@ mod tests {
     use super::*;
     use crate::app::start_parts;
     use core::cell::RefCell;
-    use hil_mock::{AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, Window};
+    use hil_mock::{
+        AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, Window,
+        SAMPLE_PERIOD_NS,
+    };
     use mwd_core::protocol::Decoder;
     use std::vec::Vec;
 
@@ -151,13 +202,13 @@ mod tests {
         let mut delay = SimDelay::new(&clock);
         let mut probe = ProbeState::new();
         start_parts(&mut parts, &mut delay, |p| {
-            probe.queue.push(p);
+            probe.push(p);
         });
         probe.acquire();
-        assert!(probe.nav_inbox.is_empty(), "not streaming yet");
+        assert!(probe.nav_inbox().is_empty(), "not streaming yet");
         probe.start_streaming(parts);
         for _ in 0..10 {
-            clock.advance_ms(50);
+            clock.advance_ns(SAMPLE_PERIOD_NS);
             probe.acquire();
         }
         assert!(probe.take_recovery().is_none());
@@ -169,32 +220,32 @@ mod tests {
             start_ns: now,
             end_ns: now + 100_000_000,
         });
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire();
         let Some(mut job) = probe.take_recovery() else {
             panic!("part 1 asks for recovery")
         };
-        assert!(probe.sensors.is_none());
-        clock.advance_ms(50);
+        assert!(!probe.has_parts());
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire(); // a sample while the parts are away
         let mut resets = Vec::new();
         job.run(&mut delay, |part, code| resets.push((part, code)));
         assert_eq!(resets, [(1, 0)], "a transient: the part came back");
         let resync = probe.end_recovery(job);
         assert!(matches!(resync, Payload::Event(e) if e.kind == EventKind::Resync && e.value == 1));
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire();
-        assert!(probe.sensors.is_some() && probe.take_recovery().is_none());
+        assert!(probe.has_parts() && probe.take_recovery().is_none());
 
         // 13 raw samples reached the navigation and the UART, in order.
         let mut counters = Vec::new();
-        while let Some(sample) = probe.nav_inbox.pop() {
+        while let Some(sample) = probe.next_sample() {
             counters.push(sample.sample_counter);
         }
         assert_eq!(counters, (0..13).collect::<Vec<u32>>());
         let mut decoder = Decoder::new();
         let mut raw = 0;
-        while let Some(b) = probe.queue.pop() {
+        while let Some(b) = probe.next_byte() {
             decoder.feed(&[b], |f| {
                 raw += usize::from(matches!(f.payload, Payload::Raw(_)))
             });

@@ -6,9 +6,10 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
-use mwd_core::protocol::{Event, EventKind, Payload};
+use mwd_core::protocol::Payload;
 
-use crate::scc1300::{Error, Part, Recovery, RecoveryReport};
+use super::sensor_wire::sensor_fault_event;
+use crate::scc1300::{Error, Part};
 
 /// Start-up attempts per part before giving up on it.
 pub const START_ATTEMPTS: u32 = 3;
@@ -39,31 +40,12 @@ pub fn start_parts<G: SpiDevice, A: SpiDevice>(
                 }
                 Err(error) => {
                     *result = Some(error);
-                    report(&Payload::Event(Event {
-                        time_us: 0,
-                        kind: EventKind::SensorFault,
-                        part: index as u8,
-                        code: error.code(),
-                        value: attempt,
-                    }));
+                    report(&sensor_fault_event(0, index as u8, &error, attempt));
                 }
             }
         }
     }
     outcome
-}
-
-/// The `code` of the SensorReset event that reports a recovery: 0 when the
-/// part came back by itself (a transient S_OK drop) or only its
-/// accelerometer was restarted, the loop-failure code when the gyro had to
-/// be soft-reset (its loop was off: a loop failure, or the start-up after a
-/// power cycle), and the error's own code when the recovery failed.
-pub fn reset_event_code(outcome: &Result<RecoveryReport, Error>) -> u16 {
-    match outcome {
-        Ok(report) if report.gyro == Some(Recovery::SoftReset) => Error::LoopFailure.code(),
-        Ok(_) => 0,
-        Err(error) => error.code(),
-    }
 }
 
 #[cfg(test)]
@@ -72,28 +54,11 @@ mod tests {
     use super::*;
     use crate::app::FrameQueue;
     use core::cell::RefCell;
-    use hil_mock::{AccelSpi, Constant, DeadLevel, GyroSpi, Scc1300, SimClock, SimDelay};
+    use hil_mock::{
+        AccelSpi, Constant, DeadLevel, GyroSpi, Scc1300, SimClock, SimDelay, SAMPLE_PERIOD_NS,
+    };
     use mwd_core::protocol::Decoder;
     use std::vec::Vec;
-
-    #[test]
-    fn reset_event_codes_tell_transient_soft_reset_and_failure_apart() {
-        let transient = RecoveryReport {
-            gyro: Some(Recovery::Transient),
-            accel_restarted: true,
-        };
-        let soft_reset = RecoveryReport {
-            gyro: Some(Recovery::SoftReset),
-            accel_restarted: false,
-        };
-        assert_eq!(reset_event_code(&Ok(transient)), 0);
-        assert_eq!(reset_event_code(&Ok(soft_reset)), Error::LoopFailure.code());
-        assert_eq!(
-            reset_event_code(&Err(Error::NotReady)),
-            Error::NotReady.code()
-        );
-        assert_ne!(Error::LoopFailure.code(), 0);
-    }
 
     #[test]
     fn a_dead_part_is_retried_reported_and_the_other_starts() {
@@ -123,7 +88,7 @@ mod tests {
             assert_eq!((e.part, e.value), (1, attempt));
         }
         // The good part samples cleanly after its start-up.
-        clock.advance_ms(50);
+        clock.advance_ns(SAMPLE_PERIOD_NS);
         let reading = parts[0].sample();
         assert_eq!((reading.gyro_error, reading.accel_error), (None, None));
     }

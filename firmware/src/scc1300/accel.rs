@@ -17,7 +17,7 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Error as _, SpiDevice};
-use mwd_core::sensor_units::{self, ACCEL_TEMPERATURE};
+use mwd_core::sensor_units;
 
 use super::datasheet::{accel_reg, accel_status, DparScope, ACCEL_DPAR_SCOPE, ACCEL_SETTLE_MS};
 use super::error::{Error, Slave, Word};
@@ -213,19 +213,6 @@ impl<SPI: SpiDevice> Accel<SPI> {
             xyz: [pair(4), pair(2), pair(0)],
             temp: sensor_units::word_to_count(u16::from_be_bytes([temp[0], temp[1]])),
         })
-    }
-
-    /// Specific force along the part's X, Y, Z in m/s^2.
-    pub fn read_m_s2(&mut self) -> Result<[f32; 3], Error> {
-        self.read_counts()
-            .map(|c| c.xyz.map(sensor_units::accel_count_to_m_s2))
-    }
-
-    /// Temperature in degrees Celsius (formula UNVERIFIED, see
-    /// `sensor_units::ACCEL_TEMPERATURE`); costs a full sample read.
-    pub fn read_temperature_degc(&mut self) -> Result<f32, Error> {
-        self.read_counts()
-            .map(|c| ACCEL_TEMPERATURE.count_to_degc(c.temp))
     }
 }
 

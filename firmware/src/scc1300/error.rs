@@ -1,8 +1,10 @@
 //! What can go wrong on the sensor bus, told apart so the firmware can
-//! count, flag and recover (design rule: no panics on data).
+//! count, flag and recover (design rule: no panics on data), and told in
+//! a sentence for logs.
+
+use core::fmt;
 
 use embedded_hal::spi::ErrorKind;
-use mwd_core::protocol::frame::{raw_flags, Event, EventKind};
 
 /// Which slave of a part an error concerns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -60,94 +62,93 @@ impl Error {
     pub fn needs_recovery(&self) -> bool {
         matches!(self, Error::NotReady | Error::PowerOnReset)
     }
+}
 
-    /// The raw-sample flag bit this error sets.
-    pub fn raw_flag(&self) -> u16 {
-        match self {
-            Error::Bus(..) | Error::NoResponse(_) | Error::BadStatus => raw_flags::NO_RESPONSE,
-            Error::Parity(..) => raw_flags::PARITY_ERROR,
-            Error::NotReady => 0,
-            Error::LoopFailure | Error::PowerOnReset => raw_flags::RESET_SEEN,
-            Error::Saturated(Slave::Gyro) => raw_flags::GYRO_SATURATED,
-            Error::Saturated(Slave::Accel) => raw_flags::ACCEL_SATURATED,
-            Error::SelfTest => raw_flags::SELF_TEST_FAILED,
-            Error::FrameError => raw_flags::ACCEL_FRAME_ERROR,
-        }
+impl fmt::Display for Slave {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Slave::Gyro => "gyro",
+            Slave::Accel => "accelerometer",
+        })
     }
+}
 
-    /// A stable number for event frames (`Event::code` of a sensor fault).
-    pub fn code(&self) -> u16 {
-        let slave = |s: &Slave| match s {
-            Slave::Gyro => 0,
-            Slave::Accel => 0x100,
-        };
+impl fmt::Display for Word {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Word::Status => "status word",
+            Word::Data => "data",
+        })
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Bus(s, _) => 1 | slave(s),
-            Error::NoResponse(s) => 2 | slave(s),
-            Error::BadStatus => 3 | 0x100,
-            Error::Parity(s, Word::Status) => 4 | slave(s),
-            Error::Parity(s, Word::Data) => 5 | slave(s),
-            Error::NotReady => 6,
-            Error::LoopFailure => 7,
-            Error::Saturated(s) => 8 | slave(s),
-            Error::SelfTest => 9 | 0x100,
-            Error::FrameError => 10 | 0x100,
-            Error::PowerOnReset => 11 | 0x100,
+            Error::Bus(slave, kind) => {
+                write!(f, "the SPI peripheral failed on the {slave}'s chip select: {kind}")
+            }
+            Error::NoResponse(slave) => write!(
+                f,
+                "the {slave} did not answer (MISO all zeros or all ones: dead chip select or no part)"
+            ),
+            Error::BadStatus => f.write_str(
+                "the accelerometer's status byte lacks its fixed 0 1 bits (stuck MISO bit or another device)",
+            ),
+            Error::Parity(slave, word) => {
+                write!(f, "the {slave}'s MISO {word} failed its odd-parity check")
+            }
+            Error::NotReady => f.write_str(
+                "the gyro's S_OK is clear: its output is not valid (start-up or a transient)",
+            ),
+            Error::LoopFailure => f.write_str(
+                "the gyro's LOOPF_OK was clear (STATUS register): it was soft-reset and restarted",
+            ),
+            Error::Saturated(Slave::Gyro) => {
+                f.write_str("the gyro's rate (RATE_X register) is beyond the specified +-300 deg/s")
+            }
+            Error::Saturated(Slave::Accel) => f.write_str(
+                "the accelerometer's output saturated (SAT, acknowledged through INT_STATUS)",
+            ),
+            Error::SelfTest => {
+                f.write_str("the accelerometer reported a self-test or memory checksum failure (ST)")
+            }
+            Error::FrameError => {
+                f.write_str("the accelerometer received a bad frame from the driver (FRME)")
+            }
+            Error::PowerOnReset => {
+                f.write_str("the accelerometer went through a power-on reset (PORST)")
+            }
         }
     }
 }
 
-impl Error {
-    /// The sensor-fault event frame that reports this error for part
-    /// `part` (0 or 1), with `count` occurrences since the last report.
-    pub fn to_event(&self, part: u8, time_us: u64, count: u32) -> Event {
-        Event {
-            time_us,
-            kind: EventKind::SensorFault,
-            part,
-            code: self.code(),
-            value: count,
-        }
-    }
-}
+impl core::error::Error for Error {}
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn codes_are_distinct() {
-        let all = [
-            Error::Bus(Slave::Gyro, ErrorKind::Other),
-            Error::Bus(Slave::Accel, ErrorKind::Other),
-            Error::NoResponse(Slave::Gyro),
-            Error::NoResponse(Slave::Accel),
-            Error::BadStatus,
-            Error::Parity(Slave::Gyro, Word::Status),
-            Error::Parity(Slave::Gyro, Word::Data),
-            Error::Parity(Slave::Accel, Word::Data),
-            Error::NotReady,
-            Error::LoopFailure,
-            Error::Saturated(Slave::Gyro),
-            Error::Saturated(Slave::Accel),
-            Error::SelfTest,
-            Error::FrameError,
-            Error::PowerOnReset,
-        ];
-        for (i, a) in all.iter().enumerate() {
-            for b in &all[i + 1..] {
-                assert_ne!(a.code(), b.code(), "{a:?} vs {b:?}");
-            }
-        }
-        let e = Error::SelfTest.to_event(1, 42, 3);
-        assert_eq!(
-            (e.kind, e.part, e.code, e.value),
-            (EventKind::SensorFault, 1, 0x109, 3)
-        );
+    fn recovery_is_asked_for_by_not_ready_and_power_on_reset_only() {
         assert!(Error::PowerOnReset.needs_recovery());
         assert!(Error::NotReady.needs_recovery());
         assert!(!Error::LoopFailure.needs_recovery());
-        assert_eq!(Error::LoopFailure.raw_flag(), raw_flags::RESET_SEEN);
         assert!(!Error::Parity(Slave::Gyro, Word::Data).needs_recovery());
+    }
+
+    #[test]
+    fn errors_read_as_sentences_naming_the_slave_and_word() {
+        extern crate std;
+        use std::string::ToString;
+        let text = Error::Parity(Slave::Gyro, Word::Status).to_string();
+        assert_eq!(
+            text,
+            "the gyro's MISO status word failed its odd-parity check"
+        );
+        let text = Error::Bus(Slave::Accel, ErrorKind::ModeFault).to_string();
+        assert!(text.contains("accelerometer's chip select"), "{text}");
+        let as_error: &dyn core::error::Error = &Error::PowerOnReset;
+        assert!(as_error.to_string().contains("PORST"));
     }
 }

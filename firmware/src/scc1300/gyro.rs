@@ -3,7 +3,7 @@
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Error as _, SpiDevice};
-use mwd_core::sensor_units::{self, GYRO_TEMPERATURE};
+use mwd_core::sensor_units;
 
 use super::datasheet::{
     gyro_reg, GYRO_LOOPF_OK, GYRO_RECHECK_WAIT_MS, GYRO_SOFT_RESET_DATA, GYRO_S_OK,
@@ -31,9 +31,17 @@ pub struct GyroStatus {
     pub s_ok_now: bool,
 }
 
+/// The gyro's half of a part's sample, in counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct GyroCounts {
+    /// Rate about the part's X axis (18 LSB per deg/s).
+    pub rate: i16,
+    pub temp: i16,
+}
+
 /// How a supervision run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Recovery {
+pub enum GyroRecovery {
     /// S_OK was back at the recheck: a transient.
     Transient,
     /// LOOPF_OK was clear: soft reset and a full start-up, now S_OK again.
@@ -125,21 +133,8 @@ impl<SPI: SpiDevice> Gyro<SPI> {
         Ok(count)
     }
 
-    /// Rate about the part's X axis in rad/s.
-    pub fn read_rate_rad_s(&mut self) -> Result<f32, Error> {
-        self.read_rate_count()
-            .map(sensor_units::gyro_count_to_rad_s)
-    }
-
     pub fn read_temperature_count(&mut self) -> Result<i16, Error> {
         self.read_count(gyro_reg::TEMP)
-    }
-
-    /// Temperature in degrees Celsius (formula UNVERIFIED, see
-    /// `sensor_units::GYRO_TEMPERATURE`).
-    pub fn read_temperature_degc(&mut self) -> Result<f32, Error> {
-        self.read_temperature_count()
-            .map(|c| GYRO_TEMPERATURE.count_to_degc(c))
     }
 
     /// Reads STATUS (0x08); reading clears its latched flags [TN92].
@@ -179,7 +174,7 @@ impl<SPI: SpiDevice> Gyro<SPI> {
     /// start-up. Blocks for 60 ms (860+ ms with a reset): run it outside
     /// the 20 Hz acquisition interrupt. A loop failure is remembered for
     /// the next sample ([`Gyro::take_loop_failure`]).
-    pub fn supervise(&mut self, delay: &mut impl DelayNs) -> Result<Recovery, Error> {
+    pub fn supervise(&mut self, delay: &mut impl DelayNs) -> Result<GyroRecovery, Error> {
         self.read_status()?;
         delay.delay_ms(GYRO_RECHECK_WAIT_MS);
         let status = self.read_status()?;
@@ -189,11 +184,11 @@ impl<SPI: SpiDevice> Gyro<SPI> {
             self.loop_failure_pending = true;
             delay.delay_ms(POWER_UP_WAIT_MS);
             self.start()?;
-            return Ok(Recovery::SoftReset);
+            return Ok(GyroRecovery::SoftReset);
         }
         // The latched bit may still remember the drop; judge by the live one.
         if status.s_ok_now {
-            Ok(Recovery::Transient)
+            Ok(GyroRecovery::Transient)
         } else {
             Err(Error::NotReady)
         }

@@ -1,25 +1,38 @@
 //! One SCC1300 part (gyro + accelerometer): start-up, one 20 Hz sample
 //! that never blocks and never fails as a whole (each slave's error is
 //! kept and flagged), and the recovery that follows a flagged sample.
+//!
+//! The readings are the driver's own (counts and what the part reported);
+//! how they go on the wire is the application's business
+//! (`crate::app::sensor_wire`).
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
-use mwd_core::protocol::frame::{raw_flags, RawPart};
-use mwd_core::sensor_units;
+use mwd_core::sensor_units::{self, gyro_count_is_saturated};
 
-use super::accel::Accel;
+use super::accel::{Accel, AccelCounts};
 use super::datasheet::{gyro_reg, POWER_UP_WAIT_MS};
 use super::error::{Error, Slave};
-use super::gyro::{Gyro, Recovery};
-use mwd_core::sensor_units::gyro_count_is_saturated;
+use super::gyro::{Gyro, GyroCounts, GyroRecovery};
 
-/// One sample of a part: counts and flags ready for the raw-sample frame,
-/// plus the error of each slave, if any. Counts of a slave with an error
-/// are 0 unless the error left them meaningful (saturation keeps the
-/// clipped gyro count).
+/// One sample of a part: the counts of both slaves, what the part told
+/// besides, and the error of each slave, if any. Counts of a slave with an
+/// error are 0 unless the error left them meaningful (saturation keeps the
+/// clipped gyro count; a failed temperature read keeps the gyro rate).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct PartReading {
-    pub raw: RawPart,
+    pub gyro: GyroCounts,
+    pub accel: AccelCounts,
+    /// S_OK of the gyro's rate answer: its output was valid then, even if
+    /// the sample failed after (saturation, the temperature read).
+    pub gyro_s_ok: bool,
+    /// This sample reports the gyro's soft reset by the recovery before it
+    /// (a loop failure, TN92 step 4), also when `gyro_error` names a newer
+    /// error that asks for recovery again.
+    pub gyro_was_reset: bool,
+    /// A frame of this sample showed the accelerometer's SAT (acknowledged
+    /// since), also when `accel_error` names another flag that came with it.
+    pub accel_saturation_seen: bool,
     pub gyro_error: Option<Error>,
     pub accel_error: Option<Error>,
 }
@@ -27,12 +40,12 @@ pub struct PartReading {
 impl PartReading {
     /// Rate about the part's X axis in rad/s, if valid.
     pub fn rate_rad_s(&self) -> Option<f32> {
-        (self.gyro_error.is_none()).then(|| sensor_units::gyro_count_to_rad_s(self.raw.gyro_rate))
+        (self.gyro_error.is_none()).then(|| sensor_units::gyro_count_to_rad_s(self.gyro.rate))
     }
 
     /// Specific force along the part's X, Y, Z in m/s^2, if valid.
     pub fn accel_m_s2(&self) -> Option<[f32; 3]> {
-        (self.accel_error.is_none()).then(|| self.raw.accel.map(sensor_units::accel_count_to_m_s2))
+        (self.accel_error.is_none()).then(|| self.accel.xyz.map(sensor_units::accel_count_to_m_s2))
     }
 
     /// True when [`Part::recover`] has something to do.
@@ -45,7 +58,7 @@ impl PartReading {
 /// What a recovery did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct RecoveryReport {
-    pub gyro: Option<Recovery>,
+    pub gyro: Option<GyroRecovery>,
     pub accel_restarted: bool,
 }
 
@@ -84,52 +97,36 @@ impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
     /// [`Error::LoopFailure`].
     pub fn sample(&mut self) -> PartReading {
         let mut reading = PartReading::default();
-        let raw = &mut reading.raw;
-        let mut gyro = self.read_gyro(raw);
+        let mut gyro = self.read_gyro(&mut reading);
         if self.gyro.take_loop_failure() {
             // The recovery after the previous sample found a loop failure
-            // and soft-reset the gyro [TN92 step 4]: this sample reports it
-            // (RESET_SEEN), unless its own error asks for recovery again.
-            raw.flags |= Error::LoopFailure.raw_flag();
+            // and soft-reset the gyro [TN92 step 4]: this sample reports it,
+            // unless its own error asks for recovery again.
+            reading.gyro_was_reset = true;
             if !gyro.is_err_and(|e| e.needs_recovery()) {
                 gyro = Err(Error::LoopFailure);
             }
         }
-        match gyro {
-            Ok(()) => raw.flags |= raw_flags::GYRO_VALID,
-            Err(e) => {
-                raw.flags |= e.raw_flag();
-                reading.gyro_error = Some(e);
-            }
-        }
+        reading.gyro_error = gyro.err();
         let accel = self.accel.read_counts();
-        if self.accel.saturation_seen() {
-            // SAT came with another flag whose error is reported instead.
-            raw.flags |= raw_flags::ACCEL_SATURATED;
-        }
+        // SAT may have come with another flag whose error is reported instead.
+        reading.accel_saturation_seen = self.accel.saturation_seen();
         match accel {
-            Ok(counts) => {
-                raw.accel = counts.xyz;
-                raw.accel_temp = counts.temp;
-                raw.flags |= raw_flags::ACCEL_VALID;
-            }
-            Err(e) => {
-                raw.flags |= e.raw_flag();
-                reading.accel_error = Some(e);
-            }
+            Ok(counts) => reading.accel = counts,
+            Err(e) => reading.accel_error = Some(e),
         }
         reading
     }
 
-    fn read_gyro(&mut self, raw: &mut RawPart) -> Result<(), Error> {
+    fn read_gyro(&mut self, reading: &mut PartReading) -> Result<(), Error> {
         let rate = self.gyro.read_register(gyro_reg::RATE_X)?;
         if !rate.s_ok {
             return Err(Error::NotReady);
         }
-        raw.flags |= raw_flags::GYRO_S_OK;
-        raw.gyro_rate = sensor_units::word_to_count(rate.data);
-        raw.gyro_temp = self.gyro.read_temperature_count()?;
-        if gyro_count_is_saturated(raw.gyro_rate) {
+        reading.gyro_s_ok = true;
+        reading.gyro.rate = sensor_units::word_to_count(rate.data);
+        reading.gyro.temp = self.gyro.read_temperature_count()?;
+        if gyro_count_is_saturated(reading.gyro.rate) {
             return Err(Error::Saturated(Slave::Gyro));
         }
         Ok(())
@@ -204,7 +201,7 @@ mod tests {
             r.accel_error,
             Some(Error::Bus(Slave::Accel, ErrorKind::ModeFault))
         );
-        assert_eq!(r.raw.flags, raw_flags::NO_RESPONSE);
+        assert!(!r.gyro_s_ok && !r.accel_saturation_seen);
         assert_eq!(r.rate_rad_s(), None);
         assert!(!r.needs_recovery());
     }

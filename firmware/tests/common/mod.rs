@@ -20,8 +20,8 @@ pub type Driver<'p, 'c> = Part<
     AccelSpi<'p, &'c SimClock, MountedSource<Generator>>,
 >;
 
-/// 20 Hz sample period.
-pub const PERIOD_MS: u64 = 50;
+/// The probe's sample period.
+pub const PERIOD_MS: u64 = hil_mock::SAMPLE_PERIOD_NS / 1_000_000;
 
 pub fn mock_part(clock: &SimClock, index: usize) -> RefCell<MockPart<'_>> {
     seeded_mock_part(clock, index, 100 + index as u32)
@@ -91,8 +91,8 @@ pub fn assert_matches_truth(reading: &PartReading, truth: &PhysicalSample) {
     for (a, t) in acc.iter().zip(truth.accel_m_s2) {
         assert!((a - t).abs() <= lsb_acc, "accel {a} vs {t}");
     }
-    let gyro_t = GYRO_TEMPERATURE.count_to_degc(reading.raw.gyro_temp);
-    let acc_t = ACCEL_TEMPERATURE.count_to_degc(reading.raw.accel_temp);
+    let gyro_t = GYRO_TEMPERATURE.count_to_degc(reading.gyro.temp);
+    let acc_t = ACCEL_TEMPERATURE.count_to_degc(reading.accel.temp);
     let lsb_t = 1.0 / GYRO_TEMPERATURE.counts_per_degc;
     assert!((gyro_t - truth.temperature_degc).abs() <= lsb_t);
     assert!((acc_t - truth.temperature_degc).abs() <= lsb_t);

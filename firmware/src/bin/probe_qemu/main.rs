@@ -9,6 +9,10 @@
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
 //!   raw sample (navigation frames); feeds the watchdog; sleeps otherwise.
 //!
+//! What the contexts share and do is `firmware::app::SharedProbe`, as on
+//! the real board; this file adds UART0 as its `Transmitter`, SysTick, the
+//! watchdog and the run's measurements.
+//!
 //! The run ends after `PROBE_QEMU_RUN_SECONDS` simulated seconds (a
 //! compile-time setting, default 60): the queue is drained, a summary is
 //! printed through semihosting, and QEMU exits with success.
@@ -21,32 +25,29 @@ mod mock_sensors;
 mod registers;
 mod stack_paint;
 
-use core::cell::RefCell;
 use core::sync::atomic::Ordering;
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception};
-use critical_section::{CriticalSection, Mutex};
-use firmware::app::{start_parts, ProbeState, Recovery};
+use firmware::app::{FrameQueue, SharedProbe, Transmitter, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
-use mwd_core::protocol::frame::{nav_mode, NO_PART};
-use mwd_core::protocol::{EventKind, Payload};
+use mwd_core::protocol::frame::nav_mode;
+use mwd_core::timing::{SAMPLE_PERIOD_US, SAMPLE_RATE_HZ};
 
 use mock_sensors::{MockBus, TickDelay, TICKS};
 use registers::SYSTEM_CLOCK_HZ;
 
 /// Simulated seconds of streaming before the probe exits.
 const RUN_SECONDS: u32 = parse_seconds(option_env!("PROBE_QEMU_RUN_SECONDS"), 60);
-const SAMPLES_TO_RUN: u32 = RUN_SECONDS * 20;
-/// SysTick reload for 20 Hz at the board's clock.
-const RELOAD: u32 = SYSTEM_CLOCK_HZ / 20 - 1;
-/// The main loop must come round within this (it normally does every
-/// 50 ms; a sensor recovery holds it up to about a second).
-const WATCHDOG_MS: u32 = 2_000;
-/// Firmware version in the boot event.
-const VERSION: u16 = 1;
+const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
+/// The sample rate, for counting seconds in samples.
+const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
+/// When the watchdog run (feature `qemu-stall-demo`) hangs its main loop.
+const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
+/// SysTick reload for one sample period at the board's clock.
+const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
 const fn parse_seconds(text: Option<&str>, default: u32) -> u32 {
     let Some(text) = text else { return default };
@@ -62,83 +63,56 @@ const fn parse_seconds(text: Option<&str>, default: u32) -> u32 {
     value
 }
 
-/// Everything the contexts share; only touched inside critical sections.
-struct Shared {
-    probe: ProbeState<MockBus, MockBus>,
+/// CMSDK UART0's transmitter: a one-byte buffer whose interrupt fires when
+/// it empties.
+struct Uart0 {
     /// A byte is in the UART and its interrupt will ask for the next.
-    tx_busy: bool,
+    busy: bool,
 }
 
-static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
-    probe: ProbeState::new(),
-    tx_busy: false,
-}));
-
-fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
-    critical_section::with(|cs| f(&mut SHARED.borrow_ref_mut(cs), cs))
-}
-
-/// Starts the transmitter if it is idle and bytes wait. (If the UART is
-/// unexpectedly still full, the next push or timer tick tries again.)
-fn kick_transmitter(shared: &mut Shared) {
-    if shared.tx_busy || !registers::uart_ready() {
-        return;
+impl Transmitter for Uart0 {
+    /// Sends the next byte if the UART is idle. (If it is unexpectedly
+    /// still full, the next push or timer tick tries again.)
+    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
+        if self.busy || !registers::uart_ready() {
+            return;
+        }
+        if let Some(byte) = queue.pop() {
+            registers::uart_write(byte);
+            self.busy = true;
+        }
     }
-    if let Some(byte) = shared.probe.queue.pop() {
-        registers::uart_write(byte);
-        shared.tx_busy = true;
+
+    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
+        self.busy = false;
+        self.kick(queue);
     }
 }
 
-fn push(payload: &Payload) {
-    with_shared(|shared, _| {
-        shared.probe.queue.push(payload);
-        kick_transmitter(shared);
-    });
-}
-
-fn push_event(kind: EventKind, part: u8, code: u16, value: u32) {
-    with_shared(|shared, _| {
-        let event = shared.probe.event(kind, part, code, value);
-        shared.probe.queue.push(&event);
-        kick_transmitter(shared);
-    });
-}
+/// Everything the contexts share.
+static PROBE: SharedProbe<MockBus, MockBus, Uart0> = SharedProbe::new(Uart0 { busy: false });
 
 #[exception]
 fn SysTick() {
     TICKS.fetch_add(1, Ordering::Relaxed);
-    with_shared(|shared, _| {
+    PROBE.with(|shared| {
         // The run length is counted here, so the last sample is exact
         // whatever the main loop is doing.
-        if shared.probe.cycle.samples() >= SAMPLES_TO_RUN {
+        let samples = shared.probe().cycle().samples();
+        if samples >= SAMPLES_TO_RUN {
             return;
         }
-        if shared.probe.streaming {
-            mock_sensors::inject_scheduled_faults(shared.probe.cycle.samples());
+        if shared.probe().is_streaming() {
+            mock_sensors::inject_scheduled_faults(samples);
         }
-        shared.probe.acquire();
-        kick_transmitter(shared);
+        shared.acquire();
     });
 }
 
 /// UART0 TX: the transmitter's buffer went empty.
 pub fn on_uart_tx() {
     registers::uart_clear_tx_interrupt();
-    with_shared(|shared, _| {
-        shared.tx_busy = false;
-        kick_transmitter(shared);
-    });
-}
-
-/// Runs the recovery of the parts that asked for it, outside any critical
-/// section (it waits), then gives them back to the acquisition.
-fn recover(mut job: Recovery<MockBus, MockBus>) {
-    job.run(&mut TickDelay, |part, code| {
-        push_event(EventKind::SensorReset, part, code, 0)
-    });
-    let resync = with_shared(|shared, _| shared.probe.end_recovery(job));
-    push(&resync);
+    PROBE.with(|shared| shared.transmitter_ready());
 }
 
 /// Instruction budget of the busiest 20 Hz cycle and the sum for the mean,
@@ -175,11 +149,9 @@ fn main() -> ! {
     syst.enable_interrupt();
     syst.enable_counter();
 
-    push_event(EventKind::Boot, NO_PART, VERSION, 0);
-    registers::watchdog_start(WATCHDOG_MS);
-    let mut sensors = mock_sensors::power_up();
-    start_parts(&mut sensors, &mut TickDelay, push);
-    with_shared(|shared, _| shared.probe.start_streaming(sensors));
+    PROBE.announce_boot();
+    registers::watchdog_start(WATCHDOG_TIMEOUT_MS);
+    PROBE.start_streaming(mock_sensors::power_up(), &mut TickDelay);
 
     let mut cost = CycleCost::default();
     // The simulated site: the MGWD paper's test site.
@@ -188,26 +160,28 @@ fn main() -> ! {
     loop {
         registers::watchdog_feed();
         let tick = TICKS.load(Ordering::Relaxed);
-        if let Some(job) = with_shared(|shared, _| shared.probe.take_recovery()) {
-            recover(job);
-        }
         let mut mode_changed = false;
-        while let Some(sample) = with_shared(|shared, _| shared.probe.nav_inbox.pop()) {
-            let solution = navigator.step(&sample);
-            mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
-            mode = solution.mode;
-            push(&Payload::Nav(solution));
-        }
-        if cfg!(feature = "qemu-stall-demo") && with_shared(|s, _| s.probe.cycle.samples()) >= 200 {
+        PROBE.main_loop_pass(
+            &mut TickDelay,
+            &mut navigator,
+            |_, _| {},
+            |solution| {
+                mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
+                mode = solution.mode;
+            },
+        );
+        if cfg!(feature = "qemu-stall-demo")
+            && PROBE.with(|s| s.probe().cycle().samples()) >= STALL_AT_SAMPLE
+        {
             // A hung main loop (the watchdog run): interrupts go on.
             loop {
                 cortex_m::asm::wfi();
             }
         }
-        let (samples, idle) = with_shared(|s, _| {
-            let p = &s.probe;
-            let done = p.queue.is_empty() && !s.tx_busy && p.nav_inbox.is_empty();
-            (p.cycle.samples(), done)
+        let (samples, idle) = PROBE.with(|s| {
+            let p = s.probe();
+            let done = p.queue().is_empty() && !s.transmitter().busy && p.nav_inbox().is_empty();
+            (p.cycle().samples(), done)
         });
         if samples >= SAMPLES_TO_RUN && idle {
             exit::finish(&summary(&cost));
@@ -255,15 +229,15 @@ struct Summary {
 
 fn summary(cost: &CycleCost) -> Summary {
     let mean_ticks = (cost.total / u64::from(cost.cycles.max(1))) as u32;
-    with_shared(|s, _| Summary {
-        samples: s.probe.cycle.samples(),
-        skipped: s.probe.cycle.skipped(),
-        queued: s.probe.queue.queued(),
-        dropped: s.probe.queue.dropped(),
+    PROBE.with(|s| Summary {
+        samples: s.probe().cycle().samples(),
+        skipped: s.probe().cycle().skipped(),
+        queued: s.probe().queue().queued(),
+        dropped: s.probe().queue().dropped(),
         worst_ticks: cost.worst,
         mean_ticks,
         stack_bytes: stack_paint::high_water_bytes(),
-        nav_dropped: s.probe.nav_inbox.dropped(),
+        nav_dropped: s.probe().nav_inbox().dropped(),
         overruns: cost.overruns,
         longest_overrun_ticks: cost.longest_overrun,
         mode_changes: cost.mode_changes,

@@ -13,12 +13,12 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::scc1300::Part;
 use hil_mock::{
-    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe, TimeSource, Window,
+    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe, TimeSource,
+    Window, SAMPLE_PERIOD_NS,
 };
 use mwd_core::sensor_units::PART_MOUNTINGS;
 
-/// The acquisition timer's period.
-pub const PERIOD_NS: u64 = 50_000_000;
+use crate::SAMPLES_PER_SECOND;
 
 /// Timer periods since boot, counted by the SysTick interrupt.
 pub static TICKS: AtomicU32 = AtomicU32::new(0);
@@ -28,7 +28,7 @@ pub struct BoardClock;
 
 impl TimeSource for BoardClock {
     fn now_ns(&self) -> u64 {
-        u64::from(TICKS.load(Ordering::Relaxed)) * PERIOD_NS
+        u64::from(TICKS.load(Ordering::Relaxed)) * SAMPLE_PERIOD_NS
     }
 }
 
@@ -38,7 +38,7 @@ pub struct TickDelay;
 
 impl DelayNs for TickDelay {
     fn delay_ns(&mut self, ns: u32) {
-        let periods = u64::from(ns).div_ceil(PERIOD_NS) as u32;
+        let periods = u64::from(ns).div_ceil(SAMPLE_PERIOD_NS) as u32;
         let target = TICKS.load(Ordering::Relaxed).wrapping_add(periods);
         // Wrapping comparison: correct across the counter's overflow.
         while (TICKS.load(Ordering::Relaxed).wrapping_sub(target) as i32) < 0 {
@@ -125,9 +125,13 @@ pub fn power_up() -> Sensors {
 
 /// The fault run (feature `qemu-fault-demo`): faults injected into the
 /// simulated parts at fixed samples, so the end-to-end test sees each one
-/// come back as event frames while the stream goes on. Times are samples
-/// since streaming started (20 per second).
+/// come back as event frames while the stream goes on. `sample` counts
+/// from the start of streaming.
 pub fn inject_scheduled_faults(sample: u32) {
+    // When each fault comes (tests/tests/qemu_probe.rs expects these times).
+    const PARITY_ERRORS: u32 = 10 * SAMPLES_PER_SECOND;
+    const S_OK_DROP: u32 = 20 * SAMPLES_PER_SECOND;
+    const POWER_CYCLE: u32 = 30 * SAMPLES_PER_SECOND;
     if !cfg!(feature = "qemu-fault-demo") {
         return;
     }
@@ -140,18 +144,18 @@ pub fn inject_scheduled_faults(sample: u32) {
             }
         };
         match sample {
-            // 10 s: two corrupted gyro answers on part 0 (parity errors).
-            200 => with_part(0, &mut |p| p.faults.gyro.miso_parity = Chance::next(2)),
-            // 20 s: part 1's gyro loses S_OK for 100 ms (not ready, then
-            // the driver's supervision).
-            400 => with_part(1, &mut |p| {
+            // Two corrupted gyro answers on part 0 (parity errors).
+            PARITY_ERRORS => with_part(0, &mut |p| p.faults.gyro.miso_parity = Chance::next(2)),
+            // Part 1's gyro loses S_OK for 100 ms (not ready, then the
+            // driver's supervision).
+            S_OK_DROP => with_part(1, &mut |p| {
                 p.faults.s_ok_drop = Some(Window {
                     start_ns: now_ns,
                     end_ns: now_ns + 100_000_000,
                 })
             }),
-            // 30 s: part 0 power-cycles (both slaves restart: recovery).
-            600 => with_part(0, &mut |p| p.faults.reset_at_ns = Some(now_ns)),
+            // Part 0 power-cycles (both slaves restart: recovery).
+            POWER_CYCLE => with_part(0, &mut |p| p.faults.reset_at_ns = Some(now_ns)),
             _ => {}
         }
     });

@@ -11,7 +11,7 @@ const PAINT: u32 = 0x5AC0_FFEE;
 const MARGIN_BYTES: usize = 256;
 
 extern "C" {
-    /// Lowest stack address (end of .bss/.uninit), from link-qemu.x.
+    /// Lowest stack address (end of .bss/.uninit), from sections-qemu.x.
     static _stack_end: u32;
     /// Top of RAM, where the stack starts.
     static _stack_start: u32;

@@ -9,6 +9,10 @@
 //! - USART1 (TX empty): moves the next queued byte into the transmitter;
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
 //!   raw sample (navigation frames); feeds the watchdog; sleeps otherwise.
+//!
+//! What the contexts share and do is `firmware::app::SharedProbe`, as on
+//! the QEMU board; this file adds USART1 as its `Transmitter`, TIM2, the
+//! NVIC and the watchdog.
 #![no_std]
 #![no_main]
 
@@ -17,13 +21,14 @@ mod board;
 use core::cell::RefCell;
 
 use cortex_m_rt::entry;
-use critical_section::{CriticalSection, Mutex};
+use critical_section::Mutex;
 use defmt_rtt as _;
-use firmware::app::{start_parts, ProbeState, Recovery};
+use firmware::app::{
+    FrameQueue, SharedProbe, Transmitter, FIRMWARE_VERSION, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS,
+};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
-use mwd_core::protocol::frame::NO_PART;
-use mwd_core::protocol::{EventKind, Payload};
+use mwd_core::timing::SAMPLE_RATE_HZ;
 use panic_probe as _;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, NVIC};
 use stm32f4xx_hal::prelude::*;
@@ -32,88 +37,59 @@ use stm32f4xx_hal::timer::{Event as TimerEvent, Flag};
 
 use board::{Device, Timer, Uart};
 
-/// The main loop must come round within this (a recovery holds it ~1 s).
-const WATCHDOG_MS: u32 = 2_000;
-const VERSION: u16 = 1;
+/// The acquisition timer's rate: one interrupt per sample.
+const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// NVIC priorities (upper 4 bits on the F411; lower number = more urgent).
 const PRIORITY_ACQUISITION: u8 = 0x10;
 const PRIORITY_UART: u8 = 0x20;
 
-/// Everything the contexts share; only touched inside critical sections.
-struct Shared {
-    probe: ProbeState<Device, Device>,
+/// USART1's transmitter, driven by its TX-empty interrupt.
+struct Usart1 {
+    /// Set once the board is up.
     uart: Option<Uart>,
-    timer: Option<Timer>,
 }
 
-static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
-    probe: ProbeState::new(),
-    uart: None,
-    timer: None,
-}));
-
-fn with_shared<R>(f: impl FnOnce(&mut Shared, CriticalSection) -> R) -> R {
-    critical_section::with(|cs| f(&mut SHARED.borrow_ref_mut(cs), cs))
-}
-
-/// Bytes wait: let the TX-empty interrupt move them (it fires at once if
-/// the transmitter is idle).
-fn kick_transmitter(shared: &mut Shared) {
-    if let (false, Some(uart)) = (shared.probe.queue.is_empty(), shared.uart.as_mut()) {
-        uart.listen();
-    }
-}
-
-fn push(payload: &Payload) {
-    with_shared(|shared, _| {
-        shared.probe.queue.push(payload);
-        kick_transmitter(shared);
-    });
-}
-
-fn push_event(kind: EventKind, part: u8, code: u16, value: u32) {
-    with_shared(|shared, _| {
-        let event = shared.probe.event(kind, part, code, value);
-        shared.probe.queue.push(&event);
-        kick_transmitter(shared);
-    });
-}
-
-#[interrupt]
-fn TIM2() {
-    with_shared(|shared, _| {
-        if let Some(timer) = shared.timer.as_mut() {
-            timer.clear_flags(Flag::Update);
+impl Transmitter for Usart1 {
+    /// Bytes wait: let the TX-empty interrupt move them (it fires at once
+    /// if the transmitter is idle).
+    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
+        if let (false, Some(uart)) = (queue.is_empty(), self.uart.as_mut()) {
+            uart.listen();
         }
-        shared.probe.acquire();
-        kick_transmitter(shared);
-    });
-}
+    }
 
-#[interrupt]
-fn USART1() {
-    with_shared(|shared, _| {
-        let Some(uart) = shared.uart.as_mut() else {
+    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
+        let Some(uart) = self.uart.as_mut() else {
             return;
         };
-        match shared.probe.queue.pop() {
+        match queue.pop() {
             // TXE is set (that is why we are here), so the write succeeds.
             Some(byte) => {
                 let _ = uart.write(byte);
             }
             None => uart.unlisten(),
         }
-    });
+    }
 }
 
-/// Recovery of the parts that asked for it, outside any critical section.
-fn recover(mut job: Recovery<Device, Device>, delay: &mut stm32f4xx_hal::timer::SysDelay) {
-    job.run(delay, |part, code| {
-        defmt::warn!("part {=u8} recovered, code {=u16}", part, code);
-        push_event(EventKind::SensorReset, part, code, 0);
+/// Everything the contexts share.
+static PROBE: SharedProbe<Device, Device, Usart1> = SharedProbe::new(Usart1 { uart: None });
+/// The acquisition timer, whose interrupt flag its interrupt clears.
+static TIMER: Mutex<RefCell<Option<Timer>>> = Mutex::new(RefCell::new(None));
+
+#[interrupt]
+fn TIM2() {
+    critical_section::with(|cs| {
+        if let Some(timer) = TIMER.borrow_ref_mut(cs).as_mut() {
+            timer.clear_flags(Flag::Update);
+        }
     });
-    let resync = with_shared(|shared, _| shared.probe.end_recovery(job));
-    push(&resync);
+    PROBE.with(|shared| shared.acquire());
+}
+
+#[interrupt]
+fn USART1() {
+    PROBE.with(|shared| shared.transmitter_ready());
 }
 
 #[entry]
@@ -126,21 +102,19 @@ fn main() -> ! {
         Err(what) => defmt::panic!("board set-up failed: {=str}", what),
     };
     let board::Board {
-        mut sensors,
+        sensors,
         uart,
         mut timer,
         mut delay,
         mut watchdog,
     } = board;
-    defmt::info!("probe-stm32 v{=u16}: booting", VERSION);
-    if timer.start(20.Hz()).is_err() {
-        defmt::panic!("TIM2 cannot run at 20 Hz");
+    defmt::info!("probe-stm32 v{=u16}: booting", FIRMWARE_VERSION);
+    if timer.start(SAMPLES_PER_SECOND.Hz()).is_err() {
+        defmt::panic!("TIM2 cannot run at the sample rate");
     }
     timer.listen(TimerEvent::Update);
-    with_shared(|shared, _| {
-        shared.uart = Some(uart);
-        shared.timer = Some(timer);
-    });
+    PROBE.with(|shared| shared.transmitter_mut().uart = Some(uart));
+    critical_section::with(|cs| *TIMER.borrow_ref_mut(cs) = Some(timer));
     // SAFETY: register writes of the NVIC, done once before the handlers
     // share anything; both handlers only touch state behind critical
     // sections, so unmasking them cannot break a critical section.
@@ -152,22 +126,21 @@ fn main() -> ! {
         NVIC::unmask(Interrupt::USART1);
     }
 
-    push_event(EventKind::Boot, NO_PART, VERSION, 0);
-    watchdog.start(WATCHDOG_MS.millis());
-    start_parts(&mut sensors, &mut delay, push);
-    with_shared(|shared, _| shared.probe.start_streaming(sensors));
-    defmt::info!("streaming at 20 Hz");
+    PROBE.announce_boot();
+    watchdog.start(WATCHDOG_TIMEOUT_MS.millis());
+    PROBE.start_streaming(sensors, &mut delay);
+    defmt::info!("streaming at {=u32} Hz", SAMPLES_PER_SECOND);
 
     // The probe's site: the MGWD paper's test site until it is configurable.
     let mut navigator = Navigator::new(Position::paper_site());
     loop {
         watchdog.feed();
-        if let Some(job) = with_shared(|shared, _| shared.probe.take_recovery()) {
-            recover(job, &mut delay);
-        }
-        while let Some(sample) = with_shared(|shared, _| shared.probe.nav_inbox.pop()) {
-            push(&Payload::Nav(navigator.step(&sample)));
-        }
+        PROBE.main_loop_pass(
+            &mut delay,
+            &mut navigator,
+            |part, code| defmt::warn!("part {=u8} recovered, code {=u16}", part, code),
+            |_| {},
+        );
         cortex_m::asm::wfi();
     }
 }

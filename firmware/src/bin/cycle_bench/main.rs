@@ -7,18 +7,21 @@
 //! SysTick runs from the 25 MHz board clock, so it ticks every 40
 //! instructions. The loop calibration below measures that ratio instead of
 //! trusting it.
+//!
+//! Run it with `scripts/qemu-cycle-bench.sh` (feature `qemu-cycle-bench`,
+//! profile `cycle-bench`); the figures are in docs/filter-benchmarks.md.
 #![no_std]
 #![no_main]
+#![deny(unsafe_code)]
 
 use core::panic::PanicInfo;
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
-use mwd_core::earth::{earth_rate_n, gravity_n, Position};
+use mwd_core::earth::{earth_rate_n, gravity_n, LocalEarth, Position};
 use mwd_core::error_model::{
-    AugmentedModel, EarthTerms, LinearizationPoint, ProcessNoise, POS, STATES, STATES_WITH_BIASES,
-    VEL,
+    AugmentedModel, LinearizationPoint, ProcessNoise, POS, STATES, STATES_WITH_BIASES, VEL,
 };
 use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use mwd_core::kalman::{dense, FilterScalar};
@@ -77,7 +80,7 @@ fn dense_cycle<T: FilterScalar>() -> u32 {
     }
     let r = SMatrix::<T, 6, 6>::identity() * T::of(0.1);
     // Geodetic terms cached as in the fast cycle: compare filters, not caches.
-    let earth = EarthTerms::at(&state.position);
+    let earth = LocalEarth::at(&state.position);
     let start = SYST::get_current();
     for _ in 0..CYCLES {
         sd.step(core::hint::black_box(&sample));
@@ -140,7 +143,7 @@ fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 5] {
         position: s.position,
         specific_force_n: c_bn * sample.specific_force,
     };
-    let earth = EarthTerms::at(&s.position);
+    let earth = LocalEarth::at(&s.position);
     let start = SYST::get_current();
     for _ in 0..CYCLES {
         core::hint::black_box(model.transition_with::<T, N>(&earth, core::hint::black_box(&lp)));
@@ -156,11 +159,11 @@ fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 5] {
         f.predict(core::hint::black_box(&phi), &q);
     }
     let predict = ticks(start) / CYCLES;
-    let zv = mwd_core::measurement::ZeroVelocity {
+    let zv = mwd_core::aid_sources::ZeroVelocity {
         velocity_n: [T::of(0.01); 3],
         variance: T::of(0.1),
     };
-    let zp = mwd_core::measurement::ZeroPosition {
+    let zp = mwd_core::aid_sources::ZeroPosition {
         position_error_ned_m: [T::of(0.01); 3],
         variance: T::of(0.1),
     };

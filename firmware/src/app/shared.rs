@@ -1,0 +1,170 @@
+//! The glue every board runs, once: the probe's state and the board's
+//! [`Transmitter`] behind one critical section ([`SharedProbe`], kept in a
+//! static), reached from the timer interrupt ([`Shared::acquire`]), the
+//! UART's interrupt ([`Shared::transmitter_ready`]) and the main loop
+//! ([`SharedProbe::main_loop_pass`]: sensor recovery, then navigation).
+//! A board adds its timer, its UART's registers and its watchdog.
+
+use core::cell::RefCell;
+
+use critical_section::Mutex;
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::SpiDevice;
+use mwd_core::probe::Navigator;
+use mwd_core::protocol::frame::NO_PART;
+use mwd_core::protocol::{EventKind, NavSolution, Payload};
+
+use super::probe::{ProbeState, Sensors};
+use super::start_up::start_parts;
+use super::transmitter::Transmitter;
+use crate::scc1300::Error;
+
+/// Firmware version, sent in the boot event.
+pub const FIRMWARE_VERSION: u16 = 1;
+
+/// The board's watchdog timeout: the main loop comes round every 50 ms, a
+/// sensor recovery holds it up to about a second.
+pub const WATCHDOG_TIMEOUT_MS: u32 = 2_000;
+
+/// What the contexts share: the probe's state and its transmitter.
+pub struct Shared<G, A, T> {
+    probe: ProbeState<G, A>,
+    transmitter: T,
+}
+
+impl<G, A, T: Transmitter> Shared<G, A, T> {
+    pub fn probe(&self) -> &ProbeState<G, A> {
+        &self.probe
+    }
+
+    pub fn transmitter(&self) -> &T {
+        &self.transmitter
+    }
+
+    /// The board's own set-up of its transmitter (e.g. handing it the UART).
+    pub fn transmitter_mut(&mut self) -> &mut T {
+        &mut self.transmitter
+    }
+
+    /// Queues one frame and gets the transmitter going.
+    pub fn push(&mut self, payload: &Payload) {
+        self.probe.push(payload);
+        self.transmitter.kick(self.probe.queue_mut());
+    }
+
+    /// The UART's interrupt: the transmitter can take the next byte.
+    pub fn transmitter_ready(&mut self) {
+        self.transmitter.ready(self.probe.queue_mut());
+    }
+}
+
+impl<G: SpiDevice, A: SpiDevice, T: Transmitter> Shared<G, A, T> {
+    /// The timer interrupt's work: one acquisition (see
+    /// [`ProbeState::acquire`]), then the transmitter. Never waits.
+    pub fn acquire(&mut self) {
+        self.probe.acquire();
+        self.transmitter.kick(self.probe.queue_mut());
+    }
+}
+
+/// The probe's shared state behind the board's critical section.
+pub struct SharedProbe<G, A, T> {
+    shared: Mutex<RefCell<Shared<G, A, T>>>,
+}
+
+impl<G, A, T> SharedProbe<G, A, T> {
+    /// Not streaming, nothing queued: for a `static`.
+    pub const fn new(transmitter: T) -> Self {
+        Self {
+            shared: Mutex::new(RefCell::new(Shared {
+                probe: ProbeState::new(),
+                transmitter,
+            })),
+        }
+    }
+}
+
+impl<G, A, T: Transmitter> SharedProbe<G, A, T> {
+    /// Runs `f` on the shared state inside a critical section: keep it short.
+    pub fn with<R>(&self, f: impl FnOnce(&mut Shared<G, A, T>) -> R) -> R {
+        critical_section::with(|cs| f(&mut self.shared.borrow_ref_mut(cs)))
+    }
+
+    pub fn push(&self, payload: &Payload) {
+        self.with(|shared| shared.push(payload));
+    }
+
+    /// Queues an event stamped with the time of the next sample.
+    pub fn push_event(&self, kind: EventKind, part: u8, code: u16, value: u32) {
+        self.with(|shared| {
+            let event = shared.probe.event(kind, part, code, value);
+            shared.push(&event);
+        });
+    }
+
+    /// The boot event, the first frame of a run.
+    pub fn announce_boot(&self) {
+        self.push_event(EventKind::Boot, NO_PART, FIRMWARE_VERSION, 0);
+    }
+
+    /// Navigates every waiting sample, oldest first, outside the critical
+    /// section, and queues each solution; `on_solution` sees each first.
+    pub fn navigate_waiting(
+        &self,
+        navigator: &mut Navigator,
+        mut on_solution: impl FnMut(&NavSolution),
+    ) {
+        while let Some(sample) = self.with(|shared| shared.probe.next_sample()) {
+            let solution = navigator.step(&sample);
+            on_solution(&solution);
+            self.push(&Payload::Nav(solution));
+        }
+    }
+}
+
+impl<G: SpiDevice, A: SpiDevice, T: Transmitter> SharedProbe<G, A, T> {
+    /// Starts the parts (each failed attempt reported as an event; this
+    /// waits, outside the critical section), then hands them to the
+    /// acquisition. Returns the error of each part that never started: it
+    /// streams anyway, flagged in every raw frame.
+    pub fn start_streaming(
+        &self,
+        mut sensors: Sensors<G, A>,
+        delay: &mut impl DelayNs,
+    ) -> [Option<Error>; 2] {
+        let outcome = start_parts(&mut sensors, delay, |payload| self.push(payload));
+        self.with(|shared| shared.probe.start_streaming(sensors));
+        outcome
+    }
+
+    /// Runs the recovery the acquisition asked for, if any, outside the
+    /// critical section (it waits): one SensorReset event per part (also
+    /// told to `on_reset`), then the parts go back with a Resync event.
+    pub fn recover_if_asked(&self, delay: &mut impl DelayNs, mut on_reset: impl FnMut(u8, u16)) {
+        let Some(mut job) = self.with(|shared| shared.probe.take_recovery()) else {
+            return;
+        };
+        job.run(delay, |part, code| {
+            on_reset(part, code);
+            self.push_event(EventKind::SensorReset, part, code, 0);
+        });
+        let resync = self.with(|shared| shared.probe.end_recovery(job));
+        self.push(&resync);
+    }
+
+    /// The main loop's work each time it wakes: the recovery, then the
+    /// navigation of the samples taken meanwhile.
+    pub fn main_loop_pass(
+        &self,
+        delay: &mut impl DelayNs,
+        navigator: &mut Navigator,
+        on_reset: impl FnMut(u8, u16),
+        on_solution: impl FnMut(&NavSolution),
+    ) {
+        self.recover_if_asked(delay, on_reset);
+        self.navigate_waiting(navigator, on_solution);
+    }
+}
+
+#[cfg(test)]
+mod tests;
