@@ -35,6 +35,16 @@ pub enum ArQuantity {
     Other,
 }
 
+impl std::fmt::Display for ArQuantity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::SpecificForce => "a specific force",
+            Self::AngularRate => "an angular rate",
+            Self::Other => "a quantity of unknown unit",
+        })
+    }
+}
+
 impl ArQuantity {
     /// The variance unit written beside the number.
     pub fn variance_unit(self) -> &'static str {
@@ -341,7 +351,7 @@ impl ArModelFile {
             };
             if entry.quantity != axis.quantity {
                 bail!(
-                    "sensor {}: the file says {:?} where {} needs {:?} (fit it with SI \
+                    "sensor {}: the file has {} where {} needs {} (fit it with SI \
                      units, e.g. `--units auto` on `_m_s2` / `_rad_s` columns)",
                     entry.sensor,
                     entry.quantity,
@@ -498,7 +508,7 @@ mod tests {
         assert!(err(&f, true).contains("not stationary"));
         let mut f = probe_file();
         f.models[1].quantity = ArQuantity::Other;
-        assert!(err(&f, true).contains("needs AngularRate"));
+        assert!(err(&f, true).contains("needs an angular rate"));
     }
 
     #[test]

@@ -32,6 +32,20 @@ pub enum Face {
     ZDown,
 }
 
+/// The position's name in the calibration report.
+impl std::fmt::Display for Face {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::XUp => "XUp",
+            Self::XDown => "XDown",
+            Self::YUp => "YUp",
+            Self::YDown => "YDown",
+            Self::ZUp => "ZUp",
+            Self::ZDown => "ZDown",
+        })
+    }
+}
+
 impl Face {
     /// All six, in file-code order.
     pub const ALL: [Face; 6] = [
@@ -42,6 +56,11 @@ impl Face {
         Face::ZUp,
         Face::ZDown,
     ];
+
+    /// Its code in the `position` column, 1..=6.
+    pub fn code(self) -> usize {
+        Self::ALL.iter().position(|&f| f == self).unwrap_or(0) + 1
+    }
 
     /// The face of a file code 1..=6.
     pub fn from_code(code: f64) -> Option<Face> {
@@ -94,7 +113,8 @@ pub fn position_means(positions: &[f64], columns: &[&[f64]]) -> Result<Vec<Posit
     for (face, idx) in Face::ALL.iter().zip(&rows) {
         if idx.len() < 2 {
             bail!(
-                "position {face:?} has {} samples; each of the six needs at least 2",
+                "position {} ({face}) has {} samples; each of the six needs at least 2",
+                face.code(),
                 idx.len()
             );
         }

@@ -94,7 +94,10 @@ impl CalibrationFile {
                 .chain(t.correction.iter().flatten())
                 .all(|v| v.is_finite());
             if !finite {
-                bail!("triad {:?}: non-finite calibration value", t.columns);
+                bail!(
+                    "triad {}: a calibration value is not a finite number",
+                    t.columns.join(",")
+                );
             }
         }
         for g in &file.gyro {

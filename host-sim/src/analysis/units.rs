@@ -7,8 +7,8 @@ use anyhow::{bail, Result};
 /// Standard gravity (m/s^2) for inputs given in g or mg (ISO 80000-3).
 pub use mwd_core::sensor_units::STANDARD_GRAVITY;
 
-/// Unit of an input column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Unit of an input column (`allan --json` writes its variant name).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum InputUnit {
     /// rad/s (SI angular rate).
     RadPerS,

@@ -7,7 +7,7 @@ use host_sim::analysis::allan::{allan_deviation, averaging_factors, AllanPoint, 
 use host_sim::analysis::allan_fit::{bias_instability_factor, fit_noise, NoiseCoefficients};
 use host_sim::analysis::csv_input::{read_analysis_input, AnalysisInput};
 use host_sim::analysis::plot::{loglog_svg, Labels, Series, Style};
-use host_sim::analysis::units::{deviation_unit, report_noise, Quantity, Reported};
+use host_sim::analysis::units::{deviation_unit, report_noise, InputUnit, Quantity, Reported};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -44,7 +44,7 @@ pub struct Args {
 #[derive(Serialize)]
 struct SensorReport {
     name: String,
-    input_unit: String,
+    input_unit: InputUnit,
     /// Unit of `tau` is s; of `oadev`, `adev` and the intervals this one.
     oadev_unit: &'static str,
     samples: usize,
@@ -111,7 +111,7 @@ pub fn run(args: Args) -> Result<()> {
         );
         sensors.push(SensorReport {
             name: table.names[col].clone(),
-            input_unit: format!("{unit:?}"),
+            input_unit: *unit,
             oadev_unit: match unit.quantity() {
                 Quantity::AngularRate => "rad/s",
                 Quantity::SpecificForce => "m/s^2",

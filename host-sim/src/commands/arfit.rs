@@ -104,7 +104,7 @@ pub fn run(args: Args) -> Result<()> {
             let _ = writeln!(
                 out,
                 "{name:<14} {:<12}{coeffs} {:>13.4e} {:>9.4e} {report_unit}",
-                format!("{method:?}"),
+                method.to_string(),
                 fit.noise_variance,
                 report
             );
@@ -141,7 +141,7 @@ pub fn run(args: Args) -> Result<()> {
             .map_or(0, |s| s.order);
         let _ = writeln!(
             out,
-            "{:>4} {:>13} {:>9} {:>15} {:>15}  ({:?})",
+            "{:>4} {:>13} {:>9} {:>15} {:>15}  ({})",
             "p", "sigma^2", "k_p", "AIC", "BIC", args.method
         );
         for s in &scores {
@@ -165,7 +165,7 @@ pub fn run(args: Args) -> Result<()> {
     ArModelFile::new(entries).save(&path)?;
     let _ = writeln!(
         out,
-        "\nmodel file ({:?}, order {}) written to {}",
+        "\nmodel file ({}, order {}) written to {}",
         args.method,
         args.order,
         path.display()

@@ -162,7 +162,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut out = String::new();
     let counts: Vec<String> = means
         .iter()
-        .map(|m| format!("{:?} {}", m.face, m.samples))
+        .map(|m| format!("{} {}", m.face, m.samples))
         .collect();
     let _ = writeln!(
         out,

@@ -62,7 +62,7 @@ fn filter_model(args: &MgwdArgs) -> Result<(AugmentedModel, String)> {
     for s in &sources {
         let a = s.model.coefficients;
         let from = match (&s.sensor, s.method) {
-            (Some(name), Some(m)) => format!("{name} ({m:?})"),
+            (Some(name), Some(m)) => format!("{name} ({m})"),
             (Some(name), None) => name.clone(),
             (None, _) => "paper Table 5 (--paper-derived-rate)".into(),
         };
