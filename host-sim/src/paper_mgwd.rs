@@ -265,11 +265,11 @@ pub struct Ranks {
 }
 
 pub fn ranks(coupling: Coupling) -> Ranks {
-    use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, POS};
-    use mwd_core::observability::{
+    use crate::observability::matrices::{
         controllability_matrix, dynamic, observability_matrix, observability_matrix_discrete, rank,
         ObservabilityReport,
     };
+    use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, POS};
     use nalgebra::DMatrix;
     let position = Position::paper_site();
     let lp = LinearizationPoint {

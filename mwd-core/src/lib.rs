@@ -6,7 +6,7 @@
 //! * Sensors: [`sensor_units`] (SCC1300 counts), [`sensor_noise`] (error
 //!   budget), [`calibration`] (correction step), [`ar`] (AR(p) noise).
 //! * The filter: [`error_model`], [`kalman`], [`measurement`],
-//!   [`fine_alignment`]; [`observability`] on the host (`std` feature).
+//!   [`fine_alignment`].
 //! * The wire protocol: [`protocol`].
 #![no_std]
 #![forbid(unsafe_code)]
@@ -22,8 +22,6 @@ pub mod fine_alignment;
 pub mod kalman;
 pub mod measurement;
 pub mod mechanization;
-#[cfg(feature = "std")]
-pub mod observability;
 pub mod probe;
 pub mod protocol;
 pub mod sensor_noise;

@@ -2,15 +2,18 @@
 //! the navigation errors, optionally with constant sensor-bias states, under
 //! zero-velocity and zero-position updates, for one toolface or a sequence
 //! of toolfaces (a piece-wise constant system, analysed with the stripped
-//! observability matrix). The numbers come from `mwd_core::observability`;
-//! this module builds the models and names the states.
-use mwd_core::conventions::{dcm_from_euler, Euler};
-use mwd_core::earth::{gravity_n, Position};
-use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, NAV_STATES, POS, VEL};
-use mwd_core::observability::{
+//! observability matrix). The matrices, their ranks and the per-state
+//! report are [`matrices`]; this module builds the static probe's models
+//! and names the states.
+pub mod matrices;
+
+use matrices::{
     dynamic, observability_matrix, rank, stripped_observability_matrix, stripping_condition_holds,
     ObservabilityReport,
 };
+use mwd_core::conventions::{dcm_from_euler, Euler};
+use mwd_core::earth::{gravity_n, Position};
+use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, NAV_STATES, POS, VEL};
 use nalgebra::{DMatrix, Vector3};
 
 /// Names of the navigation-error states, then of the bias states.

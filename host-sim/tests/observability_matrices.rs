@@ -1,13 +1,12 @@
 //! Controllability / observability on systems with known answers, then the
 //! MGWD static alignment problem.
 
+use host_sim::observability::matrices::*;
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{
     navigation_error_dynamics, LinearizationPoint, ATT, NAV_STATES, POS, VEL,
 };
-
-use mwd_core::observability::*;
 use nalgebra::{DMatrix, Vector3};
 
 fn double_integrator() -> DMatrix<f64> {
