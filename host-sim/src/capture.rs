@@ -286,14 +286,15 @@ fn raw_csv(r: &RawSample) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mwd_core::probe::timing::SAMPLE_INTERVAL_S;
     use mwd_core::protocol::example;
-    use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s};
+    use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s, STANDARD_GRAVITY};
 
     fn sample(i: u32) -> SiSample {
-        let g = 9.806_65;
+        let g = STANDARD_GRAVITY;
         SiSample {
             index: i,
-            time_s: f64::from(i) * 0.05,
+            time_s: f64::from(i) * SAMPLE_INTERVAL_S,
             gyro_body_xz_rad_s: [1e-3 * f64::from(i), -0.2],
             accel_body_m_s2: [[0.1, 0.2, g], [0.3, -0.2, g + 0.01]],
             temperature_degc: 30.0,

@@ -6,20 +6,20 @@
 
 use crate::coarse;
 use crate::samples_csv::Record;
-use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
+use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory};
 use anyhow::Result;
 use mwd_core::alignment::AlignmentConfig;
-use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, wrap_pi, Euler};
+use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, wrap_pi, Euler, DEG};
 use mwd_core::earth::Position;
 use mwd_core::error_model::{
     AugmentedModel, Coupling, ProcessNoise, NAV_STATES, STATES, STATES_WITH_BIASES, VEL,
 };
 use mwd_core::fine_alignment::{at_rest_sample, FineAlignment, FineAlignmentConfig};
 use mwd_core::mechanization::NavState;
+use mwd_core::probe::timing::SAMPLE_INTERVAL_S;
 use mwd_core::sensor_noise::ImuNoise;
 use nalgebra::Vector3;
 
-pub const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Samples of the paper's test and of its coarse-alignment window.
 pub const SAMPLES: usize = 1200;
 pub const COARSE_SAMPLES: usize = 100;
@@ -128,7 +128,7 @@ pub fn simulate(seed: u64, full_model: bool) -> Vec<Record> {
         }
     }
     let cal = model.deterministic.calibration();
-    SensorSimulator::new(Trajectory::paper_static(truth()), model, SAMPLE_INTERVAL)
+    SensorSimulator::new(Trajectory::paper_static(truth()), model, SAMPLE_INTERVAL_S)
         .take(SAMPLES)
         .map(|s| coarse::calibrated(&Record::from(&s), &cal))
         .collect()

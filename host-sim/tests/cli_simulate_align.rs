@@ -187,7 +187,7 @@ fn a_calibration_file_drives_simulate_and_align() {
     use host_sim::analysis::calibration_file::{
         CalibrationFile, GyroEntry, TriadEntry, FORMAT, VERSION,
     };
-    let deg = std::f64::consts::PI / 180.0;
+    use mwd_core::conventions::DEG;
     let triad = TriadEntry {
         columns: [
             "accel_x_m_s2".into(),
@@ -207,12 +207,12 @@ fn a_calibration_file_drives_simulate_and_align() {
         format: FORMAT.into(),
         version: VERSION,
         method: "tls".into(),
-        latitude_deg: 45.77755,
+        latitude_deg: mwd_core::earth::Position::paper_site().lat.to_degrees(),
         gravity: 9.8,
         accel: vec![triad],
         gyro: vec![
-            gyro("gyro_x_rad_s", "x", 0.05 * deg),
-            gyro("gyro_z_rad_s", "z", -0.03 * deg),
+            gyro("gyro_x_rad_s", "x", 0.05 * DEG),
+            gyro("gyro_z_rad_s", "z", -0.03 * DEG),
         ],
     };
     let cal = temp_path("probe.cal.json");
@@ -309,7 +309,7 @@ fn six_position_tumble_calibrates_back_to_the_simulated_errors() {
         let error = probe.accel[0].bias[axis] - truth.accel_bias[axis];
         assert!(error.abs() < 0.04, "accel bias {axis} off by {error}");
     }
-    let deg_h = std::f64::consts::PI / 180.0 / 3600.0;
+    let deg_h = mwd_core::conventions::DEG / 3600.0;
     for (gyro, axis) in [(0, 0), (1, 2)] {
         let error = (probe.gyro[gyro].bias - truth.gyro_bias[axis]) / deg_h;
         assert!(error.abs() < 22.0, "gyro {axis} bias off by {error} deg/h");

@@ -255,6 +255,9 @@ mod tests {
         assert_eq!(Face::from_code(7.0), None);
         assert_eq!(Face::ZDown.reference_force(9.8), [0.0, 0.0, -9.8]);
         assert_eq!(Face::XUp.axis(), (0, 1.0));
+        for (i, face) in Face::ALL.iter().enumerate() {
+            assert_eq!(Face::from_code(face.code() as f64), Some(*face), "{i}");
+        }
     }
 
     #[test]
@@ -269,7 +272,8 @@ mod tests {
 
     #[test]
     fn earth_rate_at_the_paper_site() {
-        let up = earth_rate_up(45.77755f64.to_radians());
-        assert!((up - 7.292115e-5 * 45.77755f64.to_radians().sin()).abs() < 1e-15);
+        let lat = mwd_core::earth::Position::paper_site().lat;
+        let up = earth_rate_up(lat);
+        assert!((up - 7.292115e-5 * lat.sin()).abs() < 1e-15);
     }
 }

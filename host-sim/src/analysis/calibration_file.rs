@@ -154,7 +154,7 @@ mod tests {
             format: FORMAT.into(),
             version: VERSION,
             method: "tls".into(),
-            latitude_deg: 45.77755,
+            latitude_deg: mwd_core::earth::Position::paper_site().lat.to_degrees(),
             gravity: 9.806,
             accel: vec![TriadEntry {
                 columns: ["ax".into(), "ay".into(), "az".into()],

@@ -18,12 +18,10 @@
 
 use super::tls::{fit_row, FitMethod};
 use anyhow::Result;
+use mwd_core::sensor_units::STANDARD_GRAVITY as G;
 use nalgebra::{DMatrix, DVector, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
-
-/// Standard gravity for the paper's "1e-5 g".
-const G: f64 = 9.806_65;
 
 /// Set-up of the simulated experiment.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,13 +3,15 @@ use anyhow::{bail, Context, Result};
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::coarse;
 use host_sim::samples_csv;
-use host_sim::sim::{DeterministicErrors, SensorModelFile, SAMPLE_INTERVAL};
+use host_sim::sim::{DeterministicErrors, SensorModelFile};
 use mwd_core::alignment::AlignmentConfig;
 use mwd_core::calibration::ProbeCalibration;
+use mwd_core::conventions::DEG;
+use mwd_core::probe::timing::SAMPLE_INTERVAL_S;
 use mwd_core::sensor_noise::ImuNoise;
 use std::path::PathBuf;
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
+use super::site::SiteArgs;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum CalibrationKind {
@@ -25,9 +27,9 @@ pub enum CalibrationKind {
 pub struct Args {
     /// Sample CSV (as written by `host-sim simulate`).
     pub file: PathBuf,
-    /// Latitude of the site, degrees.
-    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
-    pub lat: f64,
+    /// The site (coarse alignment uses its latitude).
+    #[command(flatten)]
+    pub site: SiteArgs,
     /// Rough heading (degrees) to choose between ambiguous candidates, e.g.
     /// the parent well's survey.
     #[arg(long, allow_hyphen_values = true)]
@@ -57,7 +59,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut records = samples_csv::read(std::io::BufReader::new(file))
         .with_context(|| format!("reading {}", args.file.display()))?;
     if let Some(first) = args.first {
-        let keep = (first / SAMPLE_INTERVAL).round() as usize;
+        let keep = (first / SAMPLE_INTERVAL_S).round() as usize;
         if keep == 0 {
             bail!("--first {first} keeps no sample");
         }
@@ -90,7 +92,7 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     let config = AlignmentConfig {
         noise,
-        ..AlignmentConfig::probe(args.lat * DEG)
+        ..AlignmentConfig::probe(args.site.position().lat)
     }
     .with_heading_prior(args.prior_heading.map(|h| h * DEG));
     let spans = coarse::find_segments(&records);

@@ -8,6 +8,7 @@ use host_sim::analysis::ar_file::{ArModelEntry, ArModelFile, ArQuantity};
 use host_sim::analysis::arfit::{autocorrelation, fit_ar, order_scores, ArFit, ArMethod};
 use host_sim::analysis::csv_input::{read_analysis_input, AnalysisInput};
 use host_sim::analysis::units::{InputUnit, Quantity};
+use mwd_core::conventions::DEG;
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -94,10 +95,7 @@ pub fn run(args: Args) -> Result<()> {
                 .collect();
             let (report, report_unit) = match unit.quantity() {
                 // The paper's Table 5 betas are (deg/s)^2 (project assumption).
-                Quantity::AngularRate => (
-                    fit.noise_variance * (180.0 / std::f64::consts::PI).powi(2),
-                    "(deg/s)^2",
-                ),
+                Quantity::AngularRate => (fit.noise_variance * (1.0 / DEG).powi(2), "(deg/s)^2"),
                 Quantity::SpecificForce => (fit.noise_variance, "(m/s^2)^2"),
                 Quantity::Other => (fit.noise_variance, "u^2"),
             };

@@ -16,9 +16,7 @@ use host_sim::analysis::units::InputUnit;
 use std::fmt::Write;
 use std::path::PathBuf;
 
-/// The paper's site (section 4): 45.77755 N, 124 m.
-const PAPER_LATITUDE_DEG: f64 = 45.777_55;
-const PAPER_HEIGHT_M: f64 = 124.0;
+use super::site::SiteArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -37,12 +35,10 @@ pub struct Args {
     /// Unit of the gyro columns (rad/s, deg/s, deg/h).
     #[arg(long, default_value = "rad/s")]
     pub gyro_unit: String,
-    /// Latitude of the test (deg), for earth rate and normal gravity.
-    #[arg(long, default_value_t = PAPER_LATITUDE_DEG)]
-    pub latitude: f64,
-    /// Height of the test (m), for normal gravity.
-    #[arg(long, default_value_t = PAPER_HEIGHT_M)]
-    pub height: f64,
+    /// The site of the test: its latitude sets earth rate, latitude and
+    /// height normal gravity (`--latitude` is the same as `--lat`).
+    #[command(flatten)]
+    pub site: SiteArgs,
     /// Gravity magnitude (m/s^2); default: normal gravity at latitude and height.
     #[arg(long)]
     pub gravity: Option<f64>,
@@ -101,10 +97,11 @@ pub fn run(args: Args) -> Result<()> {
     let table = read_columns(&args.file)?;
     let accel_si = InputUnit::parse(&args.accel_unit)?.to_si();
     let gyro_si = InputUnit::parse(&args.gyro_unit)?.to_si();
-    let lat = args.latitude.to_radians();
+    let site = args.site.position();
+    let lat = site.lat;
     let gravity = args
         .gravity
-        .unwrap_or_else(|| mwd_core::earth::normal_gravity(lat, args.height));
+        .unwrap_or_else(|| mwd_core::earth::normal_gravity(lat, site.height));
     if !(gravity.is_finite() && gravity > 0.0) {
         bail!("gravity must be positive, got {gravity}");
     }
@@ -174,7 +171,7 @@ pub fn run(args: Args) -> Result<()> {
         out,
         "gravity {gravity:.5} m/s^2, earth rate up {:.4} deg/h at {:.5} deg",
         omega_up.to_degrees() * 3600.0,
-        args.latitude
+        args.site.lat
     );
     let use_tls = args.method == "tls";
     let mut accel_entries = Vec::new();
@@ -226,7 +223,7 @@ pub fn run(args: Args) -> Result<()> {
         format: FORMAT.into(),
         version: VERSION,
         method: args.method.clone(),
-        latitude_deg: args.latitude,
+        latitude_deg: args.site.lat,
         gravity,
         accel: accel_entries,
         gyro: gyro_entries,

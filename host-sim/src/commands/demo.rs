@@ -5,12 +5,12 @@
 use anyhow::Result;
 use host_sim::coarse;
 use host_sim::samples_csv::Record;
-use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, SAMPLE_INTERVAL};
+use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator};
 use mwd_core::alignment::AlignmentConfig;
+use mwd_core::conventions::DEG;
+use mwd_core::probe::timing::SAMPLE_INTERVAL_S;
 
 use super::simulate::TrajectoryArgs;
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -42,11 +42,15 @@ pub fn run(args: Args) -> Result<()> {
     let config = AlignmentConfig::probe(traj.position.lat)
         .with_heading_prior(Some(traj.start.heading + 30.0 * DEG));
     let simulate = |t: &host_sim::sim::Trajectory, seconds: f64| -> Vec<Record> {
-        let n = (seconds / SAMPLE_INTERVAL).round() as usize;
-        SensorSimulator::new(t.clone(), SensorModel::scc1300(args.seed), SAMPLE_INTERVAL)
-            .take(n)
-            .map(|s| Record::from(&s))
-            .collect()
+        let n = (seconds / SAMPLE_INTERVAL_S).round() as usize;
+        SensorSimulator::new(
+            t.clone(),
+            SensorModel::scc1300(args.seed),
+            SAMPLE_INTERVAL_S,
+        )
+        .take(n)
+        .map(|s| Record::from(&s))
+        .collect()
     };
     println!(
         "Simulated SCC1300 probe at rest, {:.5} N {:.6} E {:.0} m; truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result).",

@@ -12,6 +12,7 @@ mod paper;
 mod paper_mgwd;
 mod replay;
 mod simulate;
+mod site;
 
 #[derive(Parser, Debug)]
 #[command(name = "host-sim", version, about = "Host tool of the gyro MWD probe")]

@@ -4,10 +4,12 @@
 use anyhow::{anyhow, Context, Result};
 use host_sim::analysis::ar_file::ArModelFile;
 use host_sim::paper_mgwd::{
-    coarse_align, fine_align, monte_carlo, ranks, simulate, truth, History, Settings, DEG,
-    PUBLISHED,
+    coarse_align, fine_align, monte_carlo, ranks, simulate, truth, History, Settings, PUBLISHED,
 };
+use mwd_core::conventions::DEG;
+use mwd_core::earth::Position;
 use mwd_core::error_model::{AugmentedModel, Coupling};
+use mwd_core::probe::timing::SAMPLE_INTERVAL_S;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -36,7 +38,7 @@ pub struct MgwdArgs {
 }
 
 fn at(h: &History, seconds: f64) -> usize {
-    let i = (seconds / 0.05).round() as usize;
+    let i = (seconds / SAMPLE_INTERVAL_S).round() as usize;
     i.saturating_sub(1).min(h.time.len().saturating_sub(1))
 }
 
@@ -90,7 +92,14 @@ pub fn run(args: MgwdArgs) -> Result<()> {
     let records = simulate(args.seed, true);
     let (coarse, coarse_sigma) = coarse_align(&records)?;
     let t = truth();
-    println!("MGWD paper, section 4: 60 s static at 45.77755 N 126.687898 E 124 m, SCC1300 model (seed {}).", args.seed);
+    let site = Position::paper_site();
+    println!(
+        "MGWD paper, section 4: 60 s static at {:.5} N {:.6} E {:.0} m, SCC1300 model (seed {}).",
+        site.lat / DEG,
+        site.lon / DEG,
+        site.height,
+        args.seed
+    );
     println!(
         "Truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result, used as our truth).",
         t.roll / DEG,

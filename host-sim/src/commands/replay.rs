@@ -20,6 +20,8 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 
+use super::site::SiteArgs;
+
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Capture of the probe's UART bytes (`.bin`).
@@ -39,10 +41,13 @@ pub struct Args {
     /// Write the replayed navigation solutions as CSV here.
     #[arg(long, value_name = "OUT")]
     pub csv: Option<PathBuf>,
-    /// The probe's site: latitude and longitude (deg), height (m); the
-    /// QEMU probe uses the MGWD paper's site.
-    #[arg(long, num_args = 3, value_names = ["LAT", "LON", "HEIGHT"], allow_negative_numbers = true)]
-    pub site: Option<Vec<f64>>,
+    /// The probe's site (the QEMU probe's is the MGWD paper's).
+    #[command(flatten)]
+    pub site: SiteArgs,
+    /// The probe's site as three numbers, the same as --lat --lon --height.
+    #[arg(long = "site", num_args = 3, value_names = ["LAT", "LON", "HEIGHT"],
+          allow_negative_numbers = true, conflicts_with_all = ["lat", "lon", "height"])]
+    pub site_numbers: Option<Vec<f64>>,
     /// The probe's sensor calibration (`host-sim calibrate`'s JSON): the
     /// replay applies it as the probe does. Default: none (the QEMU probe
     /// runs uncalibrated).
@@ -51,9 +56,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let site = match args.site.as_deref() {
-        Some([lat, lon, height]) => Position::from_degrees(*lat, *lon, *height),
-        _ => Position::paper_site(),
+    let site = match args.site_numbers.as_deref() {
+        Some(&[lat, lon, height]) => Position::from_degrees(lat, lon, height),
+        _ => args.site.position(),
     };
     let calibration = match &args.calibration_file {
         Some(path) => CalibrationFile::load(path)?.to_probe(),

@@ -3,13 +3,12 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
+use host_sim::paper_mgwd::PUBLISHED;
 use host_sim::sim::DeterministicErrors;
-use host_sim::sim::{
-    Motion, SensorModel, SensorModelFile, SensorSimulator, Trajectory, SAMPLE_INTERVAL,
-};
+use host_sim::sim::{Motion, SensorModel, SensorModelFile, SensorSimulator, Trajectory};
 use host_sim::{capture, samples_csv};
-use mwd_core::conventions::Euler;
-use mwd_core::earth::Position;
+use mwd_core::conventions::{Euler, DEG};
+use mwd_core::probe::timing::SAMPLE_INTERVAL_S;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::NO_PART;
 use mwd_core::protocol::{Event, EventKind, Payload};
@@ -17,7 +16,8 @@ use nalgebra::Vector3;
 use std::io::Write;
 use std::path::PathBuf;
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
+use super::site::SiteArgs;
+
 /// The `code` of a simulated capture's boot event (a real probe sends its
 /// firmware version, from 1): 0 marks the capture as the simulator's.
 const SIMULATED_FIRMWARE_VERSION: u16 = 0;
@@ -47,23 +47,16 @@ pub enum SensorKind {
 #[derive(clap::Args, Debug, Clone)]
 pub struct TrajectoryArgs {
     /// Roll (gravity toolface) at the start, degrees.
-    #[arg(long, default_value_t = -0.8061, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[0], allow_hyphen_values = true)]
     pub roll: f64,
     /// Pitch (tool axis above horizontal), degrees.
-    #[arg(long, default_value_t = 0.5371, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[1], allow_hyphen_values = true)]
     pub pitch: f64,
     /// Heading (azimuth of the tool axis), degrees.
-    #[arg(long, default_value_t = -150.9636, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[2], allow_hyphen_values = true)]
     pub heading: f64,
-    /// Latitude, degrees (default: the paper's site).
-    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
-    pub lat: f64,
-    /// Longitude, degrees.
-    #[arg(long, default_value_t = 126.687898, allow_hyphen_values = true)]
-    pub lon: f64,
-    /// Height above the ellipsoid, metres.
-    #[arg(long, default_value_t = 124.0, allow_hyphen_values = true)]
-    pub height: f64,
+    #[command(flatten)]
+    pub site: SiteArgs,
     #[arg(long, value_enum, default_value_t = MotionKind::Static)]
     pub motion: MotionKind,
     /// Toolface indexing: turn per step, degrees.
@@ -102,7 +95,7 @@ impl TrajectoryArgs {
             }
         };
         Trajectory {
-            position: Position::from_degrees(self.lat, self.lon, self.height),
+            position: self.site.position(),
             start: Euler::new(self.roll * DEG, self.pitch * DEG, self.heading * DEG),
             motion,
         }
@@ -177,8 +170,8 @@ pub fn run(args: Args) -> Result<()> {
             )
         })?;
     }
-    let n = (duration / SAMPLE_INTERVAL).round() as usize;
-    let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL).take(n);
+    let n = (duration / SAMPLE_INTERVAL_S).round() as usize;
+    let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL_S).take(n);
     let format = args
         .format
         .unwrap_or(if args.output.extension().is_some_and(|e| e == "bin") {

@@ -11,7 +11,7 @@ use matrices::{
     dynamic, observability_matrix, rank, stripped_observability_matrix, stripping_condition_holds,
     ObservabilityReport,
 };
-use mwd_core::conventions::{dcm_from_euler, Euler};
+use mwd_core::conventions::{dcm_from_euler, Euler, DEG};
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, NAV_STATES, POS, VEL};
 use nalgebra::{DMatrix, Vector3};
@@ -121,7 +121,7 @@ pub fn analyse(
     let mut scale = vec![1e-3, 1e-3, 1e-3, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01];
     if biases {
         scale.extend([9.8e-3; 3]);
-        scale.extend([2.0 * std::f64::consts::PI / 180.0 / 3600.0; 3]);
+        scale.extend([2.0 * DEG / 3600.0; 3]);
     }
     Analysis {
         states,
