@@ -73,6 +73,16 @@ impl Settings {
         }
     }
 
+    /// The setting's tag in the plots' file names.
+    pub fn file_tag(&self) -> &'static str {
+        match self {
+            Settings::PaperAsPublished => "published",
+            Settings::PaperCoupled => "paper",
+            Settings::Physical => "physical",
+            Settings::PhysicalWithoutBiases => "physical-33",
+        }
+    }
+
     /// Filter states: 39 with the sensor biases, else the paper's 33.
     pub fn states(&self) -> usize {
         match self {
@@ -212,6 +222,31 @@ fn fine_align_with<const N: usize>(
     h
 }
 
+/// The static test on one seed: the coarse alignment of its first 5 s,
+/// then the fine alignment under each of [`Settings::ALL`].
+pub struct StaticTest {
+    /// Coarse roll, pitch, azimuth and their 1-sigma (rad).
+    pub coarse: Euler,
+    pub coarse_sigma: [f64; 3],
+    pub runs: Vec<(Settings, History)>,
+}
+
+/// The static test on `seed` with the full sensor model; `model` is the
+/// filter's.
+pub fn static_test(seed: u64, model: &AugmentedModel) -> Result<StaticTest> {
+    let records = simulate(seed, true);
+    let (coarse, coarse_sigma) = coarse_align(&records)?;
+    let runs = Settings::ALL
+        .iter()
+        .map(|s| (*s, fine_align(&records, &coarse, &coarse_sigma, *s, model)))
+        .collect();
+    Ok(StaticTest {
+        coarse,
+        coarse_sigma,
+        runs,
+    })
+}
+
 /// Seeded runs: how often the final roll and pitch errors are both inside
 /// the filter's 3 sigma, and the RMS of the final errors (deg).
 pub struct MonteCarlo {
@@ -251,6 +286,38 @@ pub fn monte_carlo(
     }
     mc.rms_error_deg = mc.rms_error_deg.map(f64::sqrt);
     Ok(mc)
+}
+
+/// The settings of the consistency check, in report order.
+pub const CONSISTENCY_SETTINGS: [Settings; 3] = [
+    Settings::PaperCoupled,
+    Settings::PhysicalWithoutBiases,
+    Settings::Physical,
+];
+
+/// One line of the consistency check: seeded runs of one setting on the
+/// filter's own noise model or on the full sensor model.
+pub struct Consistency {
+    pub settings: Settings,
+    /// As in [`simulate`]: the full SCC1300 model rather than the filter's.
+    pub full_model: bool,
+    pub result: MonteCarlo,
+}
+
+/// [`monte_carlo`] of `runs` seeds for each of [`CONSISTENCY_SETTINGS`],
+/// first on the filter's own noise model, then on the full sensor model.
+pub fn consistency(runs: usize, model: &AugmentedModel) -> Result<Vec<Consistency>> {
+    let mut lines = Vec::new();
+    for full_model in [false, true] {
+        for settings in CONSISTENCY_SETTINGS {
+            lines.push(Consistency {
+                settings,
+                full_model,
+                result: monte_carlo(runs, settings, full_model, model)?,
+            });
+        }
+    }
+    Ok(lines)
 }
 
 /// Ranks of section 2.4's matrices for the static problem (33 states,
