@@ -7,7 +7,8 @@
 //! - [`arfit`]: autocorrelation and AR(p) fitting (Yule-Walker, Burg,
 //!   covariance method), order selection, the model file the filter loads.
 //! - [`calibration`]: six-position calibration of accelerometer triads and
-//!   gyro biases (paper Table 3), by least squares or total least squares.
+//!   gyro biases (paper Table 3), by least squares or total least squares;
+//!   [`six_position`] runs it on a table's columns and makes the file.
 //! - [`tls`]: total least squares and Moore-Penrose reconstruction (TLS
 //!   paper eq. 14-23); [`paper_tls`] reproduces that paper's experiment.
 //! - [`csv_input`], [`plot`], [`stats`]: file input, SVG plots, chi-square.
@@ -21,6 +22,7 @@ pub mod calibration_file;
 pub mod csv_input;
 pub mod paper_tls;
 pub mod plot;
+pub mod six_position;
 pub mod stats;
 pub mod tls;
 pub mod units;

@@ -2,6 +2,7 @@
 //! every column of a static record, with confidence intervals, the fitted
 //! noise coefficients and a log-log SVG plot.
 
+use super::print_out;
 use anyhow::{bail, Result};
 use host_sim::analysis::allan::{allan_deviation, averaging_factors, AllanPoint, TauSet};
 use host_sim::analysis::allan_fit::{bias_instability_factor, fit_noise, NoiseCoefficients};
@@ -145,15 +146,6 @@ pub fn run(args: Args) -> Result<()> {
         print_out(&tables(&report, &units_q))?;
     }
     Ok(())
-}
-
-/// Prints to stdout; a closed pipe (`| head`) ends the output quietly.
-pub fn print_out(text: &str) -> Result<()> {
-    use std::io::Write;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => Ok(other?),
-    }
 }
 
 fn tables(report: &Report, quantities: &[Quantity]) -> String {

@@ -2,7 +2,7 @@
 //! three methods in the paper's sign convention (Tables 4-5), order
 //! selection help, and the model file the filter loads.
 
-use super::allan::print_out;
+use super::print_out;
 use anyhow::{Context, Result};
 use host_sim::analysis::ar_file::{ArModelEntry, ArModelFile, ArQuantity};
 use host_sim::analysis::arfit::{autocorrelation, fit_ar, order_scores, ArFit, ArMethod};

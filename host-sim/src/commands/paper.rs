@@ -1,7 +1,7 @@
 //! `host-sim paper ...`: reproductions of the papers' experiments, each a
 //! subcommand of [`PaperCommand`] with its own arguments.
 
-use super::allan::print_out;
+use super::print_out;
 use anyhow::Result;
 use host_sim::analysis::paper_tls::{
     error_percent, monte_carlo, run_once, Experiment, Row, PAPER_TABLE_1, PAPER_TABLE_2,
