@@ -12,6 +12,7 @@
 //! ```
 
 use super::arfit::{ArFit, ArMethod};
+use super::units::Quantity;
 use anyhow::{bail, Context, Result};
 use mwd_core::ar::{Ar4, ArModel};
 use mwd_core::error_model::AugmentedModel;
@@ -42,6 +43,16 @@ impl std::fmt::Display for ArQuantity {
             Self::AngularRate => "an angular rate",
             Self::Other => "a quantity of unknown unit",
         })
+    }
+}
+
+impl From<Quantity> for ArQuantity {
+    fn from(quantity: Quantity) -> Self {
+        match quantity {
+            Quantity::AngularRate => Self::AngularRate,
+            Quantity::SpecificForce => Self::SpecificForce,
+            Quantity::Other => Self::Other,
+        }
     }
 }
 

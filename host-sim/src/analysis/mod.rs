@@ -5,7 +5,8 @@
 //! - [`allan`], [`allan_fit`]: Allan deviation with confidence intervals and
 //!   the noise coefficients (random walk, bias instability, rate random walk).
 //! - [`arfit`]: autocorrelation and AR(p) fitting (Yule-Walker, Burg,
-//!   covariance method), order selection, the model file the filter loads.
+//!   covariance method), order selection, the model file the filter loads;
+//!   [`ar_analysis`] runs them on a record's columns.
 //! - [`calibration`]: six-position calibration of accelerometer triads and
 //!   gyro biases (paper Table 3), by least squares or total least squares;
 //!   [`six_position`] runs it on a table's columns and makes the file.
@@ -15,6 +16,7 @@
 
 pub mod allan;
 pub mod allan_fit;
+pub mod ar_analysis;
 pub mod ar_file;
 pub mod arfit;
 pub mod calibration;
