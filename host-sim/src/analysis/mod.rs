@@ -3,7 +3,8 @@
 //! done in the host tool.
 //!
 //! - [`allan`], [`allan_fit`]: Allan deviation with confidence intervals and
-//!   the noise coefficients (random walk, bias instability, rate random walk).
+//!   the noise coefficients (random walk, bias instability, rate random walk);
+//!   [`allan_analysis`] runs them on a record's columns.
 //! - [`arfit`]: autocorrelation and AR(p) fitting (Yule-Walker, Burg,
 //!   covariance method), order selection, the model file the filter loads;
 //!   [`ar_analysis`] runs them on a record's columns.
@@ -15,6 +16,7 @@
 //! - [`csv_input`], [`plot`], [`stats`]: file input, SVG plots, chi-square.
 
 pub mod allan;
+pub mod allan_analysis;
 pub mod allan_fit;
 pub mod ar_analysis;
 pub mod ar_file;
