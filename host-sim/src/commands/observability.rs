@@ -2,7 +2,7 @@
 //! zero-position updates can determine, at one toolface or over toolface
 //! indexing, with a per-state report from the SVD.
 use anyhow::{ensure, Result};
-use host_sim::observability::{analyse, Measurements, STATE_NAMES};
+use host_sim::observability::{analyse, Analysis, Measurements, STATE_NAMES};
 use host_sim::paper_mgwd::PUBLISHED;
 use mwd_core::conventions::{Euler, DEG};
 
@@ -33,20 +33,11 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let measurements = match args.measurements.as_str() {
-        "zupt" => Measurements {
-            zero_velocity: true,
-            zero_position: false,
-        },
-        "zpu" => Measurements {
-            zero_velocity: false,
-            zero_position: true,
-        },
-        "both" => Measurements {
-            zero_velocity: true,
-            zero_position: true,
-        },
-        other => anyhow::bail!("--measurements takes zupt, zpu or both, not `{other}`"),
+    let Some(measurements) = Measurements::from_name(&args.measurements) else {
+        anyhow::bail!(
+            "--measurements takes zupt, zpu or both, not `{}`",
+            args.measurements
+        );
     };
     ensure!(
         !args.toolfaces.is_empty() && args.toolfaces.len() <= 16,
@@ -61,10 +52,16 @@ pub fn run(args: Args) -> Result<()> {
         !args.no_biases,
         measurements,
     );
+    report(&args, &a);
+    Ok(())
+}
+
+/// Ranks, each state's unobservable share and the unobservable directions.
+fn report(args: &Args, a: &Analysis) {
     println!(
         "{} states, {} toolface segment(s) {:?} deg, measurements: {}",
         a.states,
-        offsets.len(),
+        args.toolfaces.len(),
         args.toolfaces,
         args.measurements
     );
@@ -98,5 +95,4 @@ pub fn run(args: Args) -> Result<()> {
             .collect();
         println!("unobservable direction {}: {}", k + 1, parts.join(", "));
     }
-    Ok(())
 }

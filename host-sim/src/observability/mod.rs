@@ -42,6 +42,22 @@ pub struct Measurements {
     pub zero_position: bool,
 }
 
+impl Measurements {
+    /// By name: `zupt` (zero velocity), `zpu` (zero position) or `both`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        let (zero_velocity, zero_position) = match name {
+            "zupt" => (true, false),
+            "zpu" => (false, true),
+            "both" => (true, true),
+            _ => return None,
+        };
+        Some(Self {
+            zero_velocity,
+            zero_position,
+        })
+    }
+}
+
 /// The continuous error model of a tool at rest with attitude `e`: F of
 /// the 9 navigation errors (the core's), plus, with `biases`, six constant
 /// bias states driving them (accelerometer bias into velocity through
@@ -143,6 +159,16 @@ mod tests {
         zero_velocity: true,
         zero_position: true,
     };
+
+    #[test]
+    fn measurements_by_name() {
+        assert_eq!(Measurements::from_name("both"), Some(BOTH));
+        let zupt = Measurements::from_name("zupt").unwrap();
+        assert!(zupt.zero_velocity && !zupt.zero_position);
+        let zpu = Measurements::from_name("zpu").unwrap();
+        assert!(!zpu.zero_velocity && zpu.zero_position);
+        assert_eq!(Measurements::from_name("ZUPT"), None);
+    }
 
     /// At rest, ZUPT + zero position cannot tell a horizontal accelerometer
     /// bias from tilt, nor the east gyro bias from azimuth: three of the 15
