@@ -225,9 +225,11 @@ fn fine_align_with<const N: usize>(
 /// The static test on one seed: the coarse alignment of its first 5 s,
 /// then the fine alignment under each of [`Settings::ALL`].
 pub struct StaticTest {
-    /// Coarse roll, pitch, azimuth and their 1-sigma (rad).
+    /// The coarse alignment's roll, pitch and azimuth.
     pub coarse: Euler,
+    /// Their 1-sigma (rad).
     pub coarse_sigma: [f64; 3],
+    /// The fine alignment under each setting.
     pub runs: Vec<(Settings, History)>,
 }
 
