@@ -5,7 +5,7 @@ use mwd_core::earth::Position;
 /// Where the probe is (degrees and metres on the command line).
 #[derive(clap::Args, Debug, Clone, Copy, PartialEq)]
 pub struct SiteArgs {
-    /// Latitude of the site, degrees (default: the MGWD paper's site).
+    /// Latitude of the site, degrees (defaults: the MGWD paper's site).
     #[arg(long, alias = "latitude", default_value_t = paper_site_degrees()[0], allow_hyphen_values = true)]
     pub lat: f64,
     /// Longitude of the site, degrees.
