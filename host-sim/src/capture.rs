@@ -1,6 +1,6 @@
 //! Captures of the probe's UART stream (`.bin`: exactly the bytes the probe
 //! sends, see `docs/protocol.md`): writing simulated samples as raw-sample
-//! frames, reading and decoding a capture with its loss statistics, and
+//! frames (and the navigation frames a probe makes of them), reading and decoding a capture with its loss statistics, and
 //! exporting the frames as CSV.
 
 use std::fmt;
@@ -8,11 +8,17 @@ use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
 use std::path::Path;
 
-use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample};
+use anyhow::Context;
+use mwd_core::earth::Position;
+use mwd_core::probe::Navigator;
+use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
 use mwd_core::protocol::{Decoder, DecoderStats, Frame, FrameEncoder, MAX_WIRE_LEN};
+use mwd_core::protocol::{Event, EventKind};
 use mwd_core::sensor_units::{
     self, ACCEL_TEMPERATURE, GYRO_TEMPERATURE, PART_COUNT, PART_MOUNTINGS,
 };
+
+use crate::sim::SimSample;
 
 /// One simulated sample in SI units, body frame (x right, y forward, z up).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -114,6 +120,44 @@ impl<W: Write> CaptureWriter<W> {
 /// Creates a `.bin` capture file.
 pub fn create_capture(path: &Path) -> io::Result<CaptureWriter<BufWriter<File>>> {
     Ok(CaptureWriter::new(BufWriter::new(File::create(path)?)))
+}
+
+/// The `code` of a simulated capture's boot event (a real probe sends its
+/// firmware version, from 1): 0 marks the capture as the simulator's.
+const SIMULATED_FIRMWARE_VERSION: u16 = 0;
+
+/// Writes what a probe at `site` sends for simulated `samples`: its boot
+/// event, then per sample the raw frame and the navigation frame its own
+/// navigation code (the same `Navigator` the firmware runs) makes of that
+/// raw frame.
+pub fn write_simulated_probe<W: Write>(
+    capture: &mut CaptureWriter<W>,
+    samples: impl IntoIterator<Item = SimSample>,
+    site: Position,
+) -> anyhow::Result<()> {
+    capture.write(&Payload::Event(Event {
+        time_us: 0,
+        kind: EventKind::Boot,
+        part: NO_PART,
+        code: SIMULATED_FIRMWARE_VERSION,
+        value: 0,
+    }))?;
+    let mut navigator = Navigator::new(site);
+    for (index, s) in samples.into_iter().enumerate() {
+        // Both parts' triads see the same body-frame specific force; the
+        // encoder turns each into its part's axes and counts.
+        let accel = [s.accel.x, s.accel.y, s.accel.z];
+        let raw = raw_sample_from_si(&SiSample {
+            index: u32::try_from(index).context("more than 2^32 samples")?,
+            time_s: s.time,
+            gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
+            accel_body_m_s2: [accel, accel],
+            temperature_degc: 25.0,
+        });
+        capture.write(&Payload::Raw(raw))?;
+        capture.write(&Payload::Nav(navigator.step(&raw)))?;
+    }
+    Ok(())
 }
 
 /// A decoded capture: the good frames in order and what was lost.
@@ -287,13 +331,14 @@ fn raw_csv(r: &RawSample) -> String {
 mod tests {
     use super::*;
     use mwd_core::protocol::example;
-    use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s};
+    use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s, STANDARD_GRAVITY};
+    use mwd_core::timing::SAMPLE_INTERVAL_S;
 
     fn sample(i: u32) -> SiSample {
-        let g = 9.806_65;
+        let g = STANDARD_GRAVITY;
         SiSample {
             index: i,
-            time_s: f64::from(i) * 0.05,
+            time_s: f64::from(i) * SAMPLE_INTERVAL_S,
             gyro_body_xz_rad_s: [1e-3 * f64::from(i), -0.2],
             accel_body_m_s2: [[0.1, 0.2, g], [0.3, -0.2, g + 0.01]],
             temperature_degc: 30.0,

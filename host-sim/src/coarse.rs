@@ -106,11 +106,16 @@ pub fn align(
     let mut truth = Vec::new();
     for span in spans {
         let Some(run) = records.get(span.clone()) else {
-            bail!("segment {span:?} is outside the {} samples", records.len());
+            bail!(
+                "segment {}..{} is outside the {} samples",
+                span.start,
+                span.end,
+                records.len()
+            );
         };
         let seg = segment(run);
         let lev = level_segment(&seg, config)
-            .map_err(|e| anyhow::anyhow!("levelling samples {span:?}: {e:?}"))?;
+            .map_err(|e| anyhow::anyhow!("levelling samples {}..{}: {e}", span.start, span.end))?;
         segments.push(seg);
         levels.push(lev);
         times.push((
@@ -120,7 +125,7 @@ pub fn align(
         truth.push(run.last().and_then(|r| r.truth));
     }
     let heading =
-        gyrocompass(&segments, config).map_err(|e| anyhow::anyhow!("gyrocompassing: {e:?}"))?;
+        gyrocompass(&segments, config).map_err(|e| anyhow::anyhow!("gyrocompassing: {e}"))?;
     let analytical = analytical(&segments[0], config).ok();
     Ok(CoarseReport {
         spans: spans.to_vec(),
@@ -284,8 +289,9 @@ pub fn describe_heading(h: &HeadingEstimate, segments: usize, truth: Option<Eule
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::{Motion, SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
+    use crate::sim::{Motion, SensorModel, SensorSimulator, Trajectory};
     use mwd_core::earth::Position;
+    use mwd_core::timing::SAMPLE_INTERVAL_S as SAMPLE_INTERVAL;
 
     fn records(traj: Trajectory, model: SensorModel, seconds: f64) -> Vec<Record> {
         let n = (seconds / SAMPLE_INTERVAL).round() as usize;

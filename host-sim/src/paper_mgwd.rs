@@ -6,10 +6,10 @@
 
 use crate::coarse;
 use crate::samples_csv::Record;
-use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
+use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory};
 use anyhow::Result;
 use mwd_core::alignment::AlignmentConfig;
-use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, wrap_pi, Euler};
+use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, wrap_pi, Euler, DEG};
 use mwd_core::earth::Position;
 use mwd_core::error_model::{
     AugmentedModel, Coupling, ProcessNoise, NAV_STATES, STATES, STATES_WITH_BIASES, VEL,
@@ -18,9 +18,9 @@ use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use mwd_core::mechanization::NavState;
 use mwd_core::mechanization::{ProbeInput, ToolAxisSource};
 use mwd_core::sensor_noise::ImuNoise;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
 
-pub const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Samples of the paper's test and of its coarse-alignment window.
 pub const SAMPLES: usize = 1200;
 pub const COARSE_SAMPLES: usize = 100;
@@ -71,6 +71,16 @@ impl Settings {
             Settings::PaperCoupled => "paper P0/Q/R, coupled",
             Settings::Physical => "physically scaled",
             Settings::PhysicalWithoutBiases => "physical, 33 states",
+        }
+    }
+
+    /// The setting's tag in the plots' file names.
+    pub fn file_tag(&self) -> &'static str {
+        match self {
+            Settings::PaperAsPublished => "published",
+            Settings::PaperCoupled => "paper",
+            Settings::Physical => "physical",
+            Settings::PhysicalWithoutBiases => "physical-33",
         }
     }
 
@@ -132,7 +142,7 @@ pub fn simulate(seed: u64, full_model: bool) -> Vec<Record> {
         }
     }
     let cal = model.deterministic.calibration();
-    SensorSimulator::new(Trajectory::paper_static(truth()), model, SAMPLE_INTERVAL)
+    SensorSimulator::new(Trajectory::paper_static(truth()), model, SAMPLE_INTERVAL_S)
         .take(SAMPLES)
         .map(|s| coarse::calibrated(&Record::from(&s), &cal))
         .collect()
@@ -195,7 +205,7 @@ fn fine_align_with<const N: usize>(
     let t = truth();
     let mut h = History::default();
     let mut input = ProbeInput::new();
-    let dt = SAMPLE_INTERVAL;
+    let dt = SAMPLE_INTERVAL_S;
     for r in records {
         // The tool is at rest: its rate about the tool axis is the frame's.
         let frame_rate = fa.frame_rate_in_body();
@@ -217,6 +227,33 @@ fn fine_align_with<const N: usize>(
         h.trace.push((0..N).map(|i| p[(i, i)] as f64).sum());
     }
     h
+}
+
+/// The static test on one seed: the coarse alignment of its first 5 s,
+/// then the fine alignment under each of [`Settings::ALL`].
+pub struct StaticTest {
+    /// The coarse alignment's roll, pitch and azimuth.
+    pub coarse: Euler,
+    /// Their 1-sigma (rad).
+    pub coarse_sigma: [f64; 3],
+    /// The fine alignment under each setting.
+    pub runs: Vec<(Settings, History)>,
+}
+
+/// The static test on `seed` with the full sensor model; `model` is the
+/// filter's.
+pub fn static_test(seed: u64, model: &AugmentedModel) -> Result<StaticTest> {
+    let records = simulate(seed, true);
+    let (coarse, coarse_sigma) = coarse_align(&records)?;
+    let runs = Settings::ALL
+        .iter()
+        .map(|s| (*s, fine_align(&records, &coarse, &coarse_sigma, *s, model)))
+        .collect();
+    Ok(StaticTest {
+        coarse,
+        coarse_sigma,
+        runs,
+    })
 }
 
 /// Seeded runs: how often the final roll and pitch errors are both inside
@@ -260,6 +297,38 @@ pub fn monte_carlo(
     Ok(mc)
 }
 
+/// The settings of the consistency check, in report order.
+pub const CONSISTENCY_SETTINGS: [Settings; 3] = [
+    Settings::PaperCoupled,
+    Settings::PhysicalWithoutBiases,
+    Settings::Physical,
+];
+
+/// One line of the consistency check: seeded runs of one setting on the
+/// filter's own noise model or on the full sensor model.
+pub struct Consistency {
+    pub settings: Settings,
+    /// As in [`simulate`]: the full SCC1300 model rather than the filter's.
+    pub full_model: bool,
+    pub result: MonteCarlo,
+}
+
+/// [`monte_carlo`] of `runs` seeds for each of [`CONSISTENCY_SETTINGS`],
+/// first on the filter's own noise model, then on the full sensor model.
+pub fn consistency(runs: usize, model: &AugmentedModel) -> Result<Vec<Consistency>> {
+    let mut lines = Vec::new();
+    for full_model in [false, true] {
+        for settings in CONSISTENCY_SETTINGS {
+            lines.push(Consistency {
+                settings,
+                full_model,
+                result: monte_carlo(runs, settings, full_model, model)?,
+            });
+        }
+    }
+    Ok(lines)
+}
+
 /// Ranks of section 2.4's matrices for the static problem (33 states,
 /// discrete pair (Phi, Gamma) with Gamma = diag(sqrt q), H of eq. 48).
 pub struct Ranks {
@@ -272,11 +341,11 @@ pub struct Ranks {
 }
 
 pub fn ranks(coupling: Coupling) -> Ranks {
-    use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, POS};
-    use mwd_core::observability::{
+    use crate::observability::matrices::{
         controllability_matrix, dynamic, observability_matrix, observability_matrix_discrete, rank,
         ObservabilityReport,
     };
+    use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, POS};
     use nalgebra::DMatrix;
     let position = Position::paper_site();
     let lp = LinearizationPoint {

@@ -145,13 +145,15 @@ pub fn read<R: BufRead>(input: R) -> Result<Vec<Record>> {
 mod tests {
     use super::*;
     use crate::sim::{SensorModel, SensorSimulator, Trajectory};
+    use mwd_core::timing::SAMPLE_INTERVAL_S;
 
     #[test]
     fn round_trip_keeps_the_samples() {
         let traj = Trajectory::paper_static(Euler::new(0.1, 0.2, 0.3));
-        let samples: Vec<_> = SensorSimulator::new(traj, SensorModel::scc1300(1), 0.05)
-            .take(10)
-            .collect();
+        let samples: Vec<_> =
+            SensorSimulator::new(traj, SensorModel::scc1300(1), SAMPLE_INTERVAL_S)
+                .take(10)
+                .collect();
         let mut buf = Vec::new();
         write(&mut buf, samples.clone()).unwrap();
         let back = read(buf.as_slice()).unwrap();

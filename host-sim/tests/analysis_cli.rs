@@ -63,7 +63,7 @@ fn allan_json_and_arfit_model_file() {
     }
     // gy was given in deg/s: its variance is stored in (rad/s)^2.
     let gy = file.get("gy").unwrap();
-    let expected = 7.1662e-7 * (std::f64::consts::PI / 180.0).powi(2);
+    let expected = 7.1662e-7 * mwd_core::conventions::DEG.powi(2);
     assert!(
         (gy.noise_variance / expected - 1.0).abs() < 0.1,
         "{}",

@@ -11,6 +11,7 @@ use host_sim::analysis::calibration::{
 };
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::analysis::tls::FitMethod;
+use mwd_core::earth::Position;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
@@ -22,14 +23,13 @@ const K: [[f64; 3]; 3] = [
 ];
 const BIAS: [f64; 3] = [-0.007083, -0.020188, 0.002405]; // paper Table 3 magnitudes
 const GYRO_BIAS: [f64; 2] = [-3.686e-4, -2.871e-4]; // rad/s, paper Table 3 X and Z
-const LAT_DEG: f64 = 45.77755;
 
 /// Rows of (position, ax, ay, az, gx, gz) for the six positions.
 fn simulate(seed: u64, per_position: usize) -> Vec<[f64; 6]> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let acc_noise = Normal::new(0.0, 0.05).unwrap();
     let gyro_noise = Normal::new(0.0, 0.063f64.to_radians()).unwrap();
-    let lat = LAT_DEG.to_radians();
+    let lat = Position::paper_site().lat;
     let up = earth_rate_up(lat);
     let horizontal = 7.292115e-5 * lat.cos();
     let mut rows = Vec::new();
@@ -91,7 +91,7 @@ fn recovers_bias_scale_misalignment_and_gyro_bias() {
                 "{c:?}"
             );
         }
-        let up = earth_rate_up(LAT_DEG.to_radians());
+        let up = earth_rate_up(Position::paper_site().lat);
         for (k, (col, axis)) in [(3usize, 0usize), (4, 2)].into_iter().enumerate() {
             let g = calibrate_gyro(&means, col, axis, up).unwrap();
             let z = (g.bias - GYRO_BIAS[k]) / g.bias_se;

@@ -78,6 +78,30 @@ fn align_rejects_a_file_that_is_not_a_sample_csv() {
     let _ = std::fs::remove_file(bad);
 }
 
+/// A failed alignment is reported to the user as a sentence, not as the
+/// core's error variant (`levelling samples 0..100: NotStatic`).
+#[test]
+fn a_failed_alignment_reads_as_a_sentence() {
+    // The accelerometers read twice gravity: the tool cannot be at rest.
+    let csv = temp_path("not-static.csv");
+    let mut text =
+        String::from("time_s,gyro_x_rad_s,gyro_z_rad_s,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2\n");
+    for i in 0..100 {
+        text += &format!("{:.3},0,0,0,0,19.6\n", f64::from(i) * 0.05);
+    }
+    std::fs::write(&csv, text).expect("write the CSV");
+    let (ok, _, err) = host_sim(&[
+        "align",
+        csv.to_str().expect("utf-8"),
+        "--calibration",
+        "none",
+    ]);
+    assert!(!ok, "{err}");
+    assert!(err.contains("the tool is not at rest"), "{err}");
+    assert!(!err.contains("NotStatic"), "{err}");
+    let _ = std::fs::remove_file(csv);
+}
+
 #[test]
 fn demo_prints_the_alignment_next_to_the_truth() {
     let (ok, out, err) = host_sim(&["demo"]);
@@ -161,7 +185,7 @@ fn a_calibration_file_drives_simulate_and_align() {
     use host_sim::analysis::calibration_file::{
         CalibrationFile, GyroEntry, TriadEntry, FORMAT, VERSION,
     };
-    let deg = std::f64::consts::PI / 180.0;
+    use mwd_core::conventions::DEG;
     let triad = TriadEntry {
         columns: [
             "accel_x_m_s2".into(),
@@ -181,12 +205,12 @@ fn a_calibration_file_drives_simulate_and_align() {
         format: FORMAT.into(),
         version: VERSION,
         method: "tls".into(),
-        latitude_deg: 45.77755,
+        latitude_deg: mwd_core::earth::Position::paper_site().lat.to_degrees(),
         gravity: 9.8,
         accel: vec![triad],
         gyro: vec![
-            gyro("gyro_x_rad_s", "x", 0.05 * deg),
-            gyro("gyro_z_rad_s", "z", -0.03 * deg),
+            gyro("gyro_x_rad_s", "x", 0.05 * DEG),
+            gyro("gyro_z_rad_s", "z", -0.03 * DEG),
         ],
     };
     let cal = temp_path("probe.cal.json");
@@ -283,7 +307,7 @@ fn six_position_tumble_calibrates_back_to_the_simulated_errors() {
         let error = probe.accel[0].bias[axis] - truth.accel_bias[axis];
         assert!(error.abs() < 0.04, "accel bias {axis} off by {error}");
     }
-    let deg_h = std::f64::consts::PI / 180.0 / 3600.0;
+    let deg_h = mwd_core::conventions::DEG / 3600.0;
     for (gyro, axis) in [(0, 0), (1, 2)] {
         let error = (probe.gyro[gyro].bias - truth.gyro_bias[axis]) / deg_h;
         assert!(error.abs() < 22.0, "gyro {axis} bias off by {error} deg/h");

@@ -3,7 +3,7 @@
 //! report names each filter axis with the file's sensor and coefficients,
 //! and a file the filter cannot use stops the run with a clear error.
 
-use host_sim::analysis::ar_file::ArModelFile;
+use host_sim::analysis::ar_file::{ArModelFile, ArQuantity};
 use std::path::Path;
 use std::process::Command;
 
@@ -145,6 +145,14 @@ fn paper_mgwd_runs_on_the_models_arfit_fitted() {
     refuse(
         &serde_json::to_string(&f).unwrap(),
         &["accel_x_m_s2", "order 3"],
+    );
+    // A quantity mismatch reads as a sentence, not as the enum's variants.
+    let mut f = file.clone();
+    let accel_x = f.models.iter_mut().find(|m| m.sensor == "accel_x_m_s2");
+    accel_x.unwrap().quantity = ArQuantity::AngularRate;
+    refuse(
+        &serde_json::to_string(&f).unwrap(),
+        &["accel_x_m_s2: the file has an angular rate where accel x needs a specific force"],
     );
     let mut f = file.clone();
     f.models[1].sensor = "accel_z_m_s2".into();

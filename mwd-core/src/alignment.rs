@@ -217,6 +217,29 @@ pub enum AlignmentError {
     NoHeadingInformation,
 }
 
+impl core::fmt::Display for AlignmentError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::SegmentCount => write!(
+                f,
+                "an alignment takes 1 to {MAX_SEGMENTS} static segments (toolface positions)"
+            ),
+            Self::InvalidData => {
+                f.write_str("a static segment has no samples, or its mean is not a finite number")
+            }
+            Self::NotStatic => f.write_str(
+                "the measured specific force is far from gravity: the tool is not at rest",
+            ),
+            Self::NoHeadingInformation => f.write_str(
+                "the gyros see no horizontal earth rate (at a pole, or with a single \
+                 vertical gyro), so the heading cannot be determined",
+            ),
+        }
+    }
+}
+
+impl core::error::Error for AlignmentError {}
+
 /// Levelling (eq. 27-28) of one segment with its uncertainty.
 pub fn level_segment(
     segment: &StaticSegment,

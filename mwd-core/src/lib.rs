@@ -9,8 +9,7 @@
 //! * Navigation: [`attitude`], [`mechanization`], coarse [`alignment`].
 //! * The filter: [`kalman`] (the generic machinery, a leaf),
 //!   [`error_model`] (the 33/39-state model), [`aid_sources`] (one file per
-//!   measurement), [`fine_alignment`] (the closed loop);
-//!   `observability` on the host (`std` feature).
+//!   measurement), [`fine_alignment`] (the closed loop).
 //! * The probe's navigation, raw sample to solution: [`probe`].
 //! * The wire protocol: [`protocol`].
 #![no_std]
@@ -27,8 +26,6 @@ pub mod error_model;
 pub mod fine_alignment;
 pub mod kalman;
 pub mod mechanization;
-#[cfg(feature = "std")]
-pub mod observability;
 pub mod probe;
 pub mod probe_sample;
 pub mod protocol;

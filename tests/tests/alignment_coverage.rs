@@ -4,16 +4,14 @@
 //! answer.
 use host_sim::coarse;
 use host_sim::samples_csv::Record;
-use host_sim::sim::{
-    DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL,
-};
+use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory};
 use mwd_core::alignment::{AlignmentConfig, COVERAGE_FACTOR, MAX_DETERMINED_SIGMA};
-use mwd_core::conventions::{wrap_pi, Euler};
+use mwd_core::conventions::{wrap_pi, Euler, DEG};
 use mwd_core::earth::Position;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
 const TRIALS: u64 = 200;
 
 struct Trial {
@@ -33,12 +31,12 @@ struct Trial {
 }
 
 fn run_trial(trajectory: Trajectory, seconds: f64, seed: u64, prior: Option<f64>) -> Trial {
-    let n = (seconds / SAMPLE_INTERVAL).round() as usize;
+    let n = (seconds / SAMPLE_INTERVAL_S).round() as usize;
     let cal = DeterministicErrors::paper_table3().calibration();
     let records: Vec<Record> = SensorSimulator::new(
         trajectory.clone(),
         SensorModel::scc1300(seed),
-        SAMPLE_INTERVAL,
+        SAMPLE_INTERVAL_S,
     )
     .take(n)
     .map(|s| coarse::calibrated(&Record::from(&s), &cal))

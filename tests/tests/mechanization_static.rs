@@ -2,12 +2,11 @@
 //! (x and z gyros, tool-axis rate derived from accelerometer roll) and the
 //! strapdown mechanization: it must stay put (requirement: under 1 mm and
 //! 1e-6 m/s over 60 s).
-use host_sim::sim::{SensorModel, SensorSimulator, Trajectory, SAMPLE_INTERVAL};
-use mwd_core::conventions::{quat_from_euler, Euler};
+use host_sim::sim::{SensorModel, SensorSimulator, Trajectory};
+use mwd_core::conventions::{quat_from_euler, Euler, DEG};
 use mwd_core::mechanization::{NavState, ProbeInput, Strapdown, ToolAxisSource};
 use mwd_core::probe_sample::ProbeSample;
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 
 #[test]
 fn simulated_static_probe_stays_put_for_a_minute() {
@@ -19,14 +18,15 @@ fn simulated_static_probe_stays_put_for_a_minute() {
         let truth = Euler::new(roll * DEG, pitch * DEG, heading * DEG);
         let trajectory = Trajectory::paper_static(truth);
         let start = NavState::at_rest(quat_from_euler(&truth), trajectory.position);
-        let mut nav = Strapdown::new(start, SAMPLE_INTERVAL);
+        let mut nav = Strapdown::new(start, SAMPLE_INTERVAL_S);
         let mut input = ProbeInput::new();
-        for s in SensorSimulator::new(trajectory, SensorModel::ideal(), SAMPLE_INTERVAL).take(1200)
+        for s in
+            SensorSimulator::new(trajectory, SensorModel::ideal(), SAMPLE_INTERVAL_S).take(1200)
         {
             let probe = ProbeSample::new(s.gyro.x, s.gyro.z, s.accel);
             let source = ToolAxisSource::AccelerometerRoll;
             let frame_rate = nav.frame_rate_in_body();
-            let (sample, _) = input.imu_sample(&frame_rate, &probe, source, SAMPLE_INTERVAL);
+            let (sample, _) = input.imu_sample(&frame_rate, &probe, source, SAMPLE_INTERVAL_S);
             nav.step(&sample);
         }
         let end = nav.state();

@@ -12,6 +12,7 @@
 //! ```
 
 use super::arfit::{ArFit, ArMethod};
+use super::units::Quantity;
 use anyhow::{bail, Context, Result};
 use mwd_core::ar::{Ar4, ArModel};
 use mwd_core::error_model::AugmentedModel;
@@ -33,6 +34,26 @@ pub enum ArQuantity {
     AngularRate,
     /// Unknown unit: variance in the input unit squared.
     Other,
+}
+
+impl std::fmt::Display for ArQuantity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::SpecificForce => "a specific force",
+            Self::AngularRate => "an angular rate",
+            Self::Other => "a quantity of unknown unit",
+        })
+    }
+}
+
+impl From<Quantity> for ArQuantity {
+    fn from(quantity: Quantity) -> Self {
+        match quantity {
+            Quantity::AngularRate => Self::AngularRate,
+            Quantity::SpecificForce => Self::SpecificForce,
+            Quantity::Other => Self::Other,
+        }
+    }
 }
 
 impl ArQuantity {
@@ -341,7 +362,7 @@ impl ArModelFile {
             };
             if entry.quantity != axis.quantity {
                 bail!(
-                    "sensor {}: the file says {:?} where {} needs {:?} (fit it with SI \
+                    "sensor {}: the file has {} where {} needs {} (fit it with SI \
                      units, e.g. `--units auto` on `_m_s2` / `_rad_s` columns)",
                     entry.sensor,
                     entry.quantity,
@@ -498,7 +519,7 @@ mod tests {
         assert!(err(&f, true).contains("not stationary"));
         let mut f = probe_file();
         f.models[1].quantity = ArQuantity::Other;
-        assert!(err(&f, true).contains("needs AngularRate"));
+        assert!(err(&f, true).contains("needs an angular rate"));
     }
 
     #[test]

@@ -24,6 +24,18 @@ pub enum ArMethod {
     Covariance,
 }
 
+/// The method's name in the reports' tables (the file and the command line
+/// spell it `yule-walker`, `burg`, `covariance`).
+impl std::fmt::Display for ArMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::YuleWalker => "YuleWalker",
+            Self::Burg => "Burg",
+            Self::Covariance => "Covariance",
+        })
+    }
+}
+
 /// One fitted AR(p) model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ArFit {

@@ -32,6 +32,20 @@ pub enum Face {
     ZDown,
 }
 
+/// The position's name in the calibration report.
+impl std::fmt::Display for Face {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::XUp => "XUp",
+            Self::XDown => "XDown",
+            Self::YUp => "YUp",
+            Self::YDown => "YDown",
+            Self::ZUp => "ZUp",
+            Self::ZDown => "ZDown",
+        })
+    }
+}
+
 impl Face {
     /// All six, in file-code order.
     pub const ALL: [Face; 6] = [
@@ -42,6 +56,11 @@ impl Face {
         Face::ZUp,
         Face::ZDown,
     ];
+
+    /// Its code in the `position` column, 1..=6.
+    pub fn code(self) -> usize {
+        Self::ALL.iter().position(|&f| f == self).unwrap_or(0) + 1
+    }
 
     /// The face of a file code 1..=6.
     pub fn from_code(code: f64) -> Option<Face> {
@@ -94,7 +113,8 @@ pub fn position_means(positions: &[f64], columns: &[&[f64]]) -> Result<Vec<Posit
     for (face, idx) in Face::ALL.iter().zip(&rows) {
         if idx.len() < 2 {
             bail!(
-                "position {face:?} has {} samples; each of the six needs at least 2",
+                "position {} ({face}) has {} samples; each of the six needs at least 2",
+                face.code(),
                 idx.len()
             );
         }
@@ -235,6 +255,9 @@ mod tests {
         assert_eq!(Face::from_code(7.0), None);
         assert_eq!(Face::ZDown.reference_force(9.8), [0.0, 0.0, -9.8]);
         assert_eq!(Face::XUp.axis(), (0, 1.0));
+        for (i, face) in Face::ALL.iter().enumerate() {
+            assert_eq!(Face::from_code(face.code() as f64), Some(*face), "{i}");
+        }
     }
 
     #[test]
@@ -249,7 +272,8 @@ mod tests {
 
     #[test]
     fn earth_rate_at_the_paper_site() {
-        let up = earth_rate_up(45.77755f64.to_radians());
-        assert!((up - 7.292115e-5 * 45.77755f64.to_radians().sin()).abs() < 1e-15);
+        let lat = mwd_core::earth::Position::paper_site().lat;
+        let up = earth_rate_up(lat);
+        assert!((up - 7.292115e-5 * lat.sin()).abs() < 1e-15);
     }
 }

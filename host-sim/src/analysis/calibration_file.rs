@@ -94,7 +94,10 @@ impl CalibrationFile {
                 .chain(t.correction.iter().flatten())
                 .all(|v| v.is_finite());
             if !finite {
-                bail!("triad {:?}: non-finite calibration value", t.columns);
+                bail!(
+                    "triad {}: a calibration value is not a finite number",
+                    t.columns.join(",")
+                );
             }
         }
         for g in &file.gyro {
@@ -155,7 +158,7 @@ mod tests {
             format: FORMAT.into(),
             version: VERSION,
             method: "tls".into(),
-            latitude_deg: 45.77755,
+            latitude_deg: mwd_core::earth::Position::paper_site().lat.to_degrees(),
             gravity: 9.806,
             accel: vec![TriadEntry {
                 columns: ["ax".into(), "ay".into(), "az".into()],

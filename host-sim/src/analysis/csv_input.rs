@@ -104,6 +104,17 @@ pub struct AnalysisInput {
     pub units: Vec<InputUnit>,
 }
 
+impl AnalysisInput {
+    /// The selected columns converted to SI: name, input unit, samples.
+    pub fn si_columns(&self) -> impl Iterator<Item = (&str, InputUnit, Vec<f64>)> + '_ {
+        self.selected.iter().zip(&self.units).map(|(&col, &unit)| {
+            let si = unit.to_si();
+            let samples = self.table.data[col].iter().map(|v| v * si).collect();
+            (self.table.names[col].as_str(), unit, samples)
+        })
+    }
+}
+
 /// Checks the sample rate, reads the file and selects the columns: the
 /// common start of `allan` and `arfit`.
 pub fn read_analysis_input(

@@ -3,17 +3,22 @@
 //! done in the host tool.
 //!
 //! - [`allan`], [`allan_fit`]: Allan deviation with confidence intervals and
-//!   the noise coefficients (random walk, bias instability, rate random walk).
+//!   the noise coefficients (random walk, bias instability, rate random walk);
+//!   [`allan_analysis`] runs them on a record's columns.
 //! - [`arfit`]: autocorrelation and AR(p) fitting (Yule-Walker, Burg,
-//!   covariance method), order selection, the model file the filter loads.
+//!   covariance method), order selection, the model file the filter loads;
+//!   [`ar_analysis`] runs them on a record's columns.
 //! - [`calibration`]: six-position calibration of accelerometer triads and
-//!   gyro biases (paper Table 3), by least squares or total least squares.
+//!   gyro biases (paper Table 3), by least squares or total least squares;
+//!   [`six_position`] runs it on a table's columns and makes the file.
 //! - [`tls`]: total least squares and Moore-Penrose reconstruction (TLS
 //!   paper eq. 14-23); [`paper_tls`] reproduces that paper's experiment.
 //! - [`csv_input`], [`plot`], [`stats`]: file input, SVG plots, chi-square.
 
 pub mod allan;
+pub mod allan_analysis;
 pub mod allan_fit;
+pub mod ar_analysis;
 pub mod ar_file;
 pub mod arfit;
 pub mod calibration;
@@ -21,6 +26,7 @@ pub mod calibration_file;
 pub mod csv_input;
 pub mod paper_tls;
 pub mod plot;
+pub mod six_position;
 pub mod stats;
 pub mod tls;
 pub mod units;

@@ -18,12 +18,10 @@
 
 use super::tls::{fit_row, FitMethod};
 use anyhow::Result;
+use mwd_core::sensor_units::STANDARD_GRAVITY as G;
 use nalgebra::{DMatrix, DVector, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
-
-/// Standard gravity for the paper's "1e-5 g".
-const G: f64 = 9.806_65;
 
 /// Set-up of the simulated experiment.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,8 +79,11 @@ pub fn error_percent(estimate: f64, truth: f64) -> f64 {
     100.0 * (estimate - truth).abs() / truth.abs()
 }
 
-/// The paper's Tables 1 and 2: (N, real w_z, before, after, error %).
-pub const PAPER_TABLE_1: [(usize, f64, f64, f64, f64); 8] = [
+/// A table of the paper: rows of (N, real w_z, before, after, error %).
+pub type PaperTable = [(usize, f64, f64, f64, f64); 8];
+
+/// The paper's Table 1 (coupling angle 0.001 rad).
+pub const PAPER_TABLE_1: PaperTable = [
     (10, 0.000499, 0.000815, 0.000548, 9.82),
     (50, 0.002397, 0.003683, 0.002550, 6.38),
     (100, 0.004207, 0.006736, 0.004452, 5.82),
@@ -93,7 +94,7 @@ pub const PAPER_TABLE_1: [(usize, f64, f64, f64, f64); 8] = [
     (500, -0.004794, 0.048781, -0.004648, 3.05),
 ];
 /// Table 2 (coupling angle 0.005 rad).
-pub const PAPER_TABLE_2: [(usize, f64, f64, f64, f64); 8] = [
+pub const PAPER_TABLE_2: PaperTable = [
     (10, 0.000499, 0.001879, 0.000574, 15.03),
     (50, 0.002397, 0.008616, 0.002605, 8.67),
     (100, 0.004207, 0.016490, 0.004549, 8.13),
@@ -269,6 +270,38 @@ pub fn monte_carlo(
         sums[2] += error_percent(row.after_ls, row.true_rate);
     }
     Ok(sums.map(|s| s / runs.max(1) as f64))
+}
+
+/// The paper's tables in order: coupling angle (rad) and published rows.
+pub const PAPER_TABLES: [(f64, PaperTable); 2] = [(0.001, PAPER_TABLE_1), (0.005, PAPER_TABLE_2)];
+
+/// One row of our Tables 1-2 beside the paper's.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct TableRow {
+    pub coupling_angle: f64,
+    /// Our run of the report's seed.
+    pub row: Row,
+    /// Mean error percent over the seeded runs: before, TLS, LS.
+    pub mean_error_percent_before_tls_ls: [f64; 3],
+    /// The paper's true rate, before, after and error percent.
+    pub paper: (f64, f64, f64, f64),
+}
+
+/// Every row of [`PAPER_TABLES`] ours: the run of `seed` and the mean
+/// errors over `runs` seeded runs.
+pub fn tables(exp: &Experiment, seed: u64, runs: usize) -> Result<Vec<TableRow>> {
+    let mut rows = Vec::new();
+    for (angle, paper) in PAPER_TABLES {
+        for (n, p_true, p_before, p_after, p_err) in paper {
+            rows.push(TableRow {
+                coupling_angle: angle,
+                row: run_once(exp, angle, n, seed)?,
+                mean_error_percent_before_tls_ls: monte_carlo(exp, angle, n, runs, seed)?,
+                paper: (p_true, p_before, p_after, p_err),
+            });
+        }
+    }
+    Ok(rows)
 }
 
 #[cfg(test)]

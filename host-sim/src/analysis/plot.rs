@@ -1,8 +1,10 @@
-//! Log-log SVG plots (plotters' SVG backend, no fonts needed): measured
-//! points with vertical error bars, and model lines.
+//! SVG plots (plotters' SVG backend, no fonts needed): log-log plots of
+//! measured points with vertical error bars and model lines, and plain
+//! line plots of time series.
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
+use std::ops::Range;
 use std::path::Path;
 
 /// How a series is drawn.
@@ -128,6 +130,61 @@ pub fn loglog_svg(path: &Path, labels: &Labels, series: &[Series]) -> Result<()>
     Ok(())
 }
 
+/// A named curve of a line plot: legend label and points (x, y).
+pub type Curve<'a> = (&'a str, Vec<(f64, f64)>);
+
+/// Writes a line plot of `curves` over `x_range` to an SVG file; the y
+/// axis spans the finite values with a 5 % margin.
+pub fn line_svg(path: &Path, labels: &Labels, x_range: Range<f64>, curves: &[Curve]) -> Result<()> {
+    let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (_, pts) in curves {
+        for &(_, v) in pts.iter().filter(|p| p.1.is_finite()) {
+            y0 = y0.min(v);
+            y1 = y1.max(v);
+        }
+    }
+    // Nothing finite, or a flat line: give the axis a unit span.
+    if y0.is_nan() || y1.is_nan() || y0 >= y1 {
+        y0 = if y0.is_finite() { y0 } else { 0.0 };
+        y1 = y0 + 1.0;
+    }
+    let pad = 0.05 * (y1 - y0);
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(labels.title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range, (y0 - pad)..(y1 + pad))
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.x)
+        .y_desc(labels.y)
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (i, (name, pts)) in curves.iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))
+            .map_err(|e| err(&e))?
+            .label(*name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -182,6 +239,24 @@ mod tests {
             &[empty]
         )
         .is_err());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn line_plots_survive_flat_and_non_finite_series() {
+        let dir = std::env::temp_dir().join(format!("line-plot-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("l.svg");
+        let labels = Labels {
+            title: "flat",
+            x: "time (s)",
+            y: "deg",
+        };
+        let flat = vec![(0.0, 2.0), (1.0, 2.0), (2.0, f64::NAN)];
+        let none = vec![(0.0, f64::INFINITY)];
+        line_svg(&path, &labels, 0.0..2.0, &[("flat", flat), ("none", none)]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("<svg") && text.contains("flat"));
         std::fs::remove_dir_all(&dir).ok();
     }
 }

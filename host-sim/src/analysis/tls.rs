@@ -27,6 +27,16 @@ pub enum FitMethod {
     Tls,
 }
 
+/// The method as the command line and the calibration file name it.
+impl std::fmt::Display for FitMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Ls => "ls",
+            Self::Tls => "tls",
+        })
+    }
+}
+
 /// Classic TLS solution of `A x ~ b` (eq. 14-19): the right singular vector
 /// v of `[A | b]` for the smallest singular value gives x = -v[..n] / v[n].
 pub fn tls_solve(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {

@@ -3,12 +3,12 @@
 //! (deg/sqrt(h), deg/h; m/s/sqrt(h), m/s^2) only when printed.
 
 use anyhow::{bail, Result};
+use mwd_core::conventions::DEG;
+// Inputs given in g or mg are in standard gravities (ISO 80000-3).
+use mwd_core::sensor_units::STANDARD_GRAVITY;
 
-/// Standard gravity (m/s^2) for inputs given in g or mg (ISO 80000-3).
-pub use mwd_core::sensor_units::STANDARD_GRAVITY;
-
-/// Unit of an input column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Unit of an input column (`allan --json` writes its variant name).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum InputUnit {
     /// rad/s (SI angular rate).
     RadPerS,
@@ -71,11 +71,10 @@ impl InputUnit {
 
     /// Factor from this unit to SI.
     pub fn to_si(self) -> f64 {
-        let deg = std::f64::consts::PI / 180.0;
         match self {
             Self::RadPerS | Self::MPerS2 | Self::Raw => 1.0,
-            Self::DegPerS => deg,
-            Self::DegPerH => deg / 3600.0,
+            Self::DegPerS => DEG,
+            Self::DegPerH => DEG / 3600.0,
             Self::G => STANDARD_GRAVITY,
             Self::MilliG => STANDARD_GRAVITY * 1e-3,
         }
@@ -104,20 +103,19 @@ pub struct Reported {
 /// walk (SI unit * sqrt(s)), bias instability (SI unit), rate random walk
 /// (SI unit / sqrt(s)) and the deviation itself.
 pub fn report_noise(q: Quantity, random_walk: f64, bias: f64, rrw: f64) -> [Reported; 3] {
-    let to_deg = 180.0 / std::f64::consts::PI;
     // sqrt(3600 s) = 60 sqrt(s): x / sqrt(s) = 60 x / sqrt(h).
     match q {
         Quantity::AngularRate => [
             Reported {
-                value: random_walk * to_deg * 60.0,
+                value: random_walk.to_degrees() * 60.0,
                 unit: "deg/sqrt(h)",
             },
             Reported {
-                value: bias * to_deg * 3600.0,
+                value: bias.to_degrees() * 3600.0,
                 unit: "deg/h",
             },
             Reported {
-                value: rrw * to_deg * 3600.0 * 60.0,
+                value: rrw.to_degrees() * 3600.0 * 60.0,
                 unit: "deg/h/sqrt(h)",
             },
         ],
@@ -155,7 +153,7 @@ pub fn report_noise(q: Quantity, random_walk: f64, bias: f64, rrw: f64) -> [Repo
 /// Unit of the Allan deviation itself in reports, and the factor from SI.
 pub fn deviation_unit(q: Quantity) -> (&'static str, f64) {
     match q {
-        Quantity::AngularRate => ("deg/h", 180.0 / std::f64::consts::PI * 3600.0),
+        Quantity::AngularRate => ("deg/h", 3600.0 / DEG),
         Quantity::SpecificForce => ("m/s^2", 1.0),
         Quantity::Other => ("u", 1.0),
     }
@@ -170,7 +168,7 @@ mod tests {
         assert_eq!(InputUnit::parse("DEG/S").unwrap(), InputUnit::DegPerS);
         assert!(InputUnit::parse("furlong").is_err());
         // 1 deg/sqrt(h) = (pi/180) / 60 rad/sqrt(s).
-        let n = std::f64::consts::PI / 180.0 / 60.0;
+        let n = DEG / 60.0;
         let r = report_noise(Quantity::AngularRate, n, 0.0, 0.0);
         assert!((r[0].value - 1.0).abs() < 1e-12);
         assert!((InputUnit::MilliG.to_si() - 9.80665e-3).abs() < 1e-15);

@@ -2,14 +2,16 @@
 use anyhow::{bail, Context, Result};
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::coarse;
-use host_sim::samples_csv;
-use host_sim::sim::{DeterministicErrors, SensorModelFile, SAMPLE_INTERVAL};
+use host_sim::samples_csv::{self, Record};
+use host_sim::sim::{DeterministicErrors, SensorModel, SensorModelFile};
 use mwd_core::alignment::AlignmentConfig;
 use mwd_core::calibration::ProbeCalibration;
+use mwd_core::conventions::DEG;
 use mwd_core::sensor_noise::ImuNoise;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 use std::path::PathBuf;
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
+use super::site::SiteArgs;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum CalibrationKind {
@@ -25,9 +27,9 @@ pub enum CalibrationKind {
 pub struct Args {
     /// Sample CSV (as written by `host-sim simulate`).
     pub file: PathBuf,
-    /// Latitude of the site, degrees.
-    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
-    pub lat: f64,
+    /// The site (coarse alignment uses its latitude).
+    #[command(flatten)]
+    pub site: SiteArgs,
     /// Rough heading (degrees) to choose between ambiguous candidates, e.g.
     /// the parent well's survey.
     #[arg(long, allow_hyphen_values = true)]
@@ -52,33 +54,12 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let file = std::fs::File::open(&args.file)
-        .with_context(|| format!("opening {}", args.file.display()))?;
-    let mut records = samples_csv::read(std::io::BufReader::new(file))
-        .with_context(|| format!("reading {}", args.file.display()))?;
-    if let Some(first) = args.first {
-        let keep = (first / SAMPLE_INTERVAL).round() as usize;
-        if keep == 0 {
-            bail!("--first {first} keeps no sample");
-        }
-        records.truncate(keep);
-    }
+    let records = read_records(&args)?;
     let model = match &args.sensor_model {
         Some(path) => Some(SensorModelFile::load(path, 0)?),
         None => None,
     };
-    let cal = if let Some(path) = &args.calibration_file {
-        CalibrationFile::load(path)?.to_probe()
-    } else {
-        match (args.calibration, &model) {
-            (CalibrationKind::Paper, _) => DeterministicErrors::paper_table3().calibration(),
-            (CalibrationKind::None, _) => ProbeCalibration::default(),
-            (CalibrationKind::Model, Some(m)) => m.deterministic.calibration(),
-            (CalibrationKind::Model, None) => {
-                bail!("--calibration model needs --sensor-model FILE")
-            }
-        }
-    };
+    let cal = calibration(&args, model.as_ref())?;
     let noise = match (&model, args.noise_free) {
         (Some(m), _) => m.noise,
         (None, true) => ImuNoise::NONE,
@@ -90,11 +71,43 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     let config = AlignmentConfig {
         noise,
-        ..AlignmentConfig::probe(args.lat * DEG)
+        ..AlignmentConfig::probe(args.site.position().lat)
     }
     .with_heading_prior(args.prior_heading.map(|h| h * DEG));
     let spans = coarse::find_segments(&records);
     let report = coarse::align(&records, &spans, &config)?;
     print!("{}", report.render());
     Ok(())
+}
+
+/// The file's samples, or its first `--first` seconds.
+fn read_records(args: &Args) -> Result<Vec<Record>> {
+    let file = std::fs::File::open(&args.file)
+        .with_context(|| format!("opening {}", args.file.display()))?;
+    let mut records = samples_csv::read(std::io::BufReader::new(file))
+        .with_context(|| format!("reading {}", args.file.display()))?;
+    if let Some(first) = args.first {
+        let keep = (first / SAMPLE_INTERVAL_S).round() as usize;
+        if keep == 0 {
+            bail!("--first {first} keeps no sample");
+        }
+        records.truncate(keep);
+    }
+    Ok(records)
+}
+
+/// The correction applied before aligning: `--calibration-file`, else
+/// `--calibration` (`model` needs the sensor model's errors).
+fn calibration(args: &Args, model: Option<&SensorModel>) -> Result<ProbeCalibration> {
+    if let Some(path) = &args.calibration_file {
+        return Ok(CalibrationFile::load(path)?.to_probe());
+    }
+    Ok(match (args.calibration, model) {
+        (CalibrationKind::Paper, _) => DeterministicErrors::paper_table3().calibration(),
+        (CalibrationKind::None, _) => ProbeCalibration::default(),
+        (CalibrationKind::Model, Some(m)) => m.deterministic.calibration(),
+        (CalibrationKind::Model, None) => {
+            bail!("--calibration model needs --sensor-model FILE")
+        }
+    })
 }

@@ -1,16 +1,25 @@
 //! `host-sim allan FILE --rate HZ [--json]`: overlapping Allan deviation of
 //! every column of a static record, with confidence intervals, the fitted
-//! noise coefficients and a log-log SVG plot.
+//! noise coefficients and a log-log SVG plot. The analysis is
+//! `host_sim::analysis::allan_analysis`'s; this module reads the options
+//! and reports.
 
+use super::print_out;
 use anyhow::{bail, Result};
-use host_sim::analysis::allan::{allan_deviation, averaging_factors, AllanPoint, TauSet};
-use host_sim::analysis::allan_fit::{bias_instability_factor, fit_noise, NoiseCoefficients};
+use host_sim::analysis::allan::TauSet;
+use host_sim::analysis::allan_analysis::{analyse_columns, work, AllanReport, SensorAllan};
+use host_sim::analysis::allan_fit::bias_instability_factor;
 use host_sim::analysis::csv_input::{read_analysis_input, AnalysisInput};
 use host_sim::analysis::plot::{loglog_svg, Labels, Series, Style};
-use host_sim::analysis::units::{deviation_unit, report_noise, Quantity, Reported};
+use host_sim::analysis::units::{deviation_unit, Quantity};
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::Serialize;
 use std::path::PathBuf;
+
+/// Longest record `--all-taus` takes: every tau costs O(n), all n/2 of
+/// them would take hours on a long record.
+const ALL_TAUS_LIMIT: usize = 100_000;
+/// Work (sample visits) beyond which a progress bar is worth showing.
+const PROGRESS_WORK: u64 = 5_000_000;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -41,43 +50,37 @@ pub struct Args {
     pub no_plot: bool,
 }
 
-#[derive(Serialize)]
-struct SensorReport {
-    name: String,
-    input_unit: String,
-    /// Unit of `tau` is s; of `oadev`, `adev` and the intervals this one.
-    oadev_unit: &'static str,
-    samples: usize,
-    /// Allan deviations in SI units (rad/s or m/s^2) or the raw unit.
-    points: Vec<AllanPoint>,
-    /// Noise coefficients in SI units.
-    fit: NoiseCoefficients,
-    /// The same in report units: random walk, bias instability, rate random walk.
-    report: [Reported; 3],
-}
-
-#[derive(Serialize)]
-struct Report {
-    file: String,
-    rate_hz: f64,
-    bias_instability_factor: f64,
-    sensors: Vec<SensorReport>,
-}
-
 pub fn run(args: Args) -> Result<()> {
-    let AnalysisInput {
-        table,
-        selected,
-        units,
-    } = read_analysis_input(&args.file, args.rate, args.columns.as_deref(), &args.units)?;
-    let set = if args.all_taus {
-        TauSet::All
+    let input = read_analysis_input(&args.file, args.rate, args.columns.as_deref(), &args.units)?;
+    let set = tau_set(&args, &input)?;
+    let bar = progress_bar(work(&input, set));
+    let sensors = analyse_columns(
+        &input,
+        args.rate,
+        set,
+        |name| bar.set_message(name.to_string()),
+        |k| bar.inc(k),
+    );
+    bar.finish_and_clear();
+    if !args.no_plot {
+        let path = args
+            .plot
+            .clone()
+            .unwrap_or_else(|| args.file.with_extension("allan.svg"));
+        plot(&path, &sensors)?;
+        eprintln!("plot written to {}", path.display());
+    }
+    let report = AllanReport::new(args.file.display().to_string(), args.rate, sensors);
+    if args.json {
+        print_out(&(serde_json::to_string_pretty(&report)? + "\n"))
     } else {
-        TauSet::Octave
-    };
-    let n = table.rows();
-    // Every tau costs O(n): all n/2 of them would take hours on a long record.
-    const ALL_TAUS_LIMIT: usize = 100_000;
+        print_out(&tables(&report))
+    }
+}
+
+/// Octave taus, or with `--all-taus` every one (on a record short enough).
+fn tau_set(args: &Args, input: &AnalysisInput) -> Result<TauSet> {
+    let n = input.table.rows();
     if args.all_taus && n > ALL_TAUS_LIMIT {
         bail!("--all-taus on {n} samples is O(n^2); use it on at most {ALL_TAUS_LIMIT} samples (octave taus have no limit)");
     }
@@ -87,8 +90,16 @@ pub fn run(args: Args) -> Result<()> {
             args.file.display()
         );
     }
-    let work = (selected.len() * averaging_factors(n, set).len()) as u64 * n as u64;
-    let bar = if work > 5_000_000 {
+    Ok(if args.all_taus {
+        TauSet::All
+    } else {
+        TauSet::Octave
+    })
+}
+
+/// A progress bar for long analyses, a hidden one for short ones.
+fn progress_bar(work: u64) -> ProgressBar {
+    let bar = if work > PROGRESS_WORK {
         ProgressBar::new(work)
     } else {
         ProgressBar::hidden()
@@ -97,69 +108,14 @@ pub fn run(args: Args) -> Result<()> {
         ProgressStyle::with_template("{msg:>8} [{bar:40}] {percent:>3}% {elapsed}/{eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let mut sensors = Vec::new();
-    for (&col, unit) in selected.iter().zip(&units) {
-        bar.set_message(table.names[col].clone());
-        let y: Vec<f64> = table.data[col].iter().map(|v| v * unit.to_si()).collect();
-        let points = allan_deviation(&y, args.rate, set, |k| bar.inc(k));
-        let fit = fit_noise(&points);
-        let report = report_noise(
-            unit.quantity(),
-            fit.random_walk,
-            fit.bias_instability,
-            fit.rate_random_walk,
-        );
-        sensors.push(SensorReport {
-            name: table.names[col].clone(),
-            input_unit: format!("{unit:?}"),
-            oadev_unit: match unit.quantity() {
-                Quantity::AngularRate => "rad/s",
-                Quantity::SpecificForce => "m/s^2",
-                Quantity::Other => "input unit",
-            },
-            samples: n,
-            points,
-            fit,
-            report,
-        });
-    }
-    bar.finish_and_clear();
-    let units_q: Vec<_> = units.iter().map(|u| u.quantity()).collect();
-    if !args.no_plot {
-        let path = args
-            .plot
-            .clone()
-            .unwrap_or_else(|| args.file.with_extension("allan.svg"));
-        plot(&path, &sensors, &units_q)?;
-        eprintln!("plot written to {}", path.display());
-    }
-    let report = Report {
-        file: args.file.display().to_string(),
-        rate_hz: args.rate,
-        bias_instability_factor: bias_instability_factor(),
-        sensors,
-    };
-    if args.json {
-        print_out(&(serde_json::to_string_pretty(&report)? + "\n"))?;
-    } else {
-        print_out(&tables(&report, &units_q))?;
-    }
-    Ok(())
+    bar
 }
 
-/// Prints to stdout; a closed pipe (`| head`) ends the output quietly.
-pub fn print_out(text: &str) -> Result<()> {
-    use std::io::Write;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => Ok(other?),
-    }
-}
-
-fn tables(report: &Report, quantities: &[Quantity]) -> String {
+fn tables(report: &AllanReport) -> String {
     use std::fmt::Write;
     let mut out = String::new();
-    for (s, &q) in report.sensors.iter().zip(quantities) {
+    for s in &report.sensors {
+        let q = s.quantity();
         let (unit, k) = deviation_unit(q);
         let _ = writeln!(
             out,
@@ -204,11 +160,12 @@ fn tables(report: &Report, quantities: &[Quantity]) -> String {
     out
 }
 
-fn plot(path: &std::path::Path, sensors: &[SensorReport], quantities: &[Quantity]) -> Result<()> {
+/// The log-log plot: each sensor's deviations with their intervals, and
+/// the fitted noise terms in its colour.
+fn plot(path: &std::path::Path, sensors: &[SensorAllan]) -> Result<()> {
     let mut series = Vec::new();
-    for (i, (s, &q)) in sensors.iter().zip(quantities).enumerate() {
-        let (_, k) = deviation_unit(q);
-        let taus: Vec<f64> = s.points.iter().map(|p| p.tau).collect();
+    for (colour, s) in sensors.iter().enumerate() {
+        let (_, k) = deviation_unit(s.quantity());
         series.push(Series {
             name: s.name.clone(),
             points: s.points.iter().map(|p| (p.tau, p.oadev * k)).collect(),
@@ -218,39 +175,48 @@ fn plot(path: &std::path::Path, sensors: &[SensorReport], quantities: &[Quantity
                 .map(|p| (p.ci_low * k, p.ci_high * k))
                 .collect(),
             style: Style::Markers,
-            colour: i,
+            colour,
         });
-        let names = [
-            "quantization",
-            "random walk",
-            "bias instability",
-            "rate random walk",
-        ];
-        for (term, name) in names.iter().enumerate() {
-            let pts: Vec<(f64, f64)> = taus
-                .iter()
-                .map(|&t| (t, s.fit.terms_at(t)[term] * k))
-                .collect();
-            if pts.iter().any(|p| p.1 > 0.0) {
-                series.push(Series {
-                    name: format!("{} fit: {name}", s.name),
-                    points: pts,
-                    error_bars: vec![],
-                    style: Style::Line,
-                    colour: i,
-                });
-            }
+        series.extend(fit_terms(s, k, colour));
+    }
+    let units: Vec<&str> = sensors
+        .iter()
+        .map(|s| deviation_unit(s.quantity()).0)
+        .collect();
+    let y = format!("overlapping Allan deviation ({})", units.join(", "));
+    let labels = Labels {
+        title: "Allan deviation",
+        x: "tau (s)",
+        y: &y,
+    };
+    loglog_svg(path, &labels, &series)
+}
+
+/// The noise terms of a sensor's fit at its taus, scaled by `k`; terms
+/// that are zero throughout are left out.
+fn fit_terms(s: &SensorAllan, k: f64, colour: usize) -> Vec<Series> {
+    let names = [
+        "quantization",
+        "random walk",
+        "bias instability",
+        "rate random walk",
+    ];
+    let mut series = Vec::new();
+    for (term, name) in names.iter().enumerate() {
+        let points: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .map(|p| (p.tau, s.fit.terms_at(p.tau)[term] * k))
+            .collect();
+        if points.iter().any(|p| p.1 > 0.0) {
+            series.push(Series {
+                name: format!("{} fit: {name}", s.name),
+                points,
+                error_bars: vec![],
+                style: Style::Line,
+                colour,
+            });
         }
     }
-    let units: Vec<&str> = quantities.iter().map(|&q| deviation_unit(q).0).collect();
-    let y = format!("overlapping Allan deviation ({})", units.join(", "));
-    loglog_svg(
-        path,
-        &Labels {
-            title: "Allan deviation",
-            x: "tau (s)",
-            y: &y,
-        },
-        &series,
-    )
+    series
 }

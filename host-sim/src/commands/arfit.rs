@@ -1,15 +1,18 @@
 //! `host-sim arfit FILE --rate HZ`: autocorrelation, AR(p) fits by the
 //! three methods in the paper's sign convention (Tables 4-5), order
-//! selection help, and the model file the filter loads.
+//! selection help, and the model file the filter loads. The analysis is
+//! `host_sim::analysis::ar_analysis`'s; this module reads the options and
+//! reports.
 
-use super::allan::print_out;
-use anyhow::{Context, Result};
-use host_sim::analysis::ar_file::{ArModelEntry, ArModelFile, ArQuantity};
-use host_sim::analysis::arfit::{autocorrelation, fit_ar, order_scores, ArFit, ArMethod};
-use host_sim::analysis::csv_input::{read_analysis_input, AnalysisInput};
-use host_sim::analysis::units::{InputUnit, Quantity};
+use super::print_out;
+use anyhow::Result;
+use host_sim::analysis::ar_analysis::{analyse_columns, model_file, ArOptions, ColumnAr};
+use host_sim::analysis::arfit::{ArFit, ArMethod};
+use host_sim::analysis::csv_input::read_analysis_input;
+use host_sim::analysis::units::Quantity;
+use mwd_core::conventions::DEG;
 use std::fmt::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -48,32 +51,57 @@ pub struct Args {
     pub json: bool,
 }
 
-const METHODS: [ArMethod; 3] = [ArMethod::YuleWalker, ArMethod::Burg, ArMethod::Covariance];
-
-fn quantity_of(unit: InputUnit) -> ArQuantity {
-    match unit.quantity() {
-        Quantity::AngularRate => ArQuantity::AngularRate,
-        Quantity::SpecificForce => ArQuantity::SpecificForce,
-        Quantity::Other => ArQuantity::Other,
+pub fn run(args: Args) -> Result<()> {
+    let input = read_analysis_input(&args.file, args.rate, args.columns.as_deref(), &args.units)?;
+    let options = ArOptions {
+        order: args.order,
+        method: args.method,
+        max_order: args.max_order,
+        lags: args.lags,
+        demean: !args.no_demean,
+    };
+    let columns = analyse_columns(&input, &options)?;
+    let path = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.file.with_extension("ar.json"));
+    model_file(&columns, args.method, args.rate).save(&path)?;
+    if args.json {
+        let fits: Vec<(&str, &ArFit)> = columns
+            .iter()
+            .flat_map(|c| c.fits.iter().map(|f| (c.name.as_str(), f)))
+            .collect();
+        print_out(&(serde_json::to_string_pretty(&fits)? + "\n"))
+    } else {
+        print_out(&report(&columns, &options, &path))
     }
 }
 
-pub fn run(args: Args) -> Result<()> {
-    let AnalysisInput {
-        table,
-        selected,
-        units,
-    } = read_analysis_input(&args.file, args.rate, args.columns.as_deref(), &args.units)?;
-    let demean = !args.no_demean;
+/// The fits table, each column's autocorrelation and order scores, and
+/// where the model file went.
+fn report(columns: &[ColumnAr], options: &ArOptions, path: &Path) -> String {
     let mut out = String::new();
-    let mut entries = Vec::new();
-    let mut all_fits: Vec<(String, ArFit)> = Vec::new();
+    fits_table(&mut out, columns, options.order);
+    for column in columns {
+        order_table(&mut out, column, options);
+    }
     let _ = writeln!(
         out,
-        "AR({}) fits, paper convention z_k = -sum a_i z_(k-i) + e_k, beta = var(e)",
-        args.order
+        "\nmodel file ({}, order {}) written to {}",
+        options.method,
+        options.order,
+        path.display()
     );
-    let header: String = (1..=args.order)
+    out
+}
+
+/// Every column's fits by every method, like the paper's Tables 4-5.
+fn fits_table(out: &mut String, columns: &[ColumnAr], order: usize) {
+    let _ = writeln!(
+        out,
+        "AR({order}) fits, paper convention z_k = -sum a_i z_(k-i) + e_k, beta = var(e)"
+    );
+    let header: String = (1..=order)
         .map(|i| format!("{:>10}", format!("a{i}")))
         .collect();
     let _ = writeln!(
@@ -81,98 +109,61 @@ pub fn run(args: Args) -> Result<()> {
         "{:<14} {:<12}{header} {:>13} {:>13}",
         "sensor", "method", "beta (SI)", "beta (report)"
     );
-    for (&col, &unit) in selected.iter().zip(&units) {
-        let name = &table.names[col];
-        let x: Vec<f64> = table.data[col].iter().map(|v| v * unit.to_si()).collect();
-        for method in METHODS {
-            let fit =
-                fit_ar(&x, args.order, method, demean).with_context(|| format!("column {name}"))?;
+    for column in columns {
+        for fit in &column.fits {
             let coeffs: String = fit
                 .coefficients
                 .iter()
                 .map(|a| format!("{a:>10.4}"))
                 .collect();
-            let (report, report_unit) = match unit.quantity() {
+            let (report, report_unit) = match column.unit.quantity() {
                 // The paper's Table 5 betas are (deg/s)^2 (project assumption).
-                Quantity::AngularRate => (
-                    fit.noise_variance * (180.0 / std::f64::consts::PI).powi(2),
-                    "(deg/s)^2",
-                ),
+                Quantity::AngularRate => (fit.noise_variance * (1.0 / DEG).powi(2), "(deg/s)^2"),
                 Quantity::SpecificForce => (fit.noise_variance, "(m/s^2)^2"),
                 Quantity::Other => (fit.noise_variance, "u^2"),
             };
             let _ = writeln!(
                 out,
-                "{name:<14} {:<12}{coeffs} {:>13.4e} {:>9.4e} {report_unit}",
-                format!("{method:?}"),
+                "{:<14} {:<12}{coeffs} {:>13.4e} {:>9.4e} {report_unit}",
+                column.name,
+                fit.method.to_string(),
                 fit.noise_variance,
                 report
             );
-            if method == args.method {
-                entries.push(ArModelEntry::from_fit(
-                    name,
-                    quantity_of(unit),
-                    args.rate,
-                    &fit,
-                ));
-            }
-            all_fits.push((name.clone(), fit));
         }
     }
-    for (&col, &unit) in selected.iter().zip(&units) {
-        let name = &table.names[col];
-        let x: Vec<f64> = table.data[col].iter().map(|v| v * unit.to_si()).collect();
-        let acf = autocorrelation(&x, args.lags);
-        let acf: String = acf.iter().skip(1).map(|r| format!("{r:>8.3}")).collect();
-        let _ = writeln!(
-            out,
-            "\n{name}: autocorrelation at lags 1..{}:{acf}",
-            args.lags
-        );
-        let scores = order_scores(&x, args.max_order, args.method, demean)
-            .with_context(|| format!("column {name}"))?;
-        let best_aic = scores
-            .iter()
-            .min_by(|a, b| a.aic.total_cmp(&b.aic))
-            .map_or(0, |s| s.order);
-        let best_bic = scores
-            .iter()
-            .min_by(|a, b| a.bic.total_cmp(&b.bic))
-            .map_or(0, |s| s.order);
-        let _ = writeln!(
-            out,
-            "{:>4} {:>13} {:>9} {:>15} {:>15}  ({:?})",
-            "p", "sigma^2", "k_p", "AIC", "BIC", args.method
-        );
-        for s in &scores {
-            let mark = match (s.order == best_aic, s.order == best_bic) {
-                (true, true) => "  <- AIC, BIC",
-                (true, false) => "  <- AIC",
-                (false, true) => "  <- BIC",
-                _ => "",
-            };
-            let _ = writeln!(
-                out,
-                "{:>4} {:>13.5e} {:>9.4} {:>15.2} {:>15.2}{mark}",
-                s.order, s.noise_variance, s.reflection, s.aic, s.bic
-            );
-        }
-    }
-    let path = args
-        .output
-        .clone()
-        .unwrap_or_else(|| args.file.with_extension("ar.json"));
-    ArModelFile::new(entries).save(&path)?;
+}
+
+/// One column's autocorrelation and its AIC/BIC by order, best marked.
+fn order_table(out: &mut String, column: &ColumnAr, options: &ArOptions) {
+    let acf: String = column
+        .autocorrelation
+        .iter()
+        .skip(1)
+        .map(|r| format!("{r:>8.3}"))
+        .collect();
     let _ = writeln!(
         out,
-        "\nmodel file ({:?}, order {}) written to {}",
-        args.method,
-        args.order,
-        path.display()
+        "\n{}: autocorrelation at lags 1..{}:{acf}",
+        column.name, options.lags
     );
-    if args.json {
-        print_out(&(serde_json::to_string_pretty(&all_fits)? + "\n"))
-    } else {
-        print_out(&out)
+    let _ = writeln!(
+        out,
+        "{:>4} {:>13} {:>9} {:>15} {:>15}  ({})",
+        "p", "sigma^2", "k_p", "AIC", "BIC", options.method
+    );
+    let (best_aic, best_bic) = (column.best_aic(), column.best_bic());
+    for s in &column.scores {
+        let mark = match (s.order == best_aic, s.order == best_bic) {
+            (true, true) => "  <- AIC, BIC",
+            (true, false) => "  <- AIC",
+            (false, true) => "  <- BIC",
+            _ => "",
+        };
+        let _ = writeln!(
+            out,
+            "{:>4} {:>13.5e} {:>9.4} {:>15.2} {:>15.2}{mark}",
+            s.order, s.noise_variance, s.reflection, s.aic, s.bic
+        );
     }
 }

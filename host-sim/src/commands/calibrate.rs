@@ -1,24 +1,23 @@
 //! `host-sim calibrate FILE`: six-position calibration of accelerometer
 //! triads (LS and TLS side by side) and gyro biases with earth rate
 //! accounted for, like the paper's Table 3; writes a calibration file.
+//! The calibration is `host_sim::analysis::six_position`'s; this module
+//! reads the options and reports.
 
-use super::allan::print_out;
-use anyhow::{bail, Context, Result};
-use host_sim::analysis::calibration::{
-    calibrate_gyro, calibrate_triad, earth_rate_up, position_means, TriadResult,
-};
-use host_sim::analysis::calibration_file::{
-    CalibrationFile, GyroEntry, TriadEntry, FORMAT, VERSION,
-};
+use super::print_out;
+use anyhow::{ensure, Context, Result};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use host_sim::analysis::calibration::TriadResult;
 use host_sim::analysis::csv_input::read_columns;
+use host_sim::analysis::six_position::{
+    fit, position_data, GyroColumn, PositionData, SixPositionFit, TriadColumns,
+};
 use host_sim::analysis::tls::FitMethod;
 use host_sim::analysis::units::InputUnit;
 use std::fmt::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-/// The paper's site (section 4): 45.77755 N, 124 m.
-const PAPER_LATITUDE_DEG: f64 = 45.777_55;
-const PAPER_HEIGHT_M: f64 = 124.0;
+use super::site::SiteArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -37,21 +36,103 @@ pub struct Args {
     /// Unit of the gyro columns (rad/s, deg/s, deg/h).
     #[arg(long, default_value = "rad/s")]
     pub gyro_unit: String,
-    /// Latitude of the test (deg), for earth rate and normal gravity.
-    #[arg(long, default_value_t = PAPER_LATITUDE_DEG)]
-    pub latitude: f64,
-    /// Height of the test (m), for normal gravity.
-    #[arg(long, default_value_t = PAPER_HEIGHT_M)]
-    pub height: f64,
+    /// The site of the test: its latitude sets earth rate, latitude and
+    /// height normal gravity (`--latitude` is the same as `--lat`).
+    #[command(flatten)]
+    pub site: SiteArgs,
     /// Gravity magnitude (m/s^2); default: normal gravity at latitude and height.
     #[arg(long)]
     pub gravity: Option<f64>,
     /// Method whose triad calibration goes into the file.
-    #[arg(long, value_parser = ["ls", "tls"], default_value = "tls")]
-    pub method: String,
+    #[arg(long, value_parser = fit_method(), default_value = "tls")]
+    pub method: FitMethod,
     /// Calibration file to write (default: FILE with extension `.cal.json`).
     #[arg(long)]
     pub output: Option<PathBuf>,
+}
+
+/// `--method`: `ls` or `tls`.
+fn fit_method() -> impl TypedValueParser<Value = FitMethod> {
+    PossibleValuesParser::new(["ls", "tls"]).map(|name| match name.as_str() {
+        "ls" => FitMethod::Ls,
+        _ => FitMethod::Tls,
+    })
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let data = read_position_data(&args)?;
+    let site = args.site.position();
+    let gravity = args
+        .gravity
+        .unwrap_or_else(|| mwd_core::earth::normal_gravity(site.lat, site.height));
+    ensure!(
+        gravity.is_finite() && gravity > 0.0,
+        "gravity must be positive, got {gravity}"
+    );
+    let fit = fit(&data, gravity, site.lat)?;
+    let path = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.file.with_extension("cal.json"));
+    fit.calibration_file(args.method, args.site.lat)?
+        .save(&path)?;
+    print_out(&report(&args, &data, &fit, &path))
+}
+
+/// The table's sensor columns, as the options name them, averaged per
+/// position.
+fn read_position_data(args: &Args) -> Result<PositionData> {
+    let table = read_columns(&args.file)?;
+    let accel_si = InputUnit::parse(&args.accel_unit)?.to_si();
+    let gyro_si = InputUnit::parse(&args.gyro_unit)?.to_si();
+    let triads: Vec<TriadColumns> = args
+        .accel
+        .iter()
+        .map(|spec| TriadColumns::parse(spec))
+        .collect::<Result<_>>()?;
+    let gyros: Vec<GyroColumn> = args
+        .gyro
+        .iter()
+        .map(|spec| GyroColumn::parse(spec))
+        .collect::<Result<_>>()?;
+    position_data(&table, &triads, &gyros, accel_si, gyro_si)
+        .with_context(|| format!("{}", args.file.display()))
+}
+
+/// The report: samples per position, each triad's LS and TLS estimates,
+/// the gyro biases, and where the file went.
+fn report(args: &Args, data: &PositionData, fit: &SixPositionFit, path: &Path) -> String {
+    let mut out = String::new();
+    let counts: Vec<String> = data
+        .means
+        .iter()
+        .map(|m| format!("{} {}", m.face, m.samples))
+        .collect();
+    let _ = writeln!(
+        out,
+        "six-position calibration of {} ({})",
+        args.file.display(),
+        counts.join(", ")
+    );
+    let _ = writeln!(
+        out,
+        "gravity {:.5} m/s^2, earth rate up {:.4} deg/h at {:.5} deg",
+        fit.gravity,
+        fit.earth_rate_up.to_degrees() * 3600.0,
+        args.site.lat
+    );
+    for triad in &fit.triads {
+        let _ = writeln!(out, "\naccelerometer triad {}:", triad.columns.joined());
+        triad_rows(&mut out, &triad.ls, &triad.tls);
+    }
+    gyro_rows(&mut out, fit);
+    let _ = writeln!(
+        out,
+        "\ncalibration ({} triads, gyro biases) written to {}",
+        args.method.to_string().to_uppercase(),
+        path.display()
+    );
+    out
 }
 
 fn triad_rows(out: &mut String, ls: &TriadResult, tls: &TriadResult) {
@@ -97,150 +178,26 @@ fn triad_rows(out: &mut String, ls: &TriadResult, tls: &TriadResult) {
     }
 }
 
-pub fn run(args: Args) -> Result<()> {
-    let table = read_columns(&args.file)?;
-    let accel_si = InputUnit::parse(&args.accel_unit)?.to_si();
-    let gyro_si = InputUnit::parse(&args.gyro_unit)?.to_si();
-    let lat = args.latitude.to_radians();
-    let gravity = args
-        .gravity
-        .unwrap_or_else(|| mwd_core::earth::normal_gravity(lat, args.height));
-    if !(gravity.is_finite() && gravity > 0.0) {
-        bail!("gravity must be positive, got {gravity}");
-    }
-    let omega_up = earth_rate_up(lat);
-    let positions = table
-        .column("position")
-        .with_context(|| format!("{}", args.file.display()))?;
-    // Every sensor column converted to SI, in the order they are named.
-    let mut names: Vec<String> = Vec::new();
-    let mut data: Vec<Vec<f64>> = Vec::new();
-    let mut col_of = |name: &str, scale: f64| -> Result<usize> {
-        let col = table
-            .column(name)
-            .with_context(|| format!("{}", args.file.display()))?;
-        names.push(name.to_string());
-        data.push(col.iter().map(|v| v * scale).collect());
-        Ok(data.len() - 1)
-    };
-    let mut triads = Vec::new();
-    for spec in &args.accel {
-        let cols: Vec<&str> = spec.split(',').map(str::trim).collect();
-        let [x, y, z] = cols.as_slice() else {
-            bail!("--accel wants three column names x,y,z, got `{spec}`")
-        };
-        triads.push((
-            [x.to_string(), y.to_string(), z.to_string()],
-            [
-                col_of(x, accel_si)?,
-                col_of(y, accel_si)?,
-                col_of(z, accel_si)?,
-            ],
-        ));
-    }
-    let mut gyros = Vec::new();
-    for spec in &args.gyro {
-        let Some((name, axis)) = spec.split_once(':') else {
-            bail!("--gyro wants column:axis, got `{spec}`")
-        };
-        let axis_idx = match axis.trim() {
-            "x" => 0,
-            "y" => 1,
-            "z" => 2,
-            other => bail!("--gyro {spec}: axis `{other}` is not x, y or z"),
-        };
-        gyros.push((
-            name.trim().to_string(),
-            axis.trim().to_string(),
-            axis_idx,
-            col_of(name.trim(), gyro_si)?,
-        ));
-    }
-    let refs: Vec<&[f64]> = data.iter().map(Vec::as_slice).collect();
-    let means =
-        position_means(positions, &refs).with_context(|| format!("{}", args.file.display()))?;
-    let mut out = String::new();
-    let counts: Vec<String> = means
-        .iter()
-        .map(|m| format!("{:?} {}", m.face, m.samples))
-        .collect();
-    let _ = writeln!(
-        out,
-        "six-position calibration of {} ({})",
-        args.file.display(),
-        counts.join(", ")
-    );
-    let _ = writeln!(
-        out,
-        "gravity {gravity:.5} m/s^2, earth rate up {:.4} deg/h at {:.5} deg",
-        omega_up.to_degrees() * 3600.0,
-        args.latitude
-    );
-    let use_tls = args.method == "tls";
-    let mut accel_entries = Vec::new();
-    for (names3, cols) in &triads {
-        let ls = calibrate_triad(&means, *cols, gravity, FitMethod::Ls)?;
-        let tls = calibrate_triad(&means, *cols, gravity, FitMethod::Tls)?;
-        let _ = writeln!(out, "\naccelerometer triad {}:", names3.join(","));
-        triad_rows(&mut out, &ls, &tls);
-        let chosen = if use_tls { &tls } else { &ls };
-        let cal = chosen
-            .coupling
-            .to_triad_calibration()
-            .with_context(|| format!("triad {}", names3.join(",")))?;
-        accel_entries.push(TriadEntry {
-            columns: names3.clone(),
-            bias: cal.bias,
-            correction: cal.correction,
-        });
-    }
-    let mut gyro_entries = Vec::new();
-    if !gyros.is_empty() {
+/// The gyro biases (deg/s and deg/h) and earth-rate scale factors.
+fn gyro_rows(out: &mut String, fit: &SixPositionFit) {
+    if !fit.gyros.is_empty() {
         let _ = writeln!(
             out,
             "\n  {:<10} {:>16} {:>14} {:>12} {:>14}",
             "gyro", "bias (deg/s)", "bias (deg/h)", "+- 1 se", "scale (earth)"
         );
     }
-    for (name, axis, axis_idx, col) in &gyros {
-        let g = calibrate_gyro(&means, *col, *axis_idx, omega_up)?;
+    for (gyro, g) in &fit.gyros {
         let deg = g.bias.to_degrees();
         let _ = writeln!(
             out,
             "  {:<10} {:>16.9} {:>14.3} {:>12.3} {:>8.3} +- {:.3}",
-            format!("{name} ({axis})"),
+            format!("{} ({})", gyro.column, gyro.axis_name()),
             deg,
             deg * 3600.0,
             g.bias_se.to_degrees() * 3600.0,
             g.scale,
             g.scale_se
         );
-        gyro_entries.push(GyroEntry {
-            column: name.clone(),
-            axis: axis.clone(),
-            bias: g.to_core().bias,
-            scale: 1.0,
-        });
     }
-    let file = CalibrationFile {
-        format: FORMAT.into(),
-        version: VERSION,
-        method: args.method.clone(),
-        latitude_deg: args.latitude,
-        gravity,
-        accel: accel_entries,
-        gyro: gyro_entries,
-    };
-    let path = args
-        .output
-        .clone()
-        .unwrap_or_else(|| args.file.with_extension("cal.json"));
-    file.save(&path)?;
-    let _ = writeln!(
-        out,
-        "\ncalibration ({} triads, gyro biases) written to {}",
-        args.method.to_uppercase(),
-        path.display()
-    );
-    print_out(&out)
 }

@@ -4,13 +4,14 @@
 //! what toolface indexing buys; each result next to the truth.
 use anyhow::Result;
 use host_sim::coarse;
+use host_sim::paper_mgwd::COARSE_SAMPLES;
 use host_sim::samples_csv::Record;
-use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, SAMPLE_INTERVAL};
+use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory};
 use mwd_core::alignment::AlignmentConfig;
+use mwd_core::conventions::DEG;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 
 use super::simulate::TrajectoryArgs;
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -21,6 +22,8 @@ pub struct Args {
     pub seed: u64,
 }
 
+/// Calibrates `records` with the paper's Table 3, coarse-aligns their
+/// static segments and prints the report under `title`.
 fn run_case(title: &str, records: &[Record], config: &AlignmentConfig) -> Result<()> {
     let cal = DeterministicErrors::paper_table3().calibration();
     let records: Vec<_> = records
@@ -41,13 +44,32 @@ pub fn run(args: Args) -> Result<()> {
     // well: a prior within 90 deg resolves the north/south ambiguity.
     let config = AlignmentConfig::probe(traj.position.lat)
         .with_heading_prior(Some(traj.start.heading + 30.0 * DEG));
-    let simulate = |t: &host_sim::sim::Trajectory, seconds: f64| -> Vec<Record> {
-        let n = (seconds / SAMPLE_INTERVAL).round() as usize;
-        SensorSimulator::new(t.clone(), SensorModel::scc1300(args.seed), SAMPLE_INTERVAL)
-            .take(n)
-            .map(|s| Record::from(&s))
-            .collect()
+    print_setup(&traj);
+    let minute = simulate(&traj, 60.0, args.seed);
+    run_case(
+        "Paper's coarse alignment: first 5 s",
+        &minute[..COARSE_SAMPLES],
+        &config,
+    )?;
+    run_case("Whole 60 s static test", &minute, &config)?;
+    let indexed = Trajectory {
+        motion: Motion::ToolfaceSteps {
+            step: std::f64::consts::PI,
+            turn_rate: 30.0 * DEG,
+            dwell: 600.0,
+            steps: 1,
+        },
+        ..traj
     };
+    run_case(
+        "Toolface indexing: 10 min at the start toolface, turn 180 deg, 10 min (gyro bias separated from earth rate)",
+        &simulate(&indexed, indexed.scripted_duration(), args.seed),
+        &config,
+    )
+}
+
+/// Where the simulated probe is and how it sits.
+fn print_setup(traj: &Trajectory) {
     println!(
         "Simulated SCC1300 probe at rest, {:.5} N {:.6} E {:.0} m; truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result).",
         traj.position.lat / DEG,
@@ -58,25 +80,14 @@ pub fn run(args: Args) -> Result<()> {
         traj.start.heading / DEG
     );
     println!("Prior heading for the north/south ambiguity: truth + 30 deg.\n");
-    let minute = simulate(&traj, 60.0);
-    run_case(
-        "Paper's coarse alignment: first 5 s",
-        &minute[..100],
-        &config,
-    )?;
-    run_case("Whole 60 s static test", &minute, &config)?;
-    let mut indexed = traj.clone();
-    indexed.motion = Motion::ToolfaceSteps {
-        step: std::f64::consts::PI,
-        turn_rate: 30.0 * DEG,
-        dwell: 600.0,
-        steps: 1,
-    };
-    let records = simulate(&indexed, indexed.scripted_duration());
-    run_case(
-        "Toolface indexing: 10 min at the start toolface, turn 180 deg, 10 min (gyro bias separated from earth rate)",
-        &records,
-        &config,
-    )?;
-    Ok(())
+}
+
+/// `seconds` of the SCC1300 model on `trajectory`.
+fn simulate(trajectory: &Trajectory, seconds: f64, seed: u64) -> Vec<Record> {
+    let n = (seconds / SAMPLE_INTERVAL_S).round() as usize;
+    let model = SensorModel::scc1300(seed);
+    SensorSimulator::new(trajectory.clone(), model, SAMPLE_INTERVAL_S)
+        .take(n)
+        .map(|s| Record::from(&s))
+        .collect()
 }

@@ -12,6 +12,7 @@ mod paper;
 mod paper_mgwd;
 mod replay;
 mod simulate;
+mod site;
 
 #[derive(Parser, Debug)]
 #[command(name = "host-sim", version, about = "Host tool of the gyro MWD probe")]
@@ -45,6 +46,15 @@ pub enum Command {
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
+}
+
+/// Prints to stdout; a closed pipe (`| head`) ends the output quietly.
+fn print_out(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {

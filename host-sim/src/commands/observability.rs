@@ -2,26 +2,25 @@
 //! zero-position updates can determine, at one toolface or over toolface
 //! indexing, with a per-state report from the SVD.
 use anyhow::{ensure, Result};
-use host_sim::observability::{analyse, Measurements, STATE_NAMES};
-use mwd_core::conventions::Euler;
-use mwd_core::earth::Position;
+use host_sim::observability::{analyse, Analysis, Measurements, STATE_NAMES};
+use host_sim::paper_mgwd::PUBLISHED;
+use mwd_core::conventions::{Euler, DEG};
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
+use super::site::SiteArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Roll (toolface) of the first segment, degrees.
-    #[arg(long, default_value_t = -0.8061, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[0], allow_hyphen_values = true)]
     pub roll: f64,
     /// Pitch, degrees.
-    #[arg(long, default_value_t = 0.5371, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[1], allow_hyphen_values = true)]
     pub pitch: f64,
     /// Heading, degrees.
-    #[arg(long, default_value_t = -150.9636, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[2], allow_hyphen_values = true)]
     pub heading: f64,
-    /// Latitude, degrees.
-    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
-    pub lat: f64,
+    #[command(flatten)]
+    pub site: SiteArgs,
     /// Toolface offsets of the segments, degrees (e.g. 0,180 for indexing).
     #[arg(long, value_delimiter = ',', default_values_t = [0.0], allow_hyphen_values = true)]
     pub toolfaces: Vec<f64>,
@@ -34,20 +33,11 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let measurements = match args.measurements.as_str() {
-        "zupt" => Measurements {
-            zero_velocity: true,
-            zero_position: false,
-        },
-        "zpu" => Measurements {
-            zero_velocity: false,
-            zero_position: true,
-        },
-        "both" => Measurements {
-            zero_velocity: true,
-            zero_position: true,
-        },
-        other => anyhow::bail!("--measurements takes zupt, zpu or both, not `{other}`"),
+    let Some(measurements) = Measurements::from_name(&args.measurements) else {
+        anyhow::bail!(
+            "--measurements takes zupt, zpu or both, not `{}`",
+            args.measurements
+        );
     };
     ensure!(
         !args.toolfaces.is_empty() && args.toolfaces.len() <= 16,
@@ -55,12 +45,23 @@ pub fn run(args: Args) -> Result<()> {
     );
     let start = Euler::new(args.roll * DEG, args.pitch * DEG, args.heading * DEG);
     let offsets: Vec<f64> = args.toolfaces.iter().map(|t| t * DEG).collect();
-    let position = Position::from_degrees(args.lat, 0.0, 0.0);
-    let a = analyse(&start, position, &offsets, !args.no_biases, measurements);
+    let a = analyse(
+        &start,
+        args.site.position(),
+        &offsets,
+        !args.no_biases,
+        measurements,
+    );
+    report(&args, &a);
+    Ok(())
+}
+
+/// Ranks, each state's unobservable share and the unobservable directions.
+fn report(args: &Args, a: &Analysis) {
     println!(
         "{} states, {} toolface segment(s) {:?} deg, measurements: {}",
         a.states,
-        offsets.len(),
+        args.toolfaces.len(),
         args.toolfaces,
         args.measurements
     );
@@ -94,5 +95,4 @@ pub fn run(args: Args) -> Result<()> {
             .collect();
         println!("unobservable direction {}: {}", k + 1, parts.join(", "));
     }
-    Ok(())
 }

@@ -1,14 +1,19 @@
 //! `host-sim paper mgwd`: the MGWD paper's fine-alignment experiment
 //! (section 4, Figures 13-15) reproduced, ours beside the paper's figures.
+//! The experiment is `host_sim::paper_mgwd`'s; this module reads the
+//! options and reports.
 
-use anyhow::{anyhow, Context, Result};
-use host_sim::analysis::ar_file::ArModelFile;
+use anyhow::{Context, Result};
+use host_sim::analysis::ar_file::{ArModelFile, AxisSource};
+use host_sim::analysis::plot::{line_svg, Curve, Labels};
 use host_sim::paper_mgwd::{
-    coarse_align, fine_align, monte_carlo, ranks, simulate, truth, History, Settings, DEG,
+    consistency, ranks, static_test, truth, Consistency, History, Ranks, Settings, StaticTest,
     PUBLISHED,
 };
+use mwd_core::conventions::DEG;
+use mwd_core::earth::Position;
 use mwd_core::error_model::{AugmentedModel, Coupling};
-use plotters::prelude::*;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug)]
@@ -35,34 +40,105 @@ pub struct MgwdArgs {
     pub paper_derived_rate: bool,
 }
 
+/// Where the filter's AR models came from, when not from the paper.
+struct LoadedModels {
+    path: PathBuf,
+    sources: [AxisSource; 6],
+    unused: Vec<String>,
+}
+
+pub fn run(args: MgwdArgs) -> Result<()> {
+    let (model, loaded) = filter_model(&args)?;
+    let test = static_test(args.seed, &model)?;
+    print_static_test(args.seed, &test, &model, loaded.as_ref());
+    print_ranks(&[
+        ranks(Coupling::BlockDiagonalAsPublished),
+        ranks(Coupling::SensorErrorsDriveNavigation),
+    ]);
+    let lines = consistency(args.runs, &model)?;
+    print_consistency(args.runs, &lines, loaded.is_some());
+    println!("{WHY}");
+    write_figures(&args.plots, &test.runs)?;
+    println!(
+        "Plots of Figures 13-15 for each setting in {}",
+        args.plots.display()
+    );
+    Ok(())
+}
+
+/// The filter's model: the paper's, or with `--ar-models` the file's.
+fn filter_model(args: &MgwdArgs) -> Result<(AugmentedModel, Option<LoadedModels>)> {
+    let mut model = AugmentedModel::paper();
+    let Some(path) = &args.ar_models else {
+        return Ok((model, None));
+    };
+    let (sources, unused) = ArModelFile::load(path)?
+        .apply_to(&mut model, args.paper_derived_rate)
+        .with_context(|| format!("AR model file {}", path.display()))?;
+    let loaded = LoadedModels {
+        path: path.clone(),
+        sources,
+        unused,
+    };
+    Ok((model, Some(loaded)))
+}
+
+/// Index of the sample at `seconds` into the run (its last for a shorter
+/// run).
 fn at(h: &History, seconds: f64) -> usize {
-    let i = (seconds / 0.05).round() as usize;
+    let i = (seconds / SAMPLE_INTERVAL_S).round() as usize;
     i.saturating_sub(1).min(h.time.len().saturating_sub(1))
 }
 
-/// The filter's model and the lines that say where its AR models came from.
-fn filter_model(args: &MgwdArgs) -> Result<(AugmentedModel, String)> {
-    let mut model = AugmentedModel::paper();
-    let Some(path) = &args.ar_models else {
-        return Ok((
-            model,
-            "AR(4) noise models: the paper's Tables 4-5 (--ar-models FILE loads fitted ones).\n"
-                .into(),
-        ));
+/// The set-up, the coarse alignment, the models, and the table at 60 s.
+fn print_static_test(
+    seed: u64,
+    test: &StaticTest,
+    model: &AugmentedModel,
+    loaded: Option<&LoadedModels>,
+) {
+    let (site, t) = (Position::paper_site(), truth());
+    let (coarse, sigma) = (test.coarse, test.coarse_sigma);
+    println!(
+        "MGWD paper, section 4: 60 s static at {:.5} N {:.6} E {:.0} m, SCC1300 model (seed {seed}).",
+        site.lat / DEG,
+        site.lon / DEG,
+        site.height,
+    );
+    println!(
+        "Truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result, used as our truth).",
+        t.roll / DEG,
+        t.pitch / DEG,
+        t.heading / DEG
+    );
+    println!(
+        "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4}, azimuth {:.3} +- {:.3} deg (1 sigma)\n",
+        coarse.roll / DEG,
+        sigma[0] / DEG,
+        coarse.pitch / DEG,
+        sigma[1] / DEG,
+        coarse.heading / DEG,
+        sigma[2] / DEG
+    );
+    println!("{}", model_source(model, loaded));
+    print_final_table(&test.runs);
+}
+
+/// The lines that say where the filter's AR models came from.
+fn model_source(model: &AugmentedModel, loaded: Option<&LoadedModels>) -> String {
+    let Some(loaded) = loaded else {
+        return "AR(4) noise models: the paper's Tables 4-5 (--ar-models FILE loads fitted ones).\n"
+            .into();
     };
-    let file = ArModelFile::load(path)?;
-    let (sources, unused) = file
-        .apply_to(&mut model, args.paper_derived_rate)
-        .with_context(|| format!("AR model file {}", path.display()))?;
     let mut text = format!(
         "AR(4) noise models loaded from {} ({} Hz), used by every setting and the consistency runs:\n",
-        path.display(),
+        loaded.path.display(),
         1.0 / model.dt
     );
-    for s in &sources {
+    for s in &loaded.sources {
         let a = s.model.coefficients;
         let from = match (&s.sensor, s.method) {
-            (Some(name), Some(m)) => format!("{name} ({m:?})"),
+            (Some(name), Some(m)) => format!("{name} ({m})"),
             (Some(name), None) => name.clone(),
             (None, _) => "paper Table 5 (--paper-derived-rate)".into(),
         };
@@ -78,40 +154,18 @@ fn filter_model(args: &MgwdArgs) -> Result<(AugmentedModel, String)> {
             s.axis.quantity.variance_unit()
         );
     }
-    if !unused.is_empty() {
-        text += &format!("  not used (no filter axis): {}\n", unused.join(", "));
+    if !loaded.unused.is_empty() {
+        text += &format!(
+            "  not used (no filter axis): {}\n",
+            loaded.unused.join(", ")
+        );
     }
-    Ok((model, text))
+    text
 }
 
-pub fn run(args: MgwdArgs) -> Result<()> {
-    let (model, model_text) = filter_model(&args)?;
-    let loaded = args.ar_models.is_some();
-    let records = simulate(args.seed, true);
-    let (coarse, coarse_sigma) = coarse_align(&records)?;
-    let t = truth();
-    println!("MGWD paper, section 4: 60 s static at 45.77755 N 126.687898 E 124 m, SCC1300 model (seed {}).", args.seed);
-    println!(
-        "Truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result, used as our truth).",
-        t.roll / DEG,
-        t.pitch / DEG,
-        t.heading / DEG
-    );
-    println!(
-        "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4}, azimuth {:.3} +- {:.3} deg (1 sigma)\n",
-        coarse.roll / DEG,
-        coarse_sigma[0] / DEG,
-        coarse.pitch / DEG,
-        coarse_sigma[1] / DEG,
-        coarse.heading / DEG,
-        coarse_sigma[2] / DEG
-    );
-    println!("{model_text}");
-
-    let runs: Vec<(Settings, History)> = Settings::ALL
-        .iter()
-        .map(|s| (*s, fine_align(&records, &coarse, &coarse_sigma, *s, &model)))
-        .collect();
+/// Each setting's sigmas and errors at the end of the test, beside the
+/// paper's figures.
+fn print_final_table(runs: &[(Settings, History)]) {
     println!(
         "{:<34} {:>10} {:>22} {:>22} {:>22}",
         "at 60 s (1 sigma)",
@@ -166,109 +220,127 @@ pub fn run(args: MgwdArgs) -> Result<()> {
         let e = h.euler_error_deg[last(h)];
         format!("{:.3}/{:.3}/{:.2}", e[0], e[1], e[2])
     });
+}
 
+/// The coupling's name in the rank table.
+fn coupling_name(coupling: Coupling) -> &'static str {
+    match coupling {
+        Coupling::BlockDiagonalAsPublished => "BlockDiagonalAsPublished",
+        Coupling::SensorErrorsDriveNavigation => "SensorErrorsDriveNavigation",
+    }
+}
+
+/// Section 2.4's ranks per coupling, and what the data alone say about the
+/// azimuth (from the last coupling's, the physical one).
+fn print_ranks(ranks: &[Ranks]) {
     println!("\nRank of ctrb(Phi, Gamma) and obsv(Phi, H), 33-state model (MATLAB tolerance; the paper: both full rank):");
-    for coupling in [
-        Coupling::BlockDiagonalAsPublished,
-        Coupling::SensorErrorsDriveNavigation,
-    ] {
-        let r = ranks(coupling);
+    for r in ranks {
         println!(
             "  {:<30} ctrb {:>2}/33  obsv {:>2}/33",
-            format!("{coupling:?}"),
+            coupling_name(r.coupling),
             r.controllability,
             r.observability
         );
     }
-    let r = ranks(Coupling::SensorErrorsDriveNavigation);
-    println!(
-        "  azimuth from 60 s of ZUPT + zero position alone (9 states, no noise on the rates): {:.3} deg; tilts far better",
-        r.azimuth_sigma_from_data_deg
-    );
+    if let Some(r) = ranks.last() {
+        println!(
+            "  azimuth from 60 s of ZUPT + zero position alone (9 states, no noise on the rates): {:.3} deg; tilts far better",
+            r.azimuth_sigma_from_data_deg
+        );
+    }
+}
 
-    println!("\nConsistency over {} seeded runs: final roll and pitch errors both inside the filter's 3 sigma", args.runs);
-    for full in [false, true] {
-        for s in [
-            Settings::PaperCoupled,
-            Settings::PhysicalWithoutBiases,
-            Settings::Physical,
-        ] {
-            let mc = monte_carlo(args.runs, s, full, &model)?;
-            println!(
-                "  {:<22} {:>2} states  {:<34} {:>3}/{} inside; RMS error roll {:.4} pitch {:.4} az {:.2} deg; mean sigma {:.4} {:.4} {:.2}",
-                s.name(),
-                s.states(),
-                match (full, loaded) {
-                    (true, _) => "full SCC1300 model (biases)",
-                    (false, false) => "AR(4) noise only (filter's model)",
-                    (false, true) => "Tables 4-5 AR(4) noise only",
-                },
-                mc.inside,
-                mc.runs,
-                mc.rms_error_deg[0],
-                mc.rms_error_deg[1],
-                mc.rms_error_deg[2],
-                mc.mean_sigma_deg[0],
-                mc.mean_sigma_deg[1],
-                mc.mean_sigma_deg[2]
-            );
+/// The consistency check, one line per setting and sensor model.
+fn print_consistency(runs: usize, lines: &[Consistency], loaded: bool) {
+    println!("\nConsistency over {runs} seeded runs: final roll and pitch errors both inside the filter's 3 sigma");
+    for line in lines {
+        let mc = &line.result;
+        println!(
+            "  {:<22} {:>2} states  {:<34} {:>3}/{} inside; RMS error roll {:.4} pitch {:.4} az {:.2} deg; mean sigma {:.4} {:.4} {:.2}",
+            line.settings.name(),
+            line.settings.states(),
+            match (line.full_model, loaded) {
+                (true, _) => "full SCC1300 model (biases)",
+                (false, false) => "AR(4) noise only (filter's model)",
+                (false, true) => "Tables 4-5 AR(4) noise only",
+            },
+            mc.inside,
+            mc.runs,
+            mc.rms_error_deg[0],
+            mc.rms_error_deg[1],
+            mc.rms_error_deg[2],
+            mc.mean_sigma_deg[0],
+            mc.mean_sigma_deg[1],
+            mc.mean_sigma_deg[2]
+        );
+    }
+}
+
+/// One of Figures 13-15 of one run.
+struct Figure {
+    /// File name without the setting's tag and extension.
+    stem: &'static str,
+    title: &'static str,
+    unit: &'static str,
+    curves: Vec<Curve<'static>>,
+}
+
+/// Figures 13-15 of one run: attitude errors, attitude and velocity sigmas,
+/// trace(P).
+fn figures(h: &History) -> [Figure; 4] {
+    let series = |f: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
+        (0..h.time.len()).map(|k| (h.time[k], f(k))).collect()
+    };
+    let attitude = ["roll", "pitch", "azimuth"];
+    let velocity = ["N", "E", "D"];
+    [
+        Figure {
+            stem: "fig13-attitude-error",
+            title: "Fig. 13: attitude estimation error",
+            unit: "deg",
+            curves: (0..3)
+                .map(|i| (attitude[i], series(&|k| h.euler_error_deg[k][i])))
+                .collect(),
+        },
+        Figure {
+            stem: "fig14a-attitude-sigma",
+            title: "Fig. 14a: attitude error sigma",
+            unit: "deg",
+            curves: (0..3)
+                .map(|i| (attitude[i], series(&|k| h.euler_sigma_deg[k][i])))
+                .collect(),
+        },
+        Figure {
+            stem: "fig14b-velocity-sigma",
+            title: "Fig. 14b: velocity error sigma",
+            unit: "m/s",
+            curves: (0..3)
+                .map(|i| (velocity[i], series(&|k| h.velocity_sigma[k][i])))
+                .collect(),
+        },
+        Figure {
+            stem: "fig15-trace",
+            title: "Fig. 15: trace(P)",
+            unit: "",
+            curves: vec![("trace", series(&|k| h.trace[k]))],
+        },
+    ]
+}
+
+/// Figures 13-15 of each setting's run as SVG files in `dir`.
+fn write_figures(dir: &Path, runs: &[(Settings, History)]) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    for (settings, h) in runs {
+        for figure in figures(h) {
+            let labels = Labels {
+                title: figure.title,
+                x: "time (s)",
+                y: figure.unit,
+            };
+            let file = format!("{}-{}.svg", figure.stem, settings.file_tag());
+            line_svg(&dir.join(file), &labels, 0.0..60.0, &figure.curves)?;
         }
     }
-    println!("{}", WHY);
-
-    std::fs::create_dir_all(&args.plots)?;
-    for (s, h) in &runs {
-        let tag = match s {
-            Settings::PaperAsPublished => "published",
-            Settings::PaperCoupled => "paper",
-            Settings::Physical => "physical",
-            Settings::PhysicalWithoutBiases => "physical-33",
-        };
-        let series = |f: &dyn Fn(&History, usize) -> f64| -> Vec<(f64, f64)> {
-            (0..h.time.len()).map(|k| (h.time[k], f(h, k))).collect()
-        };
-        let names = ["roll", "pitch", "azimuth"];
-        let errs: Vec<_> = (0..3)
-            .map(|i| (names[i], series(&|h, k| h.euler_error_deg[k][i])))
-            .collect();
-        let sig: Vec<_> = (0..3)
-            .map(|i| (names[i], series(&|h, k| h.euler_sigma_deg[k][i])))
-            .collect();
-        let vel: Vec<_> = ["N", "E", "D"]
-            .iter()
-            .enumerate()
-            .map(|(i, n)| (*n, series(&|h, k| h.velocity_sigma[k][i])))
-            .collect();
-        let dir = &args.plots;
-        line_svg(
-            &dir.join(format!("fig13-attitude-error-{tag}.svg")),
-            "Fig. 13: attitude estimation error",
-            "deg",
-            &errs,
-        )?;
-        line_svg(
-            &dir.join(format!("fig14a-attitude-sigma-{tag}.svg")),
-            "Fig. 14a: attitude error sigma",
-            "deg",
-            &sig,
-        )?;
-        line_svg(
-            &dir.join(format!("fig14b-velocity-sigma-{tag}.svg")),
-            "Fig. 14b: velocity error sigma",
-            "m/s",
-            &vel,
-        )?;
-        line_svg(
-            &dir.join(format!("fig15-trace-{tag}.svg")),
-            "Fig. 15: trace(P)",
-            "",
-            &[("trace", series(&|h, k| h.trace[k]))],
-        )?;
-    }
-    println!(
-        "Plots of Figures 13-15 for each setting in {}",
-        args.plots.display()
-    );
     Ok(())
 }
 
@@ -296,53 +368,3 @@ Why ours differ from the paper:
 - The tool-axis rate is taken as the frame's (the tool is at rest): differencing single-sample
   accelerometer rolls (eq. 1-2) with Table 4's noise gives ~0.17 rad/s of rate noise per sample and
   ~0.3 deg of roll error, far beyond Table 5's model of that rate.";
-
-fn line_svg(path: &Path, title: &str, y: &str, series: &[(&str, Vec<(f64, f64)>)]) -> Result<()> {
-    let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
-    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (_, pts) in series {
-        for &(_, v) in pts.iter().filter(|p| p.1.is_finite()) {
-            y0 = y0.min(v);
-            y1 = y1.max(v);
-        }
-    }
-    // Nothing finite, or a flat line: give the axis a unit span.
-    if y0.is_nan() || y1.is_nan() || y0 >= y1 {
-        y0 = if y0.is_finite() { y0 } else { 0.0 };
-        y1 = y0 + 1.0;
-    }
-    let pad = 0.05 * (y1 - y0);
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(80)
-        .build_cartesian_2d(0.0..60.0, (y0 - pad)..(y1 + pad))
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc(y)
-        .draw()
-        .map_err(|e| err(&e))?;
-    for (i, (name, pts)) in series.iter().enumerate() {
-        let colour = Palette99::pick(i).to_rgba();
-        chart
-            .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))
-            .map_err(|e| err(&e))?
-            .label(*name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
-}

@@ -8,7 +8,7 @@
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
@@ -19,6 +19,8 @@ use host_sim::replay::{self, ReplayRow, ReplaySummary};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
+
+use super::site::SiteArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -39,10 +41,13 @@ pub struct Args {
     /// Write the replayed navigation solutions as CSV here.
     #[arg(long, value_name = "OUT")]
     pub csv: Option<PathBuf>,
-    /// The probe's site: latitude and longitude (deg), height (m); the
-    /// QEMU probe uses the MGWD paper's site.
-    #[arg(long, num_args = 3, value_names = ["LAT", "LON", "HEIGHT"], allow_negative_numbers = true)]
-    pub site: Option<Vec<f64>>,
+    /// The probe's site (the QEMU probe's is the MGWD paper's).
+    #[command(flatten)]
+    pub site: SiteArgs,
+    /// The probe's site as three numbers, the same as --lat --lon --height.
+    #[arg(long = "site", num_args = 3, value_names = ["LAT", "LON", "HEIGHT"],
+          allow_negative_numbers = true, conflicts_with_all = ["lat", "lon", "height"])]
+    pub site_numbers: Option<Vec<f64>>,
     /// The probe's sensor calibration (`host-sim calibrate`'s JSON): the
     /// replay applies it as the probe does. Default: none (the QEMU probe
     /// runs uncalibrated).
@@ -50,62 +55,95 @@ pub struct Args {
     pub calibration_file: Option<PathBuf>,
 }
 
+/// A replayed capture: where it came from, the capture, the replayed
+/// solutions and their summary.
+struct Replayed {
+    source: String,
+    capture: Capture,
+    rows: Vec<ReplayRow>,
+    summary: ReplaySummary,
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let site = match args.site.as_deref() {
-        Some([lat, lon, height]) => Position::from_degrees(*lat, *lon, *height),
-        _ => Position::paper_site(),
+    let site = match args.site_numbers.as_deref() {
+        Some(&[lat, lon, height]) => Position::from_degrees(lat, lon, height),
+        _ => args.site.position(),
     };
     let calibration = match &args.calibration_file {
         Some(path) => CalibrationFile::load(path)?.to_probe(),
         None => ProbeCalibration::default(),
     };
-    let (source, cap, rows, summary) = match (&args.port, &args.file) {
-        (Some(port), _) => {
-            let duration = match args.duration {
-                Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
-                Some(s) => {
-                    anyhow::bail!("--duration must be a positive number of seconds, not {s}")
-                }
-                None => None,
-            };
-            // A short timeout keeps the time limit responsive on a quiet line.
-            let serial = serialport::new(port.as_str(), args.baud)
-                .timeout(Duration::from_millis(100))
-                .open()
-                .with_context(|| format!("opening serial port {port}"))?;
-            // Tools driving this (tests, scripts) wait for this line before
-            // letting the probe run.
-            println!("listening on {port} at {} baud", args.baud);
-            std::io::stdout().flush()?;
-            let options = LiveOptions {
-                duration,
-                calibration,
-                ..LiveOptions::default()
-            };
-            let outcome = live::run(serial, site, options, |status| println!("{status}"));
-            println!("end of stream    {}", outcome.end);
-            (port.clone(), outcome.capture, outcome.rows, outcome.summary)
-        }
-        (None, Some(file)) => {
-            let cap = host_sim::capture::read_capture(file)
-                .with_context(|| format!("reading {}", file.display()))?;
-            let navigator = Navigator::with_calibration(site, calibration);
-            let (rows, summary) = replay::replay_with(&cap.frames, navigator);
-            (file.display().to_string(), cap, rows, summary)
-        }
+    let replayed = match (&args.port, &args.file) {
+        (Some(port), _) => replay_live(&args, port, site, calibration)?,
+        (None, Some(file)) => replay_file(file, site, calibration)?,
         (None, None) => anyhow::bail!("give a capture file or --port"),
     };
-    report(&source, &cap, &rows, &summary, args.csv.as_ref())
+    report(&replayed, args.csv.as_ref())
+}
+
+/// Replays a capture file.
+fn replay_file(
+    file: &Path,
+    site: Position,
+    calibration: ProbeCalibration,
+) -> anyhow::Result<Replayed> {
+    let capture = host_sim::capture::read_capture(file)
+        .with_context(|| format!("reading {}", file.display()))?;
+    let navigator = Navigator::with_calibration(site, calibration);
+    let (rows, summary) = replay::replay_with(&capture.frames, navigator);
+    Ok(Replayed {
+        source: file.display().to_string(),
+        capture,
+        rows,
+        summary,
+    })
+}
+
+/// Replays the live stream of a serial port until it ends (or
+/// `--duration`), with a status line a few times a second.
+fn replay_live(
+    args: &Args,
+    port: &str,
+    site: Position,
+    calibration: ProbeCalibration,
+) -> anyhow::Result<Replayed> {
+    let duration = match args.duration {
+        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
+        Some(s) => anyhow::bail!("--duration must be a positive number of seconds, not {s}"),
+        None => None,
+    };
+    // A short timeout keeps the time limit responsive on a quiet line.
+    let serial = serialport::new(port, args.baud)
+        .timeout(Duration::from_millis(100))
+        .open()
+        .with_context(|| format!("opening serial port {port}"))?;
+    // Tools driving this (tests, scripts) wait for this line before
+    // letting the probe run.
+    println!("listening on {port} at {} baud", args.baud);
+    std::io::stdout().flush()?;
+    let options = LiveOptions {
+        duration,
+        calibration,
+        ..LiveOptions::default()
+    };
+    let outcome = live::run(serial, site, options, |status| println!("{status}"));
+    println!("end of stream    {}", outcome.end);
+    Ok(Replayed {
+        source: port.to_string(),
+        capture: outcome.capture,
+        rows: outcome.rows,
+        summary: outcome.summary,
+    })
 }
 
 /// The summary both modes end with, and the CSV.
-fn report(
-    source: &str,
-    cap: &Capture,
-    rows: &[ReplayRow],
-    summary: &ReplaySummary,
-    csv: Option<&PathBuf>,
-) -> anyhow::Result<()> {
+fn report(replayed: &Replayed, csv: Option<&PathBuf>) -> anyhow::Result<()> {
+    let Replayed {
+        source,
+        capture: cap,
+        rows,
+        summary,
+    } = replayed;
     println!("capture          {source}");
     println!("{cap}");
     println!("raw frames       {}", summary.raw_frames);

@@ -3,24 +3,20 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::sim::DeterministicErrors;
+use host_sim::paper_mgwd::PUBLISHED;
 use host_sim::sim::{
-    Motion, SensorModel, SensorModelFile, SensorSimulator, Trajectory, SAMPLE_INTERVAL,
+    DeterministicErrors, Motion, SensorModel, SensorModelFile, SensorSimulator, SimSample,
+    Trajectory,
 };
 use host_sim::{capture, samples_csv};
-use mwd_core::conventions::Euler;
+use mwd_core::conventions::{Euler, DEG};
 use mwd_core::earth::Position;
-use mwd_core::probe::Navigator;
-use mwd_core::protocol::frame::NO_PART;
-use mwd_core::protocol::{Event, EventKind, Payload};
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
-/// The `code` of a simulated capture's boot event (a real probe sends its
-/// firmware version, from 1): 0 marks the capture as the simulator's.
-const SIMULATED_FIRMWARE_VERSION: u16 = 0;
+use super::site::SiteArgs;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum MotionKind {
@@ -47,23 +43,16 @@ pub enum SensorKind {
 #[derive(clap::Args, Debug, Clone)]
 pub struct TrajectoryArgs {
     /// Roll (gravity toolface) at the start, degrees.
-    #[arg(long, default_value_t = -0.8061, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[0], allow_hyphen_values = true)]
     pub roll: f64,
     /// Pitch (tool axis above horizontal), degrees.
-    #[arg(long, default_value_t = 0.5371, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[1], allow_hyphen_values = true)]
     pub pitch: f64,
     /// Heading (azimuth of the tool axis), degrees.
-    #[arg(long, default_value_t = -150.9636, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[2], allow_hyphen_values = true)]
     pub heading: f64,
-    /// Latitude, degrees (default: the paper's site).
-    #[arg(long, default_value_t = 45.77755, allow_hyphen_values = true)]
-    pub lat: f64,
-    /// Longitude, degrees.
-    #[arg(long, default_value_t = 126.687898, allow_hyphen_values = true)]
-    pub lon: f64,
-    /// Height above the ellipsoid, metres.
-    #[arg(long, default_value_t = 124.0, allow_hyphen_values = true)]
-    pub height: f64,
+    #[command(flatten)]
+    pub site: SiteArgs,
     #[arg(long, value_enum, default_value_t = MotionKind::Static)]
     pub motion: MotionKind,
     /// Toolface indexing: turn per step, degrees.
@@ -102,7 +91,7 @@ impl TrajectoryArgs {
             }
         };
         Trajectory {
-            position: Position::from_degrees(self.lat, self.lon, self.height),
+            position: self.site.position(),
             start: Euler::new(self.roll * DEG, self.pitch * DEG, self.heading * DEG),
             motion,
         }
@@ -162,12 +151,43 @@ pub fn run(args: Args) -> Result<()> {
         duration.is_finite() && duration > 0.0,
         "duration must be positive"
     );
-    let model = match (&args.sensor_model, args.sensor) {
+    let model = sensor_model(&args)?;
+    let n = (duration / SAMPLE_INTERVAL_S).round() as usize;
+    let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL_S).take(n);
+    let output = &args.output;
+    let to_stdout = output.as_os_str() == "-";
+    match output_format(&args) {
+        OutputFormat::Bin => {
+            anyhow::ensure!(
+                !to_stdout,
+                "binary captures go to a file, not standard output"
+            );
+            let bytes = write_capture(output, samples, site)?;
+            eprintln!(
+                "wrote a boot event and {n} raw-sample and navigation frames ({bytes} bytes) to {}",
+                output.display()
+            );
+        }
+        OutputFormat::Csv if to_stdout => samples_csv::write(std::io::stdout().lock(), samples)?,
+        OutputFormat::Csv => {
+            write_csv(output, samples)?;
+            eprintln!(
+                "wrote {n} samples ({duration} s at 20 Hz) to {}",
+                output.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The simulated probe: `--sensor` or `--sensor-model`, with the
+/// deterministic errors of `--calibration-file` when given.
+fn sensor_model(args: &Args) -> Result<SensorModel> {
+    let mut model = match (&args.sensor_model, args.sensor) {
         (Some(path), _) => SensorModelFile::load(path, args.seed)?,
         (None, SensorKind::Scc1300) => SensorModel::scc1300(args.seed),
         (None, SensorKind::Ideal) => SensorModel::ideal(),
     };
-    let mut model = model;
     if let Some(path) = &args.calibration_file {
         let cal = CalibrationFile::load(path)?.to_probe();
         model.deterministic = DeterministicErrors::from_calibration(&cal).with_context(|| {
@@ -177,66 +197,40 @@ pub fn run(args: Args) -> Result<()> {
             )
         })?;
     }
-    let n = (duration / SAMPLE_INTERVAL).round() as usize;
-    let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL).take(n);
-    let format = args
-        .format
+    Ok(model)
+}
+
+/// `--format`, or by default `bin` for a `.bin` output and `csv` otherwise.
+fn output_format(args: &Args) -> OutputFormat {
+    args.format
         .unwrap_or(if args.output.extension().is_some_and(|e| e == "bin") {
             OutputFormat::Bin
         } else {
             OutputFormat::Csv
-        });
-    let to_stdout = args.output.as_os_str() == "-";
-    if format == OutputFormat::Bin {
-        anyhow::ensure!(
-            !to_stdout,
-            "binary captures go to a file, not standard output"
-        );
-        let mut capture = capture::create_capture(&args.output)
-            .with_context(|| format!("creating {}", args.output.display()))?;
-        // What the probe sends: its boot event, then per sample the raw
-        // frame and the navigation frame its own navigation code (the same
-        // `Navigator` the firmware runs) makes of that raw frame.
-        capture.write(&Payload::Event(Event {
-            time_us: 0,
-            kind: EventKind::Boot,
-            part: NO_PART,
-            code: SIMULATED_FIRMWARE_VERSION,
-            value: 0,
-        }))?;
-        let mut navigator = Navigator::new(site);
-        for (index, s) in samples.enumerate() {
-            // Both parts' triads see the same body-frame specific force; the
-            // capture's encoder turns each into its part's axes and counts.
-            let accel = [s.accel.x, s.accel.y, s.accel.z];
-            let raw = capture::raw_sample_from_si(&capture::SiSample {
-                index: u32::try_from(index).context("more than 2^32 samples")?,
-                time_s: s.time,
-                gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
-                accel_body_m_s2: [accel, accel],
-                temperature_degc: 25.0,
-            });
-            capture.write(&Payload::Raw(raw))?;
-            capture.write(&Payload::Nav(navigator.step(&raw)))?;
-        }
-        let bytes = capture.bytes_written();
-        capture.finish()?;
-        eprintln!(
-            "wrote a boot event and {n} raw-sample and navigation frames ({bytes} bytes) to {}",
-            args.output.display()
-        );
-    } else if to_stdout {
-        samples_csv::write(std::io::stdout().lock(), samples)?;
-    } else {
-        let file = std::fs::File::create(&args.output)
-            .with_context(|| format!("creating {}", args.output.display()))?;
-        let mut out = std::io::BufWriter::new(file);
-        samples_csv::write(&mut out, samples)?;
-        out.flush()?;
-        eprintln!(
-            "wrote {n} samples ({duration} s at 20 Hz) to {}",
-            args.output.display()
-        );
-    }
+        })
+}
+
+/// Writes the probe's capture of `samples` at `site`; returns its size in
+/// bytes.
+fn write_capture(
+    path: &Path,
+    samples: impl Iterator<Item = SimSample>,
+    site: Position,
+) -> Result<u64> {
+    let mut capture =
+        capture::create_capture(path).with_context(|| format!("creating {}", path.display()))?;
+    capture::write_simulated_probe(&mut capture, samples, site)?;
+    let bytes = capture.bytes_written();
+    capture.finish()?;
+    Ok(bytes)
+}
+
+/// Writes `samples` as a sample CSV file.
+fn write_csv(path: &Path, samples: impl Iterator<Item = SimSample>) -> Result<()> {
+    let file =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut out = std::io::BufWriter::new(file);
+    samples_csv::write(&mut out, samples)?;
+    out.flush()?;
     Ok(())
 }

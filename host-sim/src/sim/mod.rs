@@ -6,6 +6,3 @@ pub mod trajectory;
 pub use model_file::SensorModelFile;
 pub use sensor::{DeterministicErrors, SensorModel, SensorSimulator, SimSample};
 pub use trajectory::{Motion, Trajectory};
-
-/// The probe's sample interval (s): 20 Hz.
-pub use mwd_core::timing::SAMPLE_INTERVAL_S as SAMPLE_INTERVAL;

@@ -5,14 +5,13 @@
 use super::sensor::{DeterministicErrors, SensorModel};
 use anyhow::{ensure, Context, Result};
 use mwd_core::ar::Ar4;
+use mwd_core::conventions::DEG;
 use mwd_core::sensor_noise::{
     arw_from_deg_per_sqrt_hour, rate_from_deg_per_hour, AxisNoise, ImuNoise,
 };
 use mwd_core::sensor_units::STANDARD_GRAVITY;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
 
 /// An AR(4) model in the paper's sign convention (`z_k = -sum a_i z_{k-i} + e_k`).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]

@@ -6,6 +6,7 @@
 use super::trajectory::Trajectory;
 use mwd_core::ar::Ar4;
 use mwd_core::calibration::{GyroCalibration, ProbeCalibration, TriadCalibration};
+use mwd_core::conventions::DEG;
 use mwd_core::earth::{earth_rate_n, gravity_n};
 use mwd_core::sensor_noise::{AxisNoise, ImuNoise};
 use mwd_core::sensor_units::STANDARD_GRAVITY;
@@ -14,7 +15,6 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Gyro LSB (rad/s): the D04's 18 LSB per deg/s (`mwd_core::sensor_units`).
 pub const GYRO_LSB: f64 = DEG / mwd_core::sensor_units::GYRO_LSB_PER_DEG_S as f64;
 /// Accelerometer LSB (m/s^2): 650 LSB per g.
@@ -338,6 +338,7 @@ impl Iterator for SensorSimulator {
 mod tests {
     use super::*;
     use mwd_core::conventions::Euler;
+    use mwd_core::timing::SAMPLE_INTERVAL_S;
 
     #[test]
     fn calibration_round_trips_to_the_same_errors() {
@@ -361,7 +362,7 @@ mod tests {
         let e = Euler::new(0.1, -0.3, 2.0);
         let traj = Trajectory::paper_static(e);
         let pos = traj.position;
-        let mut sim = SensorSimulator::new(traj, SensorModel::ideal(), 0.05);
+        let mut sim = SensorSimulator::new(traj, SensorModel::ideal(), SAMPLE_INTERVAL_S);
         let s = sim.next().expect("a sample");
         let c_nb = mwd_core::conventions::dcm_from_euler(&e).transpose();
         assert!((s.accel - c_nb * -gravity_n(&pos)).norm() < 1e-12);
@@ -375,7 +376,7 @@ mod tests {
         // The measured values (the absent y gyro is NaN, which never
         // compares equal, so it is left out).
         let stream = |seed| -> Vec<[f64; 5]> {
-            SensorSimulator::new(traj.clone(), SensorModel::scc1300(seed), 0.05)
+            SensorSimulator::new(traj.clone(), SensorModel::scc1300(seed), SAMPLE_INTERVAL_S)
                 .take(50)
                 .map(|s| [s.gyro.x, s.gyro.z, s.accel.x, s.accel.y, s.accel.z])
                 .collect()
@@ -387,7 +388,7 @@ mod tests {
     #[test]
     fn quantised_outputs_sit_on_the_lsb_grid() {
         let traj = Trajectory::paper_static(Euler::default());
-        for s in SensorSimulator::new(traj, SensorModel::scc1300(1), 0.05).take(20) {
+        for s in SensorSimulator::new(traj, SensorModel::scc1300(1), SAMPLE_INTERVAL_S).take(20) {
             let counts = s.gyro.x / GYRO_LSB;
             assert!((counts - counts.round()).abs() < 1e-9);
             let counts = s.accel.z / ACCEL_LSB;
@@ -402,18 +403,18 @@ mod tests {
         model.noise.gyro[0].white_density = 1e-3;
         model.seed = 3;
         let traj = Trajectory::paper_static(Euler::default());
-        let truth = SensorSimulator::new(traj.clone(), SensorModel::ideal(), 0.05)
+        let truth = SensorSimulator::new(traj.clone(), SensorModel::ideal(), SAMPLE_INTERVAL_S)
             .next()
             .expect("a sample")
             .gyro
             .x;
         let n = 20_000;
-        let var: f64 = SensorSimulator::new(traj, model, 0.05)
+        let var: f64 = SensorSimulator::new(traj, model, SAMPLE_INTERVAL_S)
             .take(n)
             .map(|s| (s.gyro.x - truth).powi(2))
             .sum::<f64>()
             / n as f64;
-        let expected = 1e-6 / 0.05;
+        let expected = 1e-6 / SAMPLE_INTERVAL_S;
         assert!((var / expected - 1.0).abs() < 0.05, "{var} vs {expected}");
     }
 }

@@ -243,6 +243,22 @@ fn bad_data_gets_a_clear_error() {
 }
 
 #[test]
+fn errors_read_as_sentences_not_variant_names() {
+    extern crate std;
+    use std::string::ToString;
+    for e in [
+        AlignmentError::SegmentCount,
+        AlignmentError::InvalidData,
+        AlignmentError::NotStatic,
+        AlignmentError::NoHeadingInformation,
+    ] {
+        let (text, name) = (e.to_string(), std::format!("{e:?}"));
+        assert!(text.split(' ').count() >= 4, "{name}: `{text}`");
+        assert!(!text.contains(&name), "{name}: `{text}`");
+    }
+}
+
+#[test]
 fn no_heading_information_at_the_pole() {
     let mut cfg = config(ImuNoise::scc1300(), None);
     cfg.latitude = PI / 2.0;

@@ -6,6 +6,14 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OutOfRoom;
 
+impl core::fmt::Display for OutOfRoom {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("the buffer ended before the field did")
+    }
+}
+
+impl core::error::Error for OutOfRoom {}
+
 /// Writes fields one after another into `buf`.
 pub struct Writer<'a> {
     buf: &'a mut [u8],

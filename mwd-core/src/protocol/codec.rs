@@ -23,6 +23,25 @@ pub enum FrameError {
     BadLength,
 }
 
+impl core::fmt::Display for FrameError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::TooShort => f.write_str("the frame is shorter than a header and its CRC"),
+            Self::BadCrc => f.write_str("the frame's CRC does not match its contents"),
+            Self::UnsupportedVersion(version) => write!(
+                f,
+                "the frame is of protocol version {version}; this decoder reads version {PROTOCOL_VERSION}"
+            ),
+            Self::UnknownKind { kind, seq } => {
+                write!(f, "frame {seq} is of an unknown kind ({kind})")
+            }
+            Self::BadLength => f.write_str("the frame's length does not fit its kind"),
+        }
+    }
+}
+
+impl core::error::Error for FrameError {}
+
 impl From<OutOfRoom> for FrameError {
     fn from(_: OutOfRoom) -> Self {
         Self::BadLength
@@ -232,6 +251,30 @@ mod tests {
         l[1] = FrameKind::RawSample as u8;
         with_crc(&mut l[..n]);
         assert_eq!(decode_body(&l[..n]), Err(FrameError::BadLength));
+    }
+
+    #[test]
+    fn errors_read_as_sentences_with_their_numbers() {
+        extern crate std;
+        use std::string::ToString;
+        let errors = [
+            FrameError::TooShort,
+            FrameError::BadCrc,
+            FrameError::UnsupportedVersion(2),
+            FrameError::UnknownKind { kind: 9, seq: 3 },
+            FrameError::BadLength,
+        ];
+        for e in errors {
+            let text = e.to_string();
+            assert!(text.split(' ').count() >= 5, "{e:?}: `{text}`");
+        }
+        assert!(errors[2].to_string().contains("version 2"));
+        let unknown = errors[3].to_string();
+        assert!(
+            unknown.contains("frame 3") && unknown.contains("(9)"),
+            "{unknown}"
+        );
+        assert!(OutOfRoom.to_string().contains("buffer"));
     }
 
     #[test]

@@ -1,13 +1,12 @@
 //! Controllability / observability on systems with known answers, then the
 //! MGWD static alignment problem.
 
+use host_sim::observability::matrices::*;
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{
     navigation_error_dynamics, LinearizationPoint, ATT, NAV_STATES, POS, VEL,
 };
-
-use mwd_core::observability::*;
 use nalgebra::{DMatrix, Vector3};
 
 fn double_integrator() -> DMatrix<f64> {
@@ -86,7 +85,7 @@ fn static_alignment_is_full_rank_but_azimuth_is_the_weakest_direction() {
     // ... but over a 60 s alignment at 20 Hz with 0.01 m/s and 0.01 m
     // measurement noise, the data alone pin the tilts to arc-seconds and the
     // azimuth only to degrees: the direction they see least is the azimuth.
-    let dt = 0.05;
+    let dt = mwd_core::timing::SAMPLE_INTERVAL_S;
     let phi = DMatrix::identity(NAV_STATES, NAV_STATES) + &f * dt;
     let o = observability_matrix_discrete(&phi, &(h / 0.01), 1200);
     let scale = [1.7e-3, 1.7e-3, 0.17, 0.1, 0.1, 0.1, 1.0, 1.0, 1.0];

@@ -2,15 +2,18 @@
 //! the navigation errors, optionally with constant sensor-bias states, under
 //! zero-velocity and zero-position updates, for one toolface or a sequence
 //! of toolfaces (a piece-wise constant system, analysed with the stripped
-//! observability matrix). The numbers come from `mwd_core::observability`;
-//! this module builds the models and names the states.
-use mwd_core::conventions::{dcm_from_euler, Euler};
-use mwd_core::earth::{gravity_n, Position};
-use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, NAV_STATES, POS, VEL};
-use mwd_core::observability::{
+//! observability matrix). The matrices, their ranks and the per-state
+//! report are [`matrices`]; this module builds the static probe's models
+//! and names the states.
+pub mod matrices;
+
+use matrices::{
     dynamic, observability_matrix, rank, stripped_observability_matrix, stripping_condition_holds,
     ObservabilityReport,
 };
+use mwd_core::conventions::{dcm_from_euler, Euler, DEG};
+use mwd_core::earth::{gravity_n, Position};
+use mwd_core::error_model::{navigation_error_dynamics, LinearizationPoint, NAV_STATES, POS, VEL};
 use nalgebra::{DMatrix, Vector3};
 
 /// Names of the navigation-error states, then of the bias states.
@@ -37,6 +40,22 @@ pub const STATE_NAMES: [&str; 15] = [
 pub struct Measurements {
     pub zero_velocity: bool,
     pub zero_position: bool,
+}
+
+impl Measurements {
+    /// By name: `zupt` (zero velocity), `zpu` (zero position) or `both`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        let (zero_velocity, zero_position) = match name {
+            "zupt" => (true, false),
+            "zpu" => (false, true),
+            "both" => (true, true),
+            _ => return None,
+        };
+        Some(Self {
+            zero_velocity,
+            zero_position,
+        })
+    }
 }
 
 /// The continuous error model of a tool at rest with attitude `e`: F of
@@ -118,7 +137,7 @@ pub fn analyse(
     let mut scale = vec![1e-3, 1e-3, 1e-3, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01];
     if biases {
         scale.extend([9.8e-3; 3]);
-        scale.extend([2.0 * std::f64::consts::PI / 180.0 / 3600.0; 3]);
+        scale.extend([2.0 * DEG / 3600.0; 3]);
     }
     Analysis {
         states,
@@ -140,6 +159,16 @@ mod tests {
         zero_velocity: true,
         zero_position: true,
     };
+
+    #[test]
+    fn measurements_by_name() {
+        assert_eq!(Measurements::from_name("both"), Some(BOTH));
+        let zupt = Measurements::from_name("zupt").unwrap();
+        assert!(zupt.zero_velocity && !zupt.zero_position);
+        let zpu = Measurements::from_name("zpu").unwrap();
+        assert!(!zpu.zero_velocity && zpu.zero_position);
+        assert_eq!(Measurements::from_name("ZUPT"), None);
+    }
 
     /// At rest, ZUPT + zero position cannot tell a horizontal accelerometer
     /// bias from tilt, nor the east gyro bias from azimuth: three of the 15

@@ -1,10 +1,10 @@
-//! Controllability and observability analysis (paper section 2.4, and the
-//! piece-wise constant systems of toolface indexing), host only.
+//! Controllability and observability matrices (paper section 2.4, and the
+//! piece-wise constant systems of toolface indexing), their ranks and a
+//! per-state report.
 //!
 //! The stacked matrices of the 33-state model are 33 x 1089 (ctrb with a
 //! full noise input) and 198 x 33 (obsv with six measurements): too big for
-//! the probe's stack, so this module uses heap matrices and is compiled
-//! only with the `std` feature.
+//! the probe's stack, so this analysis lives on the host, in heap matrices.
 //!
 //! Numerical rank of such stacks is delicate: F's entries span g ~ 10 to
 //! earth rate ~ 7e-5, and its powers up to F^32 span hundreds of decades.
@@ -15,9 +15,6 @@
 //! the [`ObservabilityReport`]: its `std_from_measurements` is what the
 //! horizon's data alone can pin each state down to.
 
-extern crate alloc;
-
-use alloc::vec::Vec;
 use nalgebra::{DMatrix, DVector, SMatrix};
 
 /// A heap copy of a fixed-size matrix.
@@ -183,7 +180,7 @@ impl ObservabilityReport {
             .collect();
         let svd = pad_rows(&scaled).svd(false, true);
         let mut weakest = DVector::zeros(n);
-        let mut std = alloc::vec![0.0; n];
+        let mut std = vec![0.0; n];
         if let Some(v_t) = &svd.v_t {
             let sv = &svd.singular_values;
             if let Some(i_min) = (0..n).min_by(|&a, &b| sv[a].total_cmp(&sv[b])) {
