@@ -66,6 +66,11 @@ pub const GYRO_TEMPERATURE: TemperatureScale = TemperatureScale {
 /// is found.
 pub const ACCEL_TEMPERATURE: TemperatureScale = GYRO_TEMPERATURE;
 
+/// The part's operating temperature range, -40..+125 degC (datasheet
+/// front page, the MGWD paper's Table 1; docs/scc1300.md). Readings outside
+/// it are flagged (`raw_flags::TEMPERATURE_OUT_OF_RANGE`).
+pub const OPERATING_TEMPERATURE_DEGC: (f32, f32) = (-40.0, 125.0);
+
 /// Converts a left-aligned 16-bit output word into its 14-bit count
 /// (arithmetic shift keeps the sign) \[TN92\].
 pub const fn word_to_count(word: u16) -> i16 {

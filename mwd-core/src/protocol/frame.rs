@@ -74,6 +74,9 @@ pub mod raw_flags {
     pub const NO_RESPONSE: u16 = 1 << 8;
     /// The accelerometer reported FRME (it received a bad frame).
     pub const ACCEL_FRAME_ERROR: u16 = 1 << 9;
+    /// A temperature of this part is outside its operating range
+    /// (`sensor_units::OPERATING_TEMPERATURE_DEGC`), or at a count limit.
+    pub const TEMPERATURE_OUT_OF_RANGE: u16 = 1 << 10;
 }
 
 /// One SCC1300's raw outputs: 14-bit counts as the part delivers them (the
@@ -116,8 +119,18 @@ pub mod nav_flags {
     pub const TOOL_AXIS_RATE_INVALID: u16 = 1 << 1;
     /// Some sensor input of this cycle was flagged invalid.
     pub const SENSOR_DEGRADED: u16 = 1 << 2;
-    /// The covariance was re-initialised (e.g. after a numerical guard).
-    pub const COVARIANCE_RESET: u16 = 1 << 3;
+    /// The filter's covariance failed its health check (a variance not
+    /// finite or not positive, or growth beyond its bound): the sigmas it
+    /// would give are sent as NaN. Bit 3 was "covariance reset", never set.
+    pub const COVARIANCE_INVALID: u16 = 1 << 3;
+    /// The solution is not to be used: its covariance is invalid, or the
+    /// small-angle error model no longer holds (a tilt sigma beyond the
+    /// limit `docs/protocol.md` states).
+    pub const SOLUTION_INVALID: u16 = 1 << 4;
+    /// Propagated through missing or invalid samples and not aided since.
+    pub const COASTING: u16 = 1 << 5;
+    /// One part is out: the solution rests on the other part alone.
+    pub const SINGLE_PART: u16 = 1 << 6;
 }
 
 /// Navigation solution frame. Angles in rad, velocity in m/s (NED), position
@@ -158,6 +171,13 @@ pub enum EventKind {
     SensorReset,
     /// Sampling resynchronised; `value` = samples skipped.
     Resync,
+    /// The navigation fell behind and samples were dropped from its inbox;
+    /// `value` = samples dropped since the previous such event.
+    SamplesDropped,
+    /// A part's temperature left (`code` 0 below, 1 above) or came back
+    /// into (`code` 2) its operating range; `part`, `value` = the
+    /// temperature count (i16, sign-extended).
+    Temperature,
     /// A code this decoder does not know (kept for forward compatibility).
     Other(u8),
 }
@@ -169,6 +189,8 @@ impl EventKind {
             Self::SensorFault => 2,
             Self::SensorReset => 3,
             Self::Resync => 4,
+            Self::SamplesDropped => 5,
+            Self::Temperature => 6,
             Self::Other(b) => b,
         }
     }
@@ -179,6 +201,8 @@ impl EventKind {
             2 => Self::SensorFault,
             3 => Self::SensorReset,
             4 => Self::Resync,
+            5 => Self::SamplesDropped,
+            6 => Self::Temperature,
             b => Self::Other(b),
         }
     }
@@ -245,6 +269,16 @@ mod tests {
         }
         assert_eq!(FrameKind::from_byte(0), None);
         assert_eq!(MAX_BODY_LEN, FrameKind::NavSolution.body_len());
-        assert_eq!(EventKind::from_byte(4), EventKind::Resync);
+        for kind in [
+            EventKind::Boot,
+            EventKind::SensorFault,
+            EventKind::SensorReset,
+            EventKind::Resync,
+            EventKind::SamplesDropped,
+            EventKind::Temperature,
+            EventKind::Other(200),
+        ] {
+            assert_eq!(EventKind::from_byte(kind.to_byte()), kind);
+        }
     }
 }
