@@ -10,8 +10,12 @@
 use heapless::Deque;
 use mwd_core::protocol::{FrameEncoder, Payload, MAX_WIRE_LEN};
 
-/// Transmit queue size of the probe: 20 raw frames (about one second at
-/// 115200 baud), enough to ride out a burst of event frames.
+/// Transmit queue size of the probe: 20 raw frames (about 90 ms of the
+/// UART at 115200 baud). Enough because nothing bursts into it: the
+/// acquisition queues at most 159 B per period while the UART drains 576 B,
+/// and the navigation, which catches up after a recovery, waits for room
+/// (`ProbeState::next_sample_to_navigate`, `budget::NAV_ROOM_BYTES`)
+/// instead of having its frames dropped.
 pub const TX_QUEUE_LEN: usize = 1024;
 
 /// The transmit queue of `N` bytes, with the frame numbering.

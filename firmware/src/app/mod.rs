@@ -5,6 +5,7 @@
 //! binary runs the same logic; a board only supplies the timer interrupt,
 //! its UART ([`Transmitter`]), the sensors' SPI and the watchdog.
 
+pub mod budget;
 pub mod cycle;
 pub mod frame_queue;
 pub mod probe;
@@ -13,12 +14,14 @@ pub mod sensor_wire;
 pub mod shared;
 pub mod start_up;
 pub mod transmitter;
+pub mod watchdog;
 
 pub use cycle::{AcquisitionCycle, CycleReport};
 pub use frame_queue::{FrameQueue, TX_QUEUE_LEN};
 pub use probe::{ProbeState, RecoveryJob, Sensors};
 pub use sample_inbox::{SampleInbox, NAV_INBOX_LEN};
 pub use sensor_wire::{fault_code, raw_part, reset_event_code, sensor_fault_event};
-pub use shared::{Shared, SharedProbe, FIRMWARE_VERSION, WATCHDOG_TIMEOUT_MS};
+pub use shared::{Shared, SharedProbe, FIRMWARE_VERSION};
 pub use start_up::{start_parts, START_ATTEMPTS};
 pub use transmitter::Transmitter;
+pub use watchdog::WATCHDOG_TIMEOUT_MS;

@@ -12,6 +12,7 @@ use mwd_core::protocol::frame::NO_PART;
 use mwd_core::protocol::{Event, EventKind, Payload, RawSample};
 use mwd_core::timing::sample_time_us;
 
+use super::budget::NAV_ROOM_BYTES;
 use super::cycle::AcquisitionCycle;
 use super::frame_queue::{FrameQueue, TX_QUEUE_LEN};
 use super::sample_inbox::{SampleInbox, NAV_INBOX_LEN};
@@ -115,6 +116,25 @@ impl<G, A> ProbeState<G, A> {
         self.nav_inbox.pop()
     }
 
+    /// The oldest sample waiting for the navigation, if the transmit queue
+    /// has room for its navigation frame and for what the acquisition may
+    /// queue meanwhile ([`NAV_ROOM_BYTES`]); otherwise the sample waits in
+    /// the inbox until the UART has drained the queue, so the catch-up after
+    /// a long recovery never drops a navigation frame. Samples the inbox
+    /// dropped since the last call are reported first, in a SamplesDropped
+    /// event (value: how many).
+    pub fn next_sample_to_navigate(&mut self) -> Option<RawSample> {
+        if TX_QUEUE_LEN - self.queue.len() < NAV_ROOM_BYTES || self.nav_inbox.is_empty() {
+            return None;
+        }
+        let dropped = self.nav_inbox.take_unreported_drops();
+        if dropped > 0 {
+            let event = self.event(EventKind::SamplesDropped, NO_PART, 0, dropped);
+            self.queue.push(&event);
+        }
+        self.nav_inbox.pop()
+    }
+
     /// An event frame stamped with the time of the next sample.
     pub fn event(&self, kind: EventKind, part: u8, code: u16, value: u32) -> Payload {
         Payload::Event(Event {
@@ -201,7 +221,7 @@ mod tests {
             [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
         let mut delay = SimDelay::new(&clock);
         let mut probe = ProbeState::new();
-        start_parts(&mut parts, &mut delay, |p| {
+        start_parts(&mut parts, &mut delay, &mut || {}, |p| {
             probe.push(p);
         });
         probe.acquire();

@@ -2,7 +2,8 @@
 //! [`Transmitter`] behind one critical section ([`SharedProbe`], kept in a
 //! static), reached from the timer interrupt ([`Shared::acquire`]), the
 //! UART's interrupt ([`Shared::transmitter_ready`]) and the main loop
-//! ([`SharedProbe::main_loop_pass`]: sensor recovery, then navigation).
+//! ([`SharedProbe::main_loop_pass`]: navigation, sensor recovery once it
+//! has caught up, navigation again; the watchdog fed between the steps).
 //! A board adds its timer, its UART's registers and its watchdog.
 
 use core::cell::RefCell;
@@ -21,10 +22,6 @@ use crate::scc1300::Error;
 
 /// Firmware version, sent in the boot event.
 pub const FIRMWARE_VERSION: u16 = 1;
-
-/// The board's watchdog timeout: the main loop comes round every 50 ms, a
-/// sensor recovery holds it up to about a second.
-pub const WATCHDOG_TIMEOUT_MS: u32 = 2_000;
 
 /// What the contexts share: the probe's state and its transmitter.
 pub struct Shared<G, A, T> {
@@ -107,15 +104,26 @@ impl<G, A, T: Transmitter> SharedProbe<G, A, T> {
         self.push_event(EventKind::Boot, NO_PART, FIRMWARE_VERSION, 0);
     }
 
-    /// Navigates every waiting sample, oldest first, outside the critical
-    /// section, and queues each solution; `on_solution` sees each first.
+    /// Navigates the waiting samples, oldest first, outside the critical
+    /// section, as long as the transmit queue has room for their frames
+    /// ([`ProbeState::next_sample_to_navigate`]; the rest wait for the
+    /// UART), and queues each solution; `on_solution` sees each first. The
+    /// watchdog is fed after each step (the slowest,
+    /// `budget::SLOWEST_NAVIGATION_STEP_MS`, is within its budget).
     pub fn navigate_waiting(
         &self,
         navigator: &mut Navigator,
+        feed_watchdog: &mut impl FnMut(),
         mut on_solution: impl FnMut(&NavSolution),
     ) {
-        while let Some(sample) = self.with(|shared| shared.probe.next_sample()) {
+        while let Some(sample) = self.with(|shared| {
+            let sample = shared.probe.next_sample_to_navigate();
+            // A SamplesDropped event may have been queued.
+            shared.transmitter.kick(shared.probe.queue_mut());
+            sample
+        }) {
             let solution = navigator.step(&sample);
+            feed_watchdog();
             on_solution(&solution);
             self.push(&Payload::Nav(solution));
         }
@@ -126,13 +134,17 @@ impl<G: SpiDevice, A: SpiDevice, T: Transmitter> SharedProbe<G, A, T> {
     /// Starts the parts (each failed attempt reported as an event; this
     /// waits, outside the critical section), then hands them to the
     /// acquisition. Returns the error of each part that never started: it
-    /// streams anyway, flagged in every raw frame.
+    /// streams anyway, flagged in every raw frame. The watchdog is fed
+    /// after each attempt (`budget::PART_START_WORST_MS` apart at most).
     pub fn start_streaming(
         &self,
         mut sensors: Sensors<G, A>,
         delay: &mut impl DelayNs,
+        feed_watchdog: &mut impl FnMut(),
     ) -> [Option<Error>; 2] {
-        let outcome = start_parts(&mut sensors, delay, |payload| self.push(payload));
+        let outcome = start_parts(&mut sensors, delay, feed_watchdog, |payload| {
+            self.push(payload)
+        });
         self.with(|shared| shared.probe.start_streaming(sensors));
         outcome
     }
@@ -140,11 +152,20 @@ impl<G: SpiDevice, A: SpiDevice, T: Transmitter> SharedProbe<G, A, T> {
     /// Runs the recovery the acquisition asked for, if any, outside the
     /// critical section (it waits): one SensorReset event per part (also
     /// told to `on_reset`), then the parts go back with a Resync event.
-    pub fn recover_if_asked(&self, delay: &mut impl DelayNs, mut on_reset: impl FnMut(u8, u16)) {
+    /// The watchdog is fed after each part's recovery, so the longest it
+    /// goes unfed is one part's (`budget::PART_RECOVERY_WORST_MS`), not
+    /// both parts'.
+    pub fn recover_if_asked(
+        &self,
+        delay: &mut impl DelayNs,
+        feed_watchdog: &mut impl FnMut(),
+        mut on_reset: impl FnMut(u8, u16),
+    ) {
         let Some(mut job) = self.with(|shared| shared.probe.take_recovery()) else {
             return;
         };
         job.run(delay, |part, code| {
+            feed_watchdog();
             on_reset(part, code);
             self.push_event(EventKind::SensorReset, part, code, 0);
         });
@@ -152,17 +173,26 @@ impl<G: SpiDevice, A: SpiDevice, T: Transmitter> SharedProbe<G, A, T> {
         self.push(&resync);
     }
 
-    /// The main loop's work each time it wakes: the recovery, then the
-    /// navigation of the samples taken meanwhile.
+    /// The main loop's work each time it wakes: the navigation of the
+    /// waiting samples; once it has caught up, the recovery the acquisition
+    /// asked for, if any, and the navigation of the samples taken
+    /// meanwhile. Recovering only when the inbox is empty bounds what it
+    /// must hold to one recovery's samples (`budget::NAV_INBOX_NEEDED`),
+    /// also when a part fails again and again.
     pub fn main_loop_pass(
         &self,
         delay: &mut impl DelayNs,
         navigator: &mut Navigator,
+        feed_watchdog: &mut impl FnMut(),
         on_reset: impl FnMut(u8, u16),
-        on_solution: impl FnMut(&NavSolution),
+        mut on_solution: impl FnMut(&NavSolution),
     ) {
-        self.recover_if_asked(delay, on_reset);
-        self.navigate_waiting(navigator, on_solution);
+        feed_watchdog();
+        self.navigate_waiting(navigator, feed_watchdog, &mut on_solution);
+        if self.with(|shared| shared.probe.nav_inbox().is_empty()) {
+            self.recover_if_asked(delay, feed_watchdog, on_reset);
+            self.navigate_waiting(navigator, feed_watchdog, &mut on_solution);
+        }
     }
 }
 

@@ -19,9 +19,13 @@ pub const START_ATTEMPTS: u32 = 3;
 /// start-up runs before streaming). A callback, not the queue, because the
 /// queue is shared with interrupts and must not stay locked while the
 /// start-up waits.
+///
+/// `after_attempt` runs after each attempt (the board feeds its watchdog
+/// there: an attempt is at most `budget::PART_START_WORST_MS`).
 pub fn start_parts<G: SpiDevice, A: SpiDevice>(
     parts: &mut [Part<G, A>; 2],
     delay: &mut impl DelayNs,
+    after_attempt: &mut impl FnMut(),
     mut report: impl FnMut(&Payload),
 ) -> [Option<Error>; 2] {
     let mut outcome = [None, None];
@@ -33,6 +37,7 @@ pub fn start_parts<G: SpiDevice, A: SpiDevice>(
             } else {
                 part.start_powered(delay)
             };
+            after_attempt();
             match started {
                 Ok(()) => {
                     *result = None;
@@ -69,9 +74,16 @@ mod tests {
         let mut parts =
             [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
         let mut queue = FrameQueue::<1024>::new();
-        let outcome = start_parts(&mut parts, &mut SimDelay::new(&clock), |p| {
-            queue.push(p);
-        });
+        let mut attempts = 0;
+        let outcome = start_parts(
+            &mut parts,
+            &mut SimDelay::new(&clock),
+            &mut || attempts += 1,
+            |p| {
+                queue.push(p);
+            },
+        );
+        assert_eq!(attempts, 1 + START_ATTEMPTS);
         assert_eq!(outcome[0], None);
         assert!(matches!(outcome[1], Some(Error::NoResponse(_))));
 

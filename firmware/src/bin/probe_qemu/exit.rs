@@ -16,7 +16,7 @@ pub fn finish(summary: &Summary) -> ! {
         "probe-qemu: samples={} skipped={} frames_queued={} frames_dropped={} \
          cycle_ticks_worst={} cycle_ticks_mean={} \
          cycle_instructions_worst={} cycle_instructions_mean={} stack_high_water_bytes={} \
-         nav_samples_dropped={} cycle_overruns={} overrun_instructions_longest={} \
+         nav_samples_dropped={} nav_inbox_high_water={} cycle_overruns={} overrun_instructions_longest={} \
          mode_changes={} mode_change_instructions_longest={}",
         summary.samples,
         summary.skipped,
@@ -28,6 +28,7 @@ pub fn finish(summary: &Summary) -> ! {
         summary.mean_ticks * INSTRUCTIONS_PER_TICK,
         summary.stack_bytes,
         summary.nav_dropped,
+        summary.nav_inbox_high_water,
         summary.overruns,
         summary.longest_overrun_ticks * u64::from(INSTRUCTIONS_PER_TICK),
         summary.mode_changes,

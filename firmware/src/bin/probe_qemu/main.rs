@@ -7,7 +7,8 @@
 //!   main loop's) and queues the raw frame and any fault events;
 //! - UART0 TX interrupt: moves the next queued byte into the transmitter;
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
-//!   raw sample (navigation frames); feeds the watchdog; sleeps otherwise.
+//!   raw sample (navigation frames); feeds the watchdog between those steps
+//!   (`firmware::app::budget`); sleeps otherwise.
 //!
 //! What the contexts share and do is `firmware::app::SharedProbe`, as on
 //! the real board; this file adds UART0 as its `Transmitter`, SysTick, the
@@ -151,19 +152,23 @@ fn main() -> ! {
 
     PROBE.announce_boot();
     registers::watchdog_start(WATCHDOG_TIMEOUT_MS);
-    PROBE.start_streaming(mock_sensors::power_up(), &mut TickDelay);
+    PROBE.start_streaming(
+        mock_sensors::power_up(),
+        &mut TickDelay,
+        &mut registers::watchdog_feed,
+    );
 
     let mut cost = CycleCost::default();
     // The simulated site: the MGWD paper's test site.
     let mut navigator = Navigator::new(Position::paper_site());
     let mut mode = nav_mode::INITIALISING;
     loop {
-        registers::watchdog_feed();
         let tick = TICKS.load(Ordering::Relaxed);
         let mut mode_changed = false;
         PROBE.main_loop_pass(
             &mut TickDelay,
             &mut navigator,
+            &mut registers::watchdog_feed,
             |_, _| {},
             |solution| {
                 mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
@@ -221,6 +226,7 @@ struct Summary {
     mean_ticks: u32,
     stack_bytes: usize,
     nav_dropped: u32,
+    nav_inbox_high_water: usize,
     overruns: u32,
     longest_overrun_ticks: u64,
     mode_changes: u32,
@@ -238,6 +244,7 @@ fn summary(cost: &CycleCost) -> Summary {
         mean_ticks,
         stack_bytes: stack_paint::high_water_bytes(),
         nav_dropped: s.probe().nav_inbox().dropped(),
+        nav_inbox_high_water: s.probe().nav_inbox().high_water(),
         overruns: cost.overruns,
         longest_overrun_ticks: cost.longest_overrun,
         mode_changes: cost.mode_changes,

@@ -21,6 +21,7 @@ use core::cell::RefCell;
 
 use critical_section::Mutex;
 use embedded_hal_bus::spi::{CriticalSectionDevice, NoDelay};
+use firmware::app::WATCHDOG_TIMEOUT_MS;
 use firmware::scc1300::datasheet::SPI_CLOCK_HZ;
 use firmware::scc1300::Part;
 use stm32f4xx_hal::gpio::{ErasedPin, Output, PushPull};
@@ -54,9 +55,15 @@ pub struct Board {
     pub watchdog: IndependentWatchdog,
 }
 
-/// Clocks, pins and peripherals. Fails (the caller logs and halts) only on
-/// a configuration the HAL rejects, which is a build-time mistake.
+/// The watchdog first, then clocks, pins and peripherals. Fails (the caller
+/// logs and resets) only on a configuration the HAL rejects, which is a
+/// build-time mistake; a hang here (e.g. a crystal that never starts:
+/// `freeze` waits for it) is ended by the watchdog.
 pub fn init(dp: pac::Peripherals, syst: cortex_m::peripheral::SYST) -> Result<Board, &'static str> {
+    // From the LSI, independent of the clocks set up below; its timeout is
+    // sized against the LSI's 17-47 kHz (`firmware::app::watchdog`).
+    let mut watchdog = IndependentWatchdog::new(dp.IWDG);
+    watchdog.start(WATCHDOG_TIMEOUT_MS.millis());
     let rcc = dp.RCC.constrain();
     let clocks: Clocks = rcc
         .cfgr
@@ -111,6 +118,6 @@ pub fn init(dp: pac::Peripherals, syst: cortex_m::peripheral::SYST) -> Result<Bo
         uart,
         timer,
         delay,
-        watchdog: IndependentWatchdog::new(dp.IWDG),
+        watchdog,
     })
 }

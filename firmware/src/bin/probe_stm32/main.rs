@@ -8,7 +8,12 @@
 //!   main loop's) and queues the raw frame and any fault events;
 //! - USART1 (TX empty): moves the next queued byte into the transmitter;
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
-//!   raw sample (navigation frames); feeds the watchdog; sleeps otherwise.
+//!   raw sample (navigation frames); feeds the watchdog between those steps
+//!   (`firmware::app::budget`); sleeps otherwise.
+//!
+//! Nothing hangs the board: the watchdog starts first thing
+//! (`board::init`), and a panic or fault resets the chip at once (the
+//! `HardFault` handler below), after panic-probe has logged it.
 //!
 //! What the contexts share and do is `firmware::app::SharedProbe`, as on
 //! the QEMU board; this file adds USART1 as its `Transmitter`, TIM2, the
@@ -20,12 +25,10 @@ mod board;
 
 use core::cell::RefCell;
 
-use cortex_m_rt::entry;
+use cortex_m_rt::{entry, exception, ExceptionFrame};
 use critical_section::Mutex;
 use defmt_rtt as _;
-use firmware::app::{
-    FrameQueue, SharedProbe, Transmitter, FIRMWARE_VERSION, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS,
-};
+use firmware::app::{FrameQueue, SharedProbe, Transmitter, FIRMWARE_VERSION, TX_QUEUE_LEN};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 use mwd_core::timing::SAMPLE_RATE_HZ;
@@ -77,6 +80,18 @@ static PROBE: SharedProbe<Device, Device, Usart1> = SharedProbe::new(Usart1 { ua
 /// The acquisition timer, whose interrupt flag its interrupt clears.
 static TIMER: Mutex<RefCell<Option<Timer>>> = Mutex::new(RefCell::new(None));
 
+/// Every panic ends here (panic-probe logs it, then executes `udf`, which
+/// escalates to a hard fault), as does any real fault: reset the chip
+/// rather than spin, so a failed start-up (the `panic!`s in `main` and
+/// `board::init`) reboots the probe, which announces itself again with a
+/// boot event, instead of hanging it.
+// SAFETY: cortex-m-rt requires the handler to be an `unsafe fn`; it only
+// requests a system reset.
+#[exception]
+unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+    cortex_m::peripheral::SCB::sys_reset()
+}
+
 #[interrupt]
 fn TIM2() {
     critical_section::with(|cs| {
@@ -127,17 +142,19 @@ fn main() -> ! {
     }
 
     PROBE.announce_boot();
-    watchdog.start(WATCHDOG_TIMEOUT_MS.millis());
-    PROBE.start_streaming(sensors, &mut delay);
+    // The watchdog runs since `board::init`; the start-up feeds it after
+    // each attempt.
+    watchdog.feed();
+    PROBE.start_streaming(sensors, &mut delay, &mut || watchdog.feed());
     defmt::info!("streaming at {=u32} Hz", SAMPLES_PER_SECOND);
 
     // The probe's site: the MGWD paper's test site until it is configurable.
     let mut navigator = Navigator::new(Position::paper_site());
     loop {
-        watchdog.feed();
         PROBE.main_loop_pass(
             &mut delay,
             &mut navigator,
+            &mut || watchdog.feed(),
             |part, code| defmt::warn!("part {=u8} recovered, code {=u16}", part, code),
             |_| {},
         );
