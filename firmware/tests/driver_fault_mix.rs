@@ -53,6 +53,14 @@ fn random_faults() -> impl proptest::strategy::Strategy<Value = hil_mock::Faults
             gyro_saturated: on[3] && on[4],
             accel_saturated: on[4] && on[5],
             accel_self_test_failed: on[5] && on[0],
+            // A part out of its temperature range (the count clipped).
+            temperature: (on[1] && on[2]).then_some(hil_mock::TemperatureExcursion {
+                window: Window {
+                    start_ns: at,
+                    end_ns: at + 500_000_000,
+                },
+                degc: if on[3] { 200 } else { -60 },
+            }),
         })
 }
 

@@ -62,7 +62,7 @@ pub(crate) fn frame<T: TimeSource, S: SampleSource>(
 ) {
     let now = part.advance();
     part.stats.accel_frames += 1;
-    let sample = part.source.sample(now);
+    let sample = part.physics(now);
     let limit = ACCEL_RANGE_G * STANDARD_GRAVITY_M_S2;
     if part.faults.accel_saturated || sample.accel_m_s2.iter().any(|a| a.abs() > limit) {
         part.accel.sat_latched = true;

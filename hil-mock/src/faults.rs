@@ -84,6 +84,15 @@ impl Window {
     }
 }
 
+/// The part's temperature forced to `degc` during `window` (both slaves'
+/// temperature outputs; whole degrees are enough to cross the operating
+/// range or clip the count: 200 degC reads as the count limit 8191).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TemperatureExcursion {
+    pub window: Window,
+    pub degc: i16,
+}
+
 /// Everything that can be injected into one part.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Faults {
@@ -102,6 +111,8 @@ pub struct Faults {
     pub accel_saturated: bool,
     /// Accelerometer ST (self-test/checksum failure) raised.
     pub accel_self_test_failed: bool,
+    /// The part runs hot or cold for a while.
+    pub temperature: Option<TemperatureExcursion>,
 }
 
 /// xorshift32: tiny, deterministic, no_std; quality is plenty for fault dice.

@@ -85,12 +85,12 @@ fn answer<T: TimeSource, S: SampleSource>(
             let count = if part.faults.gyro_saturated {
                 COUNT_MAX
             } else {
-                sensor_units::rad_s_to_gyro_count(part.source.sample(now).rate_rad_s)
+                sensor_units::rad_s_to_gyro_count(part.physics(now).rate_rad_s)
             };
             sensor_units::count_to_word(count)
         }
         TEMP => {
-            let t = part.source.sample(now).temperature_degc;
+            let t = part.physics(now).temperature_degc;
             sensor_units::count_to_word(GYRO_TEMPERATURE.degc_to_count(t))
         }
         STATUS => {
@@ -148,6 +148,31 @@ mod tests {
         let temp = exchange(&mut p, [0, 0x51, 0, 1])[1];
         assert_eq!(temp & !1, 0xCD38);
         assert_eq!(p.stats().gyro_mosi_errors, 0);
+    }
+
+    #[test]
+    fn a_temperature_excursion_clips_the_count_during_its_window() {
+        use crate::faults::{TemperatureExcursion, Window};
+        let clock = SimClock::new();
+        let mut p = part(&clock);
+        clock.advance_ms(800);
+        p.faults.temperature = Some(TemperatureExcursion {
+            window: Window {
+                start_ns: 900_000_000,
+                end_ns: 1_000_000_000,
+            },
+            degc: 200,
+        });
+        let temp = |p: &mut Scc1300<&SimClock, Constant>| {
+            sensor_units::word_to_count(exchange(p, [0, 0x51, 0, 1])[1])
+        };
+        assert_eq!(temp(&mut p), -3250, "0 degC before the window");
+        clock.advance_ms(100);
+        // 200 degC is count 9750, beyond the 14-bit limit.
+        assert_eq!(temp(&mut p), sensor_units::COUNT_MAX);
+        assert_eq!(p.truth().temperature_degc, 200.0);
+        clock.advance_ms(100);
+        assert_eq!(temp(&mut p), -3250, "back after it");
     }
 
     #[test]

@@ -38,7 +38,7 @@ pub mod still;
 
 pub use accel::ACCEL_SETTLE_NS;
 pub use clock::{SimClock, SimDelay, TimeSource, SAMPLE_PERIOD_NS};
-pub use faults::{Chance, DeadLevel, Faults, LinkFaults, Window};
+pub use faults::{Chance, DeadLevel, Faults, LinkFaults, TemperatureExcursion, Window};
 pub use part::{DparScope, MockStats, Scc1300, DEFAULT_DPAR_SCOPE, START_UP_NS};
 pub use source::{
     BodySample, BodySource, Constant, Generator, MountedSource, PhysicalSample, SampleSource,

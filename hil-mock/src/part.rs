@@ -119,7 +119,19 @@ impl<T: TimeSource, S: SampleSource> Scc1300<T, S> {
     /// What the source says now (what a perfect driver would read).
     pub fn truth(&mut self) -> PhysicalSample {
         let now = self.time.now_ns();
-        self.source.sample(now)
+        self.physics(now)
+    }
+
+    /// What the part senses at `now`: its source, with an injected
+    /// temperature excursion applied.
+    pub(crate) fn physics(&mut self, now: u64) -> PhysicalSample {
+        let mut sample = self.source.sample(now);
+        if let Some(excursion) = self.faults.temperature {
+            if excursion.window.contains(now) {
+                sample.temperature_degc = f32::from(excursion.degc);
+            }
+        }
+        sample
     }
 
     /// Applies time-triggered faults; returns the current time.

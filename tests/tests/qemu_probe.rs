@@ -271,7 +271,7 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     require_qemu();
     // Faults (firmware/src/bin/probe_qemu/mock_sensors.rs): part 0 gyro
     // parity errors at 10 s, part 1 gyro S_OK drop at 20 s, part 0
-    // power-cycle at 30 s.
+    // power-cycle at 30 s, part 1 at 200 degC from 40 to 41 s.
     let elf = build_firmware("qemu-fault-demo", "faults");
     let run = run_in_qemu(&elf, "faults");
     let (frames, stats) = decode(&run.uart);
@@ -346,10 +346,41 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     assert_eq!(summary_value(&run.stdout, "skipped"), away.count() as u64);
     assert_eq!(summary_value(&run.stdout, "skipped"), resyncs);
     assert_eq!(summary_value(&run.stdout, "nav_samples_dropped"), 0);
+    assert!(events.iter().all(|e| e.kind != EventKind::SamplesDropped));
+    assert!(
+        summary_value(&run.stdout, "nav_inbox_high_water") <= firmware::app::NAV_INBOX_LEN as u64
+    );
     assert!(raws
         .iter()
         .filter(|r| r.time_us >= 32_000_000)
         .all(|r| r.parts.iter().all(|p| p.flags & valid == valid)));
+
+    // The overheated part: its raw frames flag every sample from 40 to
+    // 41 s (values still valid), and two events say when it left its
+    // operating range (code 1, above: the clipped count 8191) and came
+    // back (code 2, its count at the simulated 25 degC).
+    let hot: Vec<u32> = raws
+        .iter()
+        .filter(|r| r.parts[1].flags & raw_flags::TEMPERATURE_OUT_OF_RANGE != 0)
+        .map(|r| r.sample_counter)
+        .collect();
+    assert_eq!(hot, (40 * 20..41 * 20).collect::<Vec<u32>>());
+    assert!(raws
+        .iter()
+        .all(|r| r.parts[0].flags & raw_flags::TEMPERATURE_OUT_OF_RANGE == 0));
+    let temperature_events: Vec<(u8, u16, i32, u64)> = events
+        .iter()
+        .filter(|e| e.kind == EventKind::Temperature)
+        .map(|e| (e.part, e.code, e.value as i32, e.time_us))
+        .collect();
+    let back_count = i32::from(
+        mwd_core::sensor_units::GYRO_TEMPERATURE
+            .degc_to_count(StillProbe::paper_test(2).temperature_degc),
+    );
+    assert_eq!(
+        temperature_events,
+        [(1, 1, 8191, 40_000_000), (1, 2, back_count, 41_000_000)]
+    );
 }
 
 #[test]

@@ -3,6 +3,9 @@
 //! becomes an event frame, so the surface sees each fault and the stream
 //! goes on.
 //!
+//! A part's temperature leaving or re-entering its operating range becomes
+//! a Temperature event (the raw frames flag every sample outside it).
+//!
 //! The cycle never waits: a part that needs its (blocking) recovery is
 //! reported to the caller, which hands it to the lower-priority main loop;
 //! the samples taken while the parts are away still go out as raw frames
@@ -13,7 +16,9 @@ use mwd_core::protocol::{Payload, RawSample};
 use mwd_core::timing::sample_time_us;
 
 use super::frame_queue::FrameQueue;
-use super::sensor_wire::{raw_part, sensor_fault_event};
+use super::sensor_wire::{
+    part_temperature, raw_part, sensor_fault_event, temperature_event, TemperatureRange,
+};
 use crate::scc1300::PartReading;
 
 /// What one cycle asks of its caller.
@@ -39,6 +44,8 @@ pub struct AcquisitionCycle {
     samples: u32,
     skipped: u32,
     faults_per_part: [u32; 2],
+    /// Each part's temperature as last measured (inside at boot).
+    temperature: [TemperatureRange; 2],
 }
 
 impl AcquisitionCycle {
@@ -47,6 +54,7 @@ impl AcquisitionCycle {
             samples: 0,
             skipped: 0,
             faults_per_part: [0; 2],
+            temperature: [TemperatureRange::Inside; 2],
         }
     }
 
@@ -89,6 +97,14 @@ impl AcquisitionCycle {
             if let Some(flag) = report.recovery_needed.get_mut(index) {
                 *flag = reading.needs_recovery();
             }
+            if let (Some((range, count)), Some(last)) =
+                (part_temperature(reading), self.temperature.get_mut(index))
+            {
+                if range != *last {
+                    *last = range;
+                    queue.push(&temperature_event(time_us, index as u8, range, count));
+                }
+            }
         }
         report
     }
@@ -111,6 +127,11 @@ impl AcquisitionCycle {
     /// Cycles whose parts were away for recovery.
     pub fn skipped(&self) -> u32 {
         self.skipped
+    }
+
+    /// Each part's temperature as last measured.
+    pub fn temperatures(&self) -> [TemperatureRange; 2] {
+        self.temperature
     }
 
     /// Sensor faults of each part so far.

@@ -272,4 +272,79 @@ mod tests {
         }
         assert_eq!(raw, 13);
     }
+
+    #[test]
+    fn a_part_outside_its_temperature_range_is_flagged_and_evented() {
+        use hil_mock::TemperatureExcursion;
+        use mwd_core::protocol::frame::raw_flags::TEMPERATURE_OUT_OF_RANGE;
+        use mwd_core::sensor_units::COUNT_MAX;
+
+        let clock = SimClock::new();
+        let mocks =
+            [0, 1].map(|i| RefCell::new(Scc1300::new(&clock, Constant::default(), i as u32)));
+        let mut parts =
+            [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
+        let mut delay = SimDelay::new(&clock);
+        let mut probe = ProbeState::new();
+        start_parts(&mut parts, &mut delay, &mut || {}, |p| {
+            probe.push(p);
+        });
+        probe.start_streaming(parts);
+        // Part 1 at 200 degC for samples 2..5 (the count clips at 8191),
+        // back at 0 degC, then at -60 degC for samples 8..10.
+        let excursion = |from: u64, to: u64, degc: i16| {
+            let t0 = clock.now_ns();
+            Some(TemperatureExcursion {
+                window: Window {
+                    start_ns: t0 + from * SAMPLE_PERIOD_NS - SAMPLE_PERIOD_NS / 2,
+                    end_ns: t0 + to * SAMPLE_PERIOD_NS - SAMPLE_PERIOD_NS / 2,
+                },
+                degc,
+            })
+        };
+        let mut out_of_range = Vec::new();
+        for n in 1..=12u64 {
+            if n == 1 {
+                mocks[1].borrow_mut().faults.temperature = excursion(2, 5, 200);
+            }
+            if n == 6 {
+                mocks[1].borrow_mut().faults.temperature = excursion(2, 4, -60);
+            }
+            clock.advance_ns(SAMPLE_PERIOD_NS);
+            probe.acquire();
+            let sample = probe.next_sample().expect("a sample per period");
+            out_of_range.push(
+                sample
+                    .parts
+                    .map(|p| p.flags & TEMPERATURE_OUT_OF_RANGE != 0),
+            );
+        }
+        let flagged: Vec<usize> = (0..12).filter(|&i| out_of_range[i][1]).collect();
+        assert_eq!(flagged, [1, 2, 3, 6, 7]);
+        assert!(out_of_range.iter().all(|p| !p[0]));
+
+        let mut decoder = Decoder::new();
+        let mut events = Vec::new();
+        while let Some(b) = probe.next_byte() {
+            decoder.feed(&[b], |f| {
+                if let Payload::Event(e) = f.payload {
+                    if e.kind == EventKind::Temperature {
+                        events.push((e.part, e.code, e.value as i32, e.time_us));
+                    }
+                }
+            });
+        }
+        let zero_degc = -3250;
+        let minus_60_degc = -60 * 65 - 3250;
+        let at = |n: u64| n * mwd_core::timing::SAMPLE_PERIOD_US;
+        assert_eq!(
+            events,
+            [
+                (1, 1, i32::from(COUNT_MAX), at(1)),
+                (1, 2, zero_degc, at(4)),
+                (1, 0, minus_60_degc, at(6)),
+                (1, 2, zero_degc, at(8)),
+            ]
+        );
+    }
 }

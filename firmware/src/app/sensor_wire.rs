@@ -5,6 +5,10 @@
 
 use mwd_core::protocol::frame::{raw_flags, RawPart};
 use mwd_core::protocol::{Event, EventKind, Payload};
+use mwd_core::sensor_units::{
+    TemperatureScale, ACCEL_TEMPERATURE, COUNT_MAX, COUNT_MIN, GYRO_TEMPERATURE,
+    OPERATING_TEMPERATURE_DEGC,
+};
 
 use crate::scc1300::{Error, GyroRecovery, PartReading, RecoveryReport, Slave, Word};
 
@@ -27,6 +31,9 @@ pub fn raw_part(reading: &PartReading) -> RawPart {
     flags |= reading
         .accel_error
         .map_or(raw_flags::ACCEL_VALID, |e| error_flag(&e));
+    if part_temperature(reading).is_some_and(|(range, _)| range != TemperatureRange::Inside) {
+        flags |= raw_flags::TEMPERATURE_OUT_OF_RANGE;
+    }
     RawPart {
         gyro_rate: reading.gyro.rate,
         gyro_temp: reading.gyro.temp,
@@ -34,6 +41,80 @@ pub fn raw_part(reading: &PartReading) -> RawPart {
         accel_temp: reading.accel.temp,
         flags,
     }
+}
+
+/// Where a part's temperature lies against its operating range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TemperatureRange {
+    Below,
+    #[default]
+    Inside,
+    Above,
+}
+
+/// A temperature count against the part's operating range
+/// (`sensor_units::OPERATING_TEMPERATURE_DEGC`, the limits inside). A count
+/// at a limit of the 14-bit range is outside whatever the (unverified)
+/// formula says: the temperature clipped there (200 degC reads 8191).
+pub fn temperature_range(count: i16, scale: &TemperatureScale) -> TemperatureRange {
+    let degc = scale.count_to_degc(count);
+    let (lowest, highest) = OPERATING_TEMPERATURE_DEGC;
+    if count == COUNT_MIN || degc < lowest {
+        TemperatureRange::Below
+    } else if count == COUNT_MAX || degc > highest {
+        TemperatureRange::Above
+    } else {
+        TemperatureRange::Inside
+    }
+}
+
+/// The part's temperature judged from the temperatures it measured in this
+/// sample (the gyro's when its values are valid or only saturated, the
+/// accelerometer's when its values are valid; other counts are not
+/// measurements): above when either is above, else below when either is
+/// below, else inside; with the count that decided. None when neither
+/// temperature was measured.
+pub fn part_temperature(reading: &PartReading) -> Option<(TemperatureRange, i16)> {
+    let gyro_measured = matches!(
+        reading.gyro_error,
+        None | Some(Error::Saturated(Slave::Gyro))
+    );
+    let measured = [
+        gyro_measured.then(|| {
+            (
+                temperature_range(reading.gyro.temp, &GYRO_TEMPERATURE),
+                reading.gyro.temp,
+            )
+        }),
+        reading.accel_error.is_none().then(|| {
+            (
+                temperature_range(reading.accel.temp, &ACCEL_TEMPERATURE),
+                reading.accel.temp,
+            )
+        }),
+    ];
+    let find = |wanted: TemperatureRange| measured.iter().flatten().find(|(r, _)| *r == wanted);
+    find(TemperatureRange::Above)
+        .or_else(|| find(TemperatureRange::Below))
+        .or_else(|| measured.iter().flatten().next())
+        .copied()
+}
+
+/// The Temperature event of part `part` entering `range`: code 0 below the
+/// operating range, 1 above it, 2 back inside; value the count that showed
+/// it, sign-extended.
+pub fn temperature_event(time_us: u64, part: u8, range: TemperatureRange, count: i16) -> Payload {
+    Payload::Event(Event {
+        time_us,
+        kind: EventKind::Temperature,
+        part,
+        code: match range {
+            TemperatureRange::Below => 0,
+            TemperatureRange::Above => 1,
+            TemperatureRange::Inside => 2,
+        },
+        value: i32::from(count) as u32,
+    })
 }
 
 /// The raw-sample flag bit a slave's error sets (none for a gyro that is
@@ -178,6 +259,61 @@ mod tests {
             raw_flags::RESET_SEEN | raw_flags::ACCEL_SATURATED | raw_flags::SELF_TEST_FAILED
         );
         assert_eq!(error_flag(&Error::LoopFailure), raw_flags::RESET_SEEN);
+    }
+
+    #[test]
+    fn temperatures_outside_the_range_or_clipped_are_flagged_when_measured() {
+        use TemperatureRange::{Above, Below, Inside};
+        // -40 degC is count -5850, +125 degC is 4875 (limits inside).
+        for (count, range) in [
+            (-5850, Inside),
+            (-5851, Below),
+            (4875, Inside),
+            (4876, Above),
+            (COUNT_MAX, Above),
+            (COUNT_MIN, Below),
+            (-1625, Inside),
+        ] {
+            assert_eq!(
+                temperature_range(count, &GYRO_TEMPERATURE),
+                range,
+                "{count}"
+            );
+        }
+        let mut hot = PartReading::default();
+        hot.gyro.temp = COUNT_MAX;
+        hot.accel.temp = 0;
+        assert_eq!(part_temperature(&hot), Some((Above, COUNT_MAX)));
+        assert_ne!(
+            raw_part(&hot).flags & raw_flags::TEMPERATURE_OUT_OF_RANGE,
+            0
+        );
+        // The valid flags stay: the values are measurements, out of spec.
+        assert_ne!(raw_part(&hot).flags & raw_flags::GYRO_VALID, 0);
+        // A cold accelerometer beside a good gyro.
+        let mut cold = PartReading::default();
+        cold.accel.temp = -7150;
+        assert_eq!(part_temperature(&cold), Some((Below, -7150)));
+        // Counts that are not measurements are not judged.
+        hot.gyro_error = Some(Error::NotReady);
+        assert_eq!(part_temperature(&hot), Some((Inside, 0)));
+        assert_eq!(
+            raw_part(&hot).flags & raw_flags::TEMPERATURE_OUT_OF_RANGE,
+            0
+        );
+        hot.accel_error = Some(Error::FrameError);
+        assert_eq!(part_temperature(&hot), None);
+        hot.gyro_error = Some(Error::Saturated(Slave::Gyro));
+        assert_eq!(part_temperature(&hot), Some((Above, COUNT_MAX)));
+
+        let Payload::Event(e) = temperature_event(5, 1, Below, -7150) else {
+            panic!("an event frame")
+        };
+        assert_eq!(
+            (e.kind, e.part, e.code, e.value),
+            (EventKind::Temperature, 1, 0, (-7150i32) as u32)
+        );
+        assert_eq!(e.value, 0xFFFF_E412);
     }
 
     #[test]

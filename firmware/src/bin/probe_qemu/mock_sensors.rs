@@ -13,8 +13,8 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::scc1300::Part;
 use hil_mock::{
-    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe, TimeSource,
-    Window, SAMPLE_PERIOD_NS,
+    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe,
+    TemperatureExcursion, TimeSource, Window, SAMPLE_PERIOD_NS,
 };
 use mwd_core::sensor_units::PART_MOUNTINGS;
 
@@ -132,6 +132,7 @@ pub fn inject_scheduled_faults(sample: u32) {
     const PARITY_ERRORS: u32 = 10 * SAMPLES_PER_SECOND;
     const S_OK_DROP: u32 = 20 * SAMPLES_PER_SECOND;
     const POWER_CYCLE: u32 = 30 * SAMPLES_PER_SECOND;
+    const OVERHEAT: u32 = 40 * SAMPLES_PER_SECOND;
     if !cfg!(feature = "qemu-fault-demo") {
         return;
     }
@@ -156,6 +157,16 @@ pub fn inject_scheduled_faults(sample: u32) {
             }),
             // Part 0 power-cycles (both slaves restart: recovery).
             POWER_CYCLE => with_part(0, &mut |p| p.faults.reset_at_ns = Some(now_ns)),
+            // Part 1 reads 200 degC for 1 s (its count clips at 8191).
+            OVERHEAT => with_part(1, &mut |p| {
+                p.faults.temperature = Some(TemperatureExcursion {
+                    window: Window {
+                        start_ns: now_ns,
+                        end_ns: now_ns + 1_000_000_000,
+                    },
+                    degc: 200,
+                })
+            }),
             _ => {}
         }
     });
