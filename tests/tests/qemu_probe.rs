@@ -271,7 +271,9 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     require_qemu();
     // Faults (firmware/src/bin/probe_qemu/mock_sensors.rs): part 0 gyro
     // parity errors at 10 s, part 1 gyro S_OK drop at 20 s, part 0
-    // power-cycle at 30 s, part 1 at 200 degC from 40 to 41 s.
+    // power-cycle at 30 s, part 1 at 200 degC from 40 to 41 s, both gyros
+    // lose their loop at 50 s (the driver's worst recovery: the probe must
+    // still send every navigation frame, docs/budgets.md).
     let elf = build_firmware("qemu-fault-demo", "faults");
     let run = run_in_qemu(&elf, "faults");
     let (frames, stats) = decode(&run.uart);
@@ -294,13 +296,20 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     assert!(seen(EventKind::SensorFault, 0, 10, 11), "{events:#?}");
     assert!(seen(EventKind::SensorFault, 1, 20, 21), "{events:#?}");
     assert!(seen(EventKind::SensorFault, 0, 30, 31), "{events:#?}");
+    assert!(seen(EventKind::SensorFault, 0, 50, 51), "{events:#?}");
+    assert!(seen(EventKind::SensorFault, 1, 50, 51), "{events:#?}");
     // The recoveries ran, succeeded and the stream resynchronised. A
     // power-cycled part takes its 800 ms start-up again: within 2 s. The
     // reset event says what the recovery did: 0 for part 1's transient
     // S_OK drop, the loop-failure code for part 0, whose gyro came back
     // from the power cycle with its loop off and was soft-reset.
     let loop_failure = firmware::app::fault_code(&firmware::scc1300::Error::LoopFailure);
-    for (part, at_s, code) in [(1, 20, 0), (0, 30, loop_failure)] {
+    for (part, at_s, code) in [
+        (1, 20, 0),
+        (0, 30, loop_failure),
+        (0, 50, loop_failure),
+        (1, 50, loop_failure),
+    ] {
         assert!(
             events.iter().any(|e| e.kind == EventKind::SensorReset
                 && e.part == part
@@ -314,7 +323,7 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
             .iter()
             .filter(|e| e.kind == EventKind::SensorReset)
             .count(),
-        2,
+        4,
         "{events:#?}"
     );
     // Each resynchronisation says how many samples its recovery cost.
@@ -327,7 +336,7 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     let faults = events.iter().filter(|e| e.kind == EventKind::SensorFault);
     assert!(faults
         .clone()
-        .all(|e| [10, 20, 30].contains(&(e.time_us / 1_000_000))));
+        .all(|e| [10, 20, 30, 50, 51].contains(&(e.time_us / 1_000_000))));
 
     // Samples lost to recovery are marked (no valid flag), all within 2 s
     // of a fault, and the probe streams good data again after.
@@ -339,7 +348,9 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
         .collect();
     assert!(!skipped.is_empty());
     assert!(
-        skipped.iter().all(|s| [10, 20, 21, 30, 31].contains(s)),
+        skipped
+            .iter()
+            .all(|s| [10, 20, 21, 30, 31, 50, 51].contains(s)),
         "{skipped:?}"
     );
     let away = raws.iter().filter(|r| r.parts.iter().all(|p| p.flags == 0));
@@ -352,8 +363,22 @@ fn injected_sensor_faults_become_events_and_the_stream_goes_on() {
     );
     assert!(raws
         .iter()
-        .filter(|r| r.time_us >= 32_000_000)
+        .filter(|r| (32_000_000..50_000_000).contains(&r.time_us) || r.time_us >= 52_000_000)
         .all(|r| r.parts.iter().all(|p| p.flags & valid == valid)));
+    // The worst recovery blocked the main loop for most of 2 s: the inbox
+    // held its samples, and every navigation frame went out (no sequence
+    // gap, frames_dropped 0 above, one navigation frame per raw frame).
+    let resync_at_50 = events
+        .iter()
+        .find(|e| e.kind == EventKind::Resync && e.time_us >= 50_000_000)
+        .map_or(0, |e| e.value);
+    assert!(resync_at_50 >= 30, "{events:#?}");
+    assert!(summary_value(&run.stdout, "nav_inbox_high_water") >= 30);
+    let navs = frames
+        .iter()
+        .filter(|f| matches!(f.payload, Payload::Nav(_)))
+        .count();
+    assert_eq!(navs, raws.len());
 
     // The overheated part: its raw frames flag every sample from 40 to
     // 41 s (values still valid), and two events say when it left its

@@ -133,6 +133,7 @@ pub fn inject_scheduled_faults(sample: u32) {
     const S_OK_DROP: u32 = 20 * SAMPLES_PER_SECOND;
     const POWER_CYCLE: u32 = 30 * SAMPLES_PER_SECOND;
     const OVERHEAT: u32 = 40 * SAMPLES_PER_SECOND;
+    const BOTH_LOOPS_FAIL: u32 = 50 * SAMPLES_PER_SECOND;
     if !cfg!(feature = "qemu-fault-demo") {
         return;
     }
@@ -167,6 +168,13 @@ pub fn inject_scheduled_faults(sample: u32) {
                     degc: 200,
                 })
             }),
+            // Both gyros lose their drive loop: the driver's worst recovery
+            // (two soft resets with their 800 ms start-ups, ~1.9 s here).
+            BOTH_LOOPS_FAIL => {
+                for index in 0..2 {
+                    with_part(index, &mut |p| p.faults.loop_failure_at_ns = Some(now_ns));
+                }
+            }
             _ => {}
         }
     });
