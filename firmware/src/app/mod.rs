@@ -1,6 +1,9 @@
 //! The probe's application core, independent of the board: what happens in
 //! each 20 Hz cycle, how frames wait for the UART, how the driver's readings
-//! and faults become frames, and the glue between the board's contexts.
+//! and faults become frames, and the glue between the board's contexts;
+//! [`budget`] derives the worst recovery, the inbox's size and the
+//! watchdog's worst unfed stretch from the driver's waits, [`watchdog`]
+//! the watchdog's timeout from them.
 //! Pure code (no registers, no heap), so the host tests it and every board
 //! binary runs the same logic; a board only supplies the timer interrupt,
 //! its UART ([`Transmitter`]), the sensors' SPI and the watchdog.
