@@ -2,7 +2,7 @@
 //! (`crate::scc1300::datasheet`) and retry counts, so that the navigation
 //! inbox, the transmit queue and the watchdog follow the driver when it
 //! changes. `docs/budgets.md` ("Worst recovery, inbox and watchdog")
-//! explains the figures; the host tests in `shared/tests.rs` run a
+//! explains the figures; the host tests in `shared/recovery_tests.rs` run a
 //! both-gyros-lose-their-loop recovery on a simulated board against them.
 
 use mwd_core::protocol::{wire_len, FrameKind};

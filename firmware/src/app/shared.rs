@@ -197,4 +197,6 @@ impl<G: SpiDevice, A: SpiDevice, T: Transmitter> SharedProbe<G, A, T> {
 }
 
 #[cfg(test)]
+mod recovery_tests;
+#[cfg(test)]
 mod tests;
