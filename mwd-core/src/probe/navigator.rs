@@ -14,6 +14,15 @@
 //!    mechanization runs on (bias estimates still compensated through the
 //!    filter's dynamics) and the reported uncertainties grow honestly.
 //!
+//! What the frames say besides the solution (docs/protocol.md, Kind 2;
+//! docs/filter-derivation.md section 5b): during the coarse alignment the
+//! attitude and velocity are NaN placeholders; after it the covariance
+//! is health-checked every cycle (an invalid one is latched, its sigmas
+//! sent as NaN), a tilt sigma beyond [`TILT_SIGMA_LIMIT_RAD`] marks the
+//! solution invalid, a sample with no valid part is propagated on the held
+//! sample (coasting), and with one part out the other carries on alone
+//! (single part; azimuth not determined).
+//!
 //! Every sample first goes through the probe's calibration (the host's
 //! six-position result, [`crate::calibration`]). The host replays the same
 //! raw frames through this same code and must get the probe's solutions
