@@ -43,10 +43,10 @@ struct Check {
     sigma: f32,
 }
 
-fn checks(nav: &NavSolution, truth: &StillProbe, earth: &LocalEarth) -> [Check; 8] {
+fn checks(nav: &NavSolution, truth: &StillProbe, earth: &LocalEarth) -> [Check; 9] {
     let site = truth.position;
     let attitude = |axis: usize, true_angle: f64| Check {
-        name: ["roll", "pitch"][axis],
+        name: ["roll", "pitch", "azimuth"][axis],
         error: wrap_pi(f64::from(nav.attitude[axis]) - true_angle),
         sigma: nav.attitude_std[axis],
     };
@@ -68,6 +68,9 @@ fn checks(nav: &NavSolution, truth: &StillProbe, earth: &LocalEarth) -> [Check; 
     [
         attitude(0, truth.attitude.roll),
         attitude(1, truth.attitude.pitch),
+        // Infinite (not determined) from one still minute: skipped, but
+        // checked if it ever became finite.
+        attitude(2, truth.attitude.heading),
         velocity(0),
         velocity(1),
         velocity(2),
