@@ -36,3 +36,6 @@ cargo test --workspace
 # in release it runs in about 12 s (measured on a shared 2-core machine,
 # plus about 2 min to build the release test binary), so CI runs it here.
 cargo test --release -p mwd-core --test filter_long_run -- --ignored
+# 24 h of the probe's own navigator on a still probe (about 7 s in release):
+# every finite sigma covers the actual error within 5 sigma.
+cargo test --release -p system-tests --test navigator_long_run -- --ignored

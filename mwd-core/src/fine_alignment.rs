@@ -16,7 +16,7 @@ use crate::error_model::{
     is_model_size, AugmentedModel, AugmentedTransition, LinearizationPoint, ProcessNoise,
     ACCEL_BIAS, ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
 };
-use crate::kalman::{FilterScalar, KalmanFilter, UpdateReport};
+use crate::kalman::{std_dev_of, FilterScalar, KalmanFilter, UpdateReport};
 use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -182,6 +182,31 @@ impl<const N: usize> FineAlignmentConfig<N> {
     }
 }
 
+/// What a step adds for a sample that was not (all) measured
+/// ([`FineAlignment::step_with`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepNoise {
+    /// Variance added to each attitude-error state (rad^2).
+    pub attitude: f64,
+    /// Variance added to each velocity-error state ((m/s)^2).
+    pub velocity: f64,
+    /// No zero-velocity or zero-position update in this step.
+    pub skip_updates: bool,
+}
+
+impl StepNoise {
+    /// A measured sample: nothing added.
+    pub const NONE: Self = Self {
+        attitude: 0.0,
+        velocity: 0.0,
+        skip_updates: false,
+    };
+
+    fn is_none(&self) -> bool {
+        self.attitude == 0.0 && self.velocity == 0.0
+    }
+}
+
 /// What one fine-alignment step did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepReport {
@@ -274,8 +299,17 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Never inlined: with its fixed-size loops unrolled it is ~20 KiB of
     /// Cortex-M code, and a caller that calls it from two places (the
     /// probe's alignment and navigation phases) would get two copies.
-    #[inline(never)]
     pub fn step(&mut self, sample: &ImuSample) -> StepReport {
+        self.step_with(sample, &StepNoise::NONE)
+    }
+
+    /// [`step`](Self::step) for a sample that is not (all) measured: a held
+    /// or substituted one (the probe's sensor gaps and single-part mode).
+    /// `extra` is added to the process noise of this step only; with
+    /// `extra.skip_updates` no zero update is made (the probe's stillness
+    /// was not seen in this sample). Never inlined, as said above.
+    #[inline(never)]
+    pub fn step_with(&mut self, sample: &ImuSample, extra: &StepNoise) -> StepReport {
         // A non-finite sample would poison the mechanization for good: skip
         // it and say so (the caller counts it; the next sample goes on).
         let finite = sample
@@ -308,15 +342,26 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             self.earth = LocalEarth::at(&state.position);
         }
         let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
-        self.filter.predict(&phi, &self.q);
+        if extra.is_none() {
+            self.filter.predict(&phi, &self.q);
+        } else {
+            let mut q = self.q;
+            for i in 0..3 {
+                q[ATT + i] += T::of(extra.attitude);
+                q[VEL + i] += T::of(extra.velocity);
+            }
+            self.filter.predict(&phi, &q);
+        }
 
         let zero_velocity = match self.config.zero_velocity_variance {
+            Some(_) if extra.skip_updates => UpdateReport::default(),
             Some(r) => self
                 .filter
                 .update(&ZeroVelocity::new(&state.velocity, T::of(r))),
             None => UpdateReport::default(),
         };
         let zero_position = match self.config.zero_position_variance {
+            Some(_) if extra.skip_updates => UpdateReport::default(),
             Some(r) => self.filter.update(&ZeroPosition::new(
                 &state.position,
                 &self.reference,
@@ -390,12 +435,14 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             .map(|v| v.as_f64())
     }
 
-    /// Standard deviations of roll, pitch and heading (rad), through the
+    /// Standard deviations of roll, pitch and heading (rad; NaN where the
+    /// variance is not valid, see [`KalmanFilter::std_dev`]), through the
     /// Jacobian of the project's Euler convention at the current attitude.
     pub fn euler_std(&self) -> Vector3<f64> {
         let j = euler_error_jacobian(&dcm_from_quat(&self.state().attitude));
         let p = j * self.attitude_error_covariance() * j.transpose();
-        Vector3::new(p[(0, 0)], p[(1, 1)], p[(2, 2)]).map(|v| libm::sqrt(v.max(0.0)))
+        // A negative or NaN variance stays NaN: never a confident 0.
+        Vector3::new(p[(0, 0)], p[(1, 1)], p[(2, 2)]).map(std_dev_of)
     }
 }
 
@@ -427,5 +474,38 @@ fn add_levelling_bias_correlation<T: FilterScalar, const N: usize>(
             p0[(ATT + i, ACCEL_BIAS + j)] = T::of(cross[(i, j)]);
             p0[(ACCEL_BIAS + j, ATT + i)] = T::of(cross[(i, j)]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::UnitQuaternion;
+
+    /// A negative or NaN attitude variance gives NaN Euler sigmas, never
+    /// the 0 the old `max(0.0)` made of it (issue 11, item 1).
+    #[test]
+    fn an_invalid_attitude_variance_gives_nan_euler_sigmas() {
+        let site = Position::paper_site();
+        let config = FineAlignmentConfig::<STATES>::physical(
+            AugmentedModel::paper(),
+            &ImuNoise::scc1300(),
+            &[0.01, 0.01, 0.1],
+            site.lat,
+        );
+        let mut fa = FineAlignment::<f32, STATES>::new(
+            NavState::at_rest(UnitQuaternion::identity(), site),
+            site,
+            config,
+        );
+        assert!(fa.euler_std().iter().all(|s| s.is_finite() && *s > 0.0));
+        // The level tool's tilt errors are phiN and phiE (roll and pitch in
+        // some order): a negative variance of either reaches one of them.
+        fa.filter.p[(ATT, ATT)] = -1e-4;
+        fa.filter.p[(ATT + 1, ATT + 1)] = -1e-4;
+        let std = fa.euler_std();
+        assert!(std.x.is_nan() && std.y.is_nan(), "{std:?}");
+        fa.filter.p[(ATT, ATT)] = f32::NAN;
+        assert!(fa.euler_std().iter().all(|s| s.is_nan()));
     }
 }

@@ -328,3 +328,33 @@ fn chi_square_gate_rejects_outliers_and_passes_ordinary_data() {
     assert!(f.update_scalar(&ordinary).is_accepted());
     assert!(f.p[(VEL, VEL)] < before.p[(VEL, VEL)]);
 }
+
+/// An invalid variance is never reported as a number: the old
+/// `std_dev` turned a negative or NaN variance into 0, the most confident
+/// sigma there is (issue 11, item 1).
+#[test]
+fn an_invalid_variance_gives_a_nan_sigma_and_fails_the_health_check() {
+    let mut kf = KalmanFilter::<f32, 3>::from_diagonal(&SVector::from([4.0, 1.0, 9.0]));
+    assert_eq!(kf.std_dev(0), 2.0);
+    assert!(kf.covariance_is_healthy(1e6));
+    kf.p[(1, 1)] = -1e-3;
+    assert!(kf.std_dev(1).is_nan());
+    assert!(!kf.covariance_is_healthy(1e6));
+    kf.p[(1, 1)] = f32::NAN;
+    assert!(kf.std_dev(1).is_nan());
+    assert!(!kf.covariance_is_healthy(1e6));
+    kf.p[(1, 1)] = f32::INFINITY;
+    assert_eq!(kf.std_dev(1), f32::INFINITY);
+    assert!(!kf.covariance_is_healthy(1e6));
+    // Positive variances, but a correlation beyond 1: not positive
+    // semi-definite (a 2 x 2 minor is negative).
+    kf.p[(1, 1)] = 1.0;
+    kf.p[(0, 2)] = 6.1;
+    kf.p[(2, 0)] = 6.1;
+    assert!(!kf.covariance_is_healthy(1e6));
+    kf.p[(0, 2)] = 5.9;
+    kf.p[(2, 0)] = 5.9;
+    assert!(kf.covariance_is_healthy(1e6));
+    // Growth beyond the bound.
+    assert!(!kf.covariance_is_healthy(8.0));
+}

@@ -189,14 +189,51 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
         self.p.trace()
     }
 
-    /// Standard deviation of state `i` (0 for a negative variance).
+    /// Standard deviation of state `i`: NaN for a negative or NaN
+    /// variance (an invalid covariance is never reported as a number),
+    /// +inf for an infinite one.
     pub fn std_dev(&self, i: usize) -> T {
-        let v = self.p[(i, i)];
-        if v > T::zero() {
-            v.sqrt()
-        } else {
-            T::zero()
+        std_dev_of(self.p[(i, i)])
+    }
+
+    /// The covariance health check (run by the probe every cycle): every
+    /// variance finite, positive and at most `variance_limit` (in the
+    /// states' own units squared), and every correlation |P_ij| <=
+    /// sqrt(P_ii P_jj) within `CORRELATION_SLACK`, the 2 x 2 minors a
+    /// positive semi-definite matrix must have non-negative. Cost: one
+    /// multiply and compare per entry of the lower triangle (~N^2/2).
+    pub fn covariance_is_healthy(&self, variance_limit: T) -> bool {
+        let d = &self.p.data.0; // d[column][row]
+        for (i, column) in d.iter().enumerate() {
+            let v = column[i];
+            if !(v > T::zero() && v <= variance_limit) {
+                return false;
+            }
         }
+        let slack = T::one() + T::of(CORRELATION_SLACK);
+        for (j, column) in d.iter().enumerate() {
+            let vj = column[j] * slack;
+            for (i, pij) in column.iter().enumerate().skip(j + 1) {
+                if *pij * *pij > vj * d[i][i] {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// How far |P_ij|^2 may exceed P_ii P_jj before the covariance counts as
+/// not positive semi-definite: a few f32 roundings of the products (the
+/// levelling prior puts some tilt-bias correlations at exactly 1).
+pub const CORRELATION_SLACK: f64 = 1e-5;
+
+/// sqrt of a variance: NaN for a negative or NaN one, +inf for +inf.
+pub fn std_dev_of<T: FilterScalar>(variance: T) -> T {
+    if variance >= T::zero() {
+        variance.sqrt()
+    } else {
+        T::zero() / T::zero()
     }
 }
 
