@@ -38,7 +38,9 @@ fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {
             probe_solutions: SAMPLES,
             matched: SAMPLES,
             mismatched: 0,
+            unchecked: 0,
             degraded: 0,
+            restarts: 0,
         },
         "the replay no longer reproduces the recorded probe: if the navigation \
          changed on purpose, record the capture again (scripts/make-test-capture.sh)"
@@ -54,4 +56,56 @@ fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {
         assert_eq!(row.solution.mode, expected, "sample {n}");
         assert_eq!(row.matches_probe, Some(true), "sample {n}");
     }
+}
+
+/// The committed capture's bytes with frame `index` (counting every frame,
+/// the boot event first) left out.
+fn without_frame(bytes: &[u8], index: usize) -> Vec<u8> {
+    let mut out = Vec::new();
+    for (i, chunk) in bytes
+        .split(|b| *b == 0)
+        .filter(|c| !c.is_empty())
+        .enumerate()
+    {
+        if i != index {
+            out.push(0);
+            out.extend_from_slice(chunk);
+            out.push(0);
+        }
+    }
+    out
+}
+
+#[test]
+fn a_lost_raw_frame_stops_the_comparison_and_a_restart_resumes_it() {
+    let bytes = std::fs::read(workspace_root().join("tests/data/qemu-static-6s.bin")).unwrap();
+    // Frame 139 is the raw frame of sample 69 (boot event, then raw and
+    // navigation frame per sample); then the probe reboots and runs again.
+    let mut damaged = without_frame(&bytes, 139);
+    damaged.extend_from_slice(&bytes);
+    let cap = capture::decode_bytes(&damaged);
+    assert_eq!(
+        (cap.stats.lost, cap.stats.sequence_restarts),
+        (1, 1),
+        "{:?}",
+        cap.stats
+    );
+    let mut replayer = replay::Replayer::new(Position::paper_site());
+    for frame in &cap.frames {
+        replayer.push(frame);
+    }
+    let losses = replayer.step_losses().to_vec();
+    assert_eq!(losses.len(), 1);
+    assert_eq!((losses[0].run, losses[0].from_sample), (0, 70));
+    let (_, summary) = replayer.finish();
+    assert_eq!(
+        (
+            summary.matched,
+            summary.mismatched,
+            summary.unchecked,
+            summary.restarts
+        ),
+        (69 + SAMPLES, 0, 51, 1),
+        "{summary:?}"
+    );
 }
