@@ -470,6 +470,39 @@ mod tests {
     }
 
     #[test]
+    fn the_frame_csv_shows_an_azimuth_only_when_determined_in_0_to_2_pi() {
+        use mwd_core::protocol::NavSolution;
+        let nav = |azimuth: f32, sigma: f32| Frame {
+            seq: 0,
+            payload: Payload::Nav(NavSolution {
+                attitude: [0.1, 0.2, azimuth],
+                attitude_std: [0.01, 0.01, sigma],
+                ..NavSolution::default()
+            }),
+        };
+        let frames = [
+            nav(-1.0, f32::INFINITY),
+            nav(-1.0, 0.01),
+            nav(f32::NAN, f32::NAN),
+        ];
+        let mut out = Vec::new();
+        write_csv(&frames, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let rows: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+        let col = |name: &str| rows[0].iter().position(|c| *c == name).unwrap();
+        let (az, status) = (col("azimuth_rad"), col("azimuth_status"));
+        assert_eq!((rows[1][az], rows[1][status]), ("", "undetermined"));
+        let wrapped: f64 = rows[2][az].parse().unwrap();
+        assert!(
+            (wrapped - (std::f64::consts::TAU - 1.0)).abs() < 1e-6,
+            "{wrapped}"
+        );
+        assert_eq!(rows[2][status], "determined");
+        assert_eq!((rows[3][az], rows[3][status]), ("", "n/a"));
+        assert_eq!(rows[1][col("roll_rad")], "0.1");
+    }
+
+    #[test]
     fn csv_has_one_row_per_frame_and_fixed_columns() {
         let frames = decode_bytes(&{
             let mut w = CaptureWriter::new(Vec::new());

@@ -109,3 +109,40 @@ fn a_lost_raw_frame_stops_the_comparison_and_a_restart_resumes_it() {
         "{summary:?}"
     );
 }
+
+/// The simulator's raw parts are what the probe's driver and
+/// `firmware::app::raw_part` send for the same counts: a gyro beyond
+/// +-300 deg/s is saturated and not valid (the driver's
+/// `Error::Saturated`), an in-range one valid.
+#[test]
+fn simulated_raw_parts_carry_the_probes_flags() {
+    use firmware::app::raw_part;
+    use firmware::scc1300::{AccelCounts, Error, GyroCounts, PartReading, Slave};
+    use host_sim::capture::{raw_sample_from_si, SiSample};
+
+    for rate_deg_s in [-400.0, -299.0, 0.5, 299.0, 301.0, 1000.0] {
+        let sample = SiSample {
+            index: 7,
+            gyro_body_xz_rad_s: [f64::to_radians(rate_deg_s), 0.01],
+            accel_body_m_s2: [[0.0, 0.0, 9.81]; 2],
+            temperature_degc: 25.0,
+        };
+        let simulated = raw_sample_from_si(&sample).parts[0];
+        let saturated = mwd_core::sensor_units::gyro_count_is_saturated(simulated.gyro_rate);
+        let reading = PartReading {
+            gyro: GyroCounts {
+                rate: simulated.gyro_rate,
+                temp: simulated.gyro_temp,
+            },
+            accel: AccelCounts {
+                xyz: simulated.accel,
+                temp: simulated.accel_temp,
+            },
+            gyro_s_ok: true,
+            gyro_error: saturated.then_some(Error::Saturated(Slave::Gyro)),
+            ..PartReading::default()
+        };
+        assert_eq!(simulated, raw_part(&reading), "{rate_deg_s} deg/s");
+        assert_eq!(saturated, rate_deg_s.abs() > 300.0, "{rate_deg_s} deg/s");
+    }
+}
