@@ -20,6 +20,7 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
+use mwd_core::protocol::decoder::starts_a_run;
 use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{encode_body, EventKind, Frame, NavSolution, Payload};
 
@@ -145,6 +146,8 @@ struct StepTracker {
     /// The probe reported dropping samples since the last raw frame.
     dropped_since_raw: bool,
     last_counter: Option<u32>,
+    /// This run began with its boot event in the capture.
+    from_boot: bool,
     in_step: bool,
 }
 
@@ -180,7 +183,7 @@ impl Replayer {
         self.step.expected_seq = Some(frame.seq.wrapping_add(1));
         let seen_before = std::mem::replace(&mut self.step.seen_any, true);
         match frame.payload {
-            Payload::Event(e) if e.kind == EventKind::Boot => {
+            _ if starts_a_run(frame.seq, &frame.payload) => {
                 if seen_before {
                     self.summary.restarts += 1;
                 }
@@ -237,6 +240,7 @@ impl Replayer {
         self.step = StepTracker {
             seen_any: true,
             expected_seq: self.step.expected_seq,
+            from_boot: true,
             in_step: true,
             ..StepTracker::default()
         };
@@ -246,8 +250,12 @@ impl Replayer {
     fn check_step(&mut self, counter: u32) {
         let step = &mut self.step;
         let reason = match step.last_counter {
-            // Sample 0 first: the navigator starts where the probe's did.
-            None if counter != 0 => Some(StepLossReason::StartsMidRun),
+            // The navigator starts where the probe's did: at its boot event
+            // with nothing lost since, or (no boot event) at sample 0.
+            None if step.from_boot && step.gap_since_raw && counter != 0 => {
+                Some(StepLossReason::RawFramesLost)
+            }
+            None if !step.from_boot && counter != 0 => Some(StepLossReason::StartsMidRun),
             None => None,
             // A skip with no frame lost is the probe's own (a resync): its
             // navigation saw the same samples.
@@ -543,6 +551,27 @@ mod tests {
         assert!(rows[129..]
             .iter()
             .all(|r| r.in_step && r.matches_probe == Some(true)));
+    }
+
+    #[test]
+    fn samples_the_probe_skipped_itself_keep_the_replay_in_step() {
+        // A resynchronisation: no raw frame for samples 51 and 52, no
+        // frame lost (the numbers run on).
+        let mut navigator = Navigator::new(Position::paper_site());
+        let payloads = (0..100u32).filter(|n| !(51..53).contains(n)).flat_map(|n| {
+            let Payload::Raw(r) = raw(n).payload else {
+                unreachable!()
+            };
+            [Payload::Raw(r), Payload::Nav(navigator.step(&r))]
+        });
+        let capture = numbered(0, payloads.collect::<Vec<_>>());
+        let mut replayer = Replayer::new(Position::paper_site());
+        for frame in &capture {
+            replayer.push(frame);
+        }
+        assert!(replayer.step_losses().is_empty());
+        let (_, summary) = replayer.finish();
+        assert_eq!((summary.matched, summary.unchecked), (98, 0));
     }
 
     #[test]

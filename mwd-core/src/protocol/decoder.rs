@@ -232,7 +232,7 @@ impl Decoder {
     /// boot event starting a new run, large gaps checked against the sample
     /// counters of the raw frames around them.
     fn note_sequence(&mut self, seq: u16, payload: Option<&Payload>) {
-        if is_probe_start(seq, payload) {
+        if payload.is_some_and(|p| starts_a_run(seq, p)) {
             // The probe numbers its first frame, the boot event, 0: a new
             // run. What its previous run sent after the last frame seen
             // cannot be known.
@@ -287,10 +287,12 @@ impl Decoder {
     }
 }
 
-/// A boot event numbered 0 and stamped 0 us: the first frame a probe sends
-/// after it starts (`firmware::app::SharedProbe::announce_boot`).
-fn is_probe_start(seq: u16, payload: Option<&Payload>) -> bool {
-    matches!(payload, Some(Payload::Event(e)) if e.kind == EventKind::Boot && e.time_us == 0 && seq == 0)
+/// Whether a frame starts a probe run: a boot event numbered 0 and stamped
+/// 0 us, the first frame a probe sends after it starts
+/// (`firmware::app::SharedProbe::announce_boot`). The one rule for the
+/// decoder's restarts and the host's replay.
+pub fn starts_a_run(seq: u16, payload: &Payload) -> bool {
+    matches!(payload, Payload::Event(e) if e.kind == EventKind::Boot && e.time_us == 0 && seq == 0)
 }
 
 #[cfg(test)]
