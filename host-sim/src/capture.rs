@@ -17,16 +17,16 @@ use mwd_core::protocol::{Event, EventKind};
 use mwd_core::sensor_units::{
     self, ACCEL_TEMPERATURE, GYRO_TEMPERATURE, PART_COUNT, PART_MOUNTINGS,
 };
+use mwd_core::timing::sample_time_us;
 
 use crate::sim::SimSample;
 
 /// One simulated sample in SI units, body frame (x right, y forward, z up).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SiSample {
-    /// Sample counter (20 Hz samples since start).
+    /// Sample counter (20 Hz samples since start); the frame's time stamp
+    /// follows from it as the probe's does.
     pub index: u32,
-    /// Sample instant, seconds since start.
-    pub time_s: f64,
     /// What the two gyros measure: the body x rate (part 1) and the body z
     /// rate (part 2), rad/s, errors included.
     pub gyro_body_xz_rad_s: [f64; 2],
@@ -39,9 +39,11 @@ pub struct SiSample {
 
 /// Turns a simulated sample into the raw-sample frame the probe would send:
 /// body -> part axes through `PART_MOUNTINGS`, SI -> 14-bit counts
-/// (rounded, saturated), flags "valid, S_OK" (and saturation where the
-/// probe's driver flags it: a gyro count beyond the specified range or at
-/// a 14-bit limit).
+/// (rounded, saturated), flags "valid, S_OK", stamped as the probe stamps
+/// sample n (`mwd_core::timing::sample_time_us`, n x 50 ms). A gyro count
+/// beyond the specified range or at a 14-bit limit is flagged as the
+/// probe's driver flags it (`firmware::app::raw_part`): saturated, and not
+/// valid (the count is still sent).
 pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
     let [x, z] = sample.gyro_body_xz_rad_s;
     // The tool-axis (y) rate is not sensed by either gyro.
@@ -59,13 +61,15 @@ pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
         part.gyro_temp = GYRO_TEMPERATURE.degc_to_count(temp);
         part.accel = sensor.map(sensor_units::m_s2_to_accel_count);
         part.accel_temp = ACCEL_TEMPERATURE.degc_to_count(temp);
-        part.flags = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
-        if sensor_units::gyro_count_is_saturated(part.gyro_rate) {
-            part.flags |= raw_flags::GYRO_SATURATED;
-        }
+        let gyro = if sensor_units::gyro_count_is_saturated(part.gyro_rate) {
+            raw_flags::GYRO_SATURATED
+        } else {
+            raw_flags::GYRO_VALID
+        };
+        part.flags = gyro | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
     }
     RawSample {
-        time_us: (sample.time_s * 1e6).round().max(0.0) as u64,
+        time_us: sample_time_us(sample.index),
         sample_counter: sample.index,
         parts,
     }
@@ -149,7 +153,6 @@ pub fn write_simulated_probe<W: Write>(
         let accel = [s.accel.x, s.accel.y, s.accel.z];
         let raw = raw_sample_from_si(&SiSample {
             index: u32::try_from(index).context("more than 2^32 samples")?,
-            time_s: s.time,
             gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
             accel_body_m_s2: [accel, accel],
             temperature_degc: 25.0,
@@ -203,6 +206,25 @@ pub fn read_capture(path: &Path) -> io::Result<Capture> {
     decode_reader(File::open(path)?)
 }
 
+/// Reads a capture for `decode` and `replay`: an error naming the file when
+/// it cannot be read or holds no good frame of the probe's protocol (an
+/// empty file, a CSV, random bytes): that is not a probe capture.
+pub fn read_probe_capture(path: &Path) -> anyhow::Result<Capture> {
+    let capture = read_capture(path).with_context(|| format!("reading {}", path.display()))?;
+    let s = &capture.stats;
+    anyhow::ensure!(
+        s.good_frames() > 0,
+        "{} is not a probe capture: {} bytes without one good frame of the probe's \
+         protocol ({} corrupt chunks, {} of another protocol version; the layout is in \
+         docs/protocol.md)",
+        path.display(),
+        s.bytes,
+        s.corrupt(),
+        s.unsupported_version
+    );
+    Ok(capture)
+}
+
 impl fmt::Display for Capture {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let s = &self.stats;
@@ -248,12 +270,12 @@ p1_gyro_count,p1_gyro_temp_count,p1_ax_count,p1_ay_count,p1_az_count,p1_accel_te
 p2_gyro_count,p2_gyro_temp_count,p2_ax_count,p2_ay_count,p2_az_count,p2_accel_temp_count,p2_flags,\
 p1_rate_rad_s,p1_ax_m_s2,p1_ay_m_s2,p1_az_m_s2,p1_gyro_temp_degc,\
 p2_rate_rad_s,p2_ax_m_s2,p2_ay_m_s2,p2_az_m_s2,p2_gyro_temp_degc,\
-nav_mode,nav_flags,roll_rad,pitch_rad,azimuth_rad,vn_m_s,ve_m_s,vd_m_s,lat_rad,lon_rad,height_m,\
+nav_mode,nav_flags,roll_rad,pitch_rad,azimuth_rad,azimuth_status,vn_m_s,ve_m_s,vd_m_s,lat_rad,lon_rad,height_m,\
 sd_roll_rad,sd_pitch_rad,sd_azimuth_rad,sd_vn_m_s,sd_ve_m_s,sd_vd_m_s,sd_pn_m,sd_pe_m,sd_pd_m,\
 event,event_part,event_code,event_value";
 
 const RAW_COLS: usize = 24;
-const NAV_COLS: usize = 20;
+const NAV_COLS: usize = 21;
 const EVENT_COLS: usize = 4;
 
 fn empties(n: usize) -> String {
@@ -277,7 +299,9 @@ pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
                 let mut cells = format!(",{},{}", n.time_us, n.sample_counter);
                 cells += &empties(RAW_COLS);
                 cells += &join([n.mode as u32, n.flags as u32]);
-                cells += &join(n.attitude.iter().chain(&n.velocity_ned));
+                cells += &join(&n.attitude[..2]);
+                cells += &azimuth_cells(n);
+                cells += &join(n.velocity_ned);
                 cells += &join([n.latitude, n.longitude]);
                 cells += &join(
                     std::iter::once(&n.height)
@@ -303,6 +327,20 @@ pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
         writeln!(out, "{},{kind}{body}", frame.seq)?;
     }
     out.flush()
+}
+
+/// The azimuth and its status, as `display` rules: in [0, 2 pi) rad when
+/// determined, empty when not (undetermined, or a NaN placeholder: "n/a").
+fn azimuth_cells(n: &mwd_core::protocol::NavSolution) -> String {
+    let (azimuth, sigma) = (f64::from(n.attitude[2]), f64::from(n.attitude_std[2]));
+    if !azimuth.is_finite() || sigma.is_nan() {
+        ",,n/a".to_string()
+    } else if !crate::display::azimuth_is_determined(sigma) {
+        ",,undetermined".to_string()
+    } else {
+        let wrapped = crate::display::deg_0_360(azimuth).to_radians();
+        format!(",{},determined", wrapped as f32)
+    }
 }
 
 fn raw_csv(r: &RawSample) -> String {
@@ -332,13 +370,11 @@ mod tests {
     use super::*;
     use mwd_core::protocol::example;
     use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s, STANDARD_GRAVITY};
-    use mwd_core::timing::SAMPLE_INTERVAL_S;
 
     fn sample(i: u32) -> SiSample {
         let g = STANDARD_GRAVITY;
         SiSample {
             index: i,
-            time_s: f64::from(i) * SAMPLE_INTERVAL_S,
             gyro_body_xz_rad_s: [1e-3 * f64::from(i), -0.2],
             accel_body_m_s2: [[0.1, 0.2, g], [0.3, -0.2, g + 0.01]],
             temperature_degc: 30.0,
@@ -368,6 +404,45 @@ mod tests {
     }
 
     #[test]
+    fn a_saturated_gyro_is_flagged_as_the_driver_flags_it_and_samples_are_stamped_n_x_50_ms() {
+        let mut s = sample(3);
+        // 400 deg/s about body x: beyond the specified +-300 deg/s.
+        s.gyro_body_xz_rad_s = [400f64.to_radians(), -0.2];
+        let raw = raw_sample_from_si(&s);
+        let [p1, p2] = raw.parts;
+        // The driver reports Error::Saturated: no GYRO_VALID, the
+        // saturation bit, S_OK as read (firmware::app::raw_part).
+        assert_eq!(
+            p1.flags,
+            raw_flags::GYRO_SATURATED | raw_flags::GYRO_S_OK | raw_flags::ACCEL_VALID
+        );
+        assert_eq!(
+            p2.flags,
+            raw_flags::GYRO_VALID | raw_flags::GYRO_S_OK | raw_flags::ACCEL_VALID
+        );
+        assert_eq!(raw.time_us, 150_000);
+        // The simulator's own capture: sample 0 at 0 us, as the probe.
+        let samples = crate::sim::SensorSimulator::new(
+            crate::sim::Trajectory::paper_static(mwd_core::conventions::Euler::new(0.0, 0.0, 0.0)),
+            crate::sim::SensorModel::ideal(),
+            mwd_core::timing::SAMPLE_INTERVAL_S,
+        )
+        .take(3);
+        let mut w = CaptureWriter::new(Vec::new());
+        write_simulated_probe(&mut w, samples, Position::paper_site()).unwrap();
+        let cap = decode_bytes(&w.finish().unwrap());
+        let stamps: Vec<u64> = cap
+            .frames
+            .iter()
+            .filter_map(|f| match f.payload {
+                Payload::Raw(r) => Some(r.time_us),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(stamps, [0, 50_000, 100_000]);
+    }
+
+    #[test]
     fn written_captures_decode_back() {
         let mut w = CaptureWriter::new(Vec::new());
         w.write(&example::boot_event()).unwrap();
@@ -392,6 +467,39 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("0 frames lost"), "{text}");
+    }
+
+    #[test]
+    fn the_frame_csv_shows_an_azimuth_only_when_determined_in_0_to_2_pi() {
+        use mwd_core::protocol::NavSolution;
+        let nav = |azimuth: f32, sigma: f32| Frame {
+            seq: 0,
+            payload: Payload::Nav(NavSolution {
+                attitude: [0.1, 0.2, azimuth],
+                attitude_std: [0.01, 0.01, sigma],
+                ..NavSolution::default()
+            }),
+        };
+        let frames = [
+            nav(-1.0, f32::INFINITY),
+            nav(-1.0, 0.01),
+            nav(f32::NAN, f32::NAN),
+        ];
+        let mut out = Vec::new();
+        write_csv(&frames, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let rows: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+        let col = |name: &str| rows[0].iter().position(|c| *c == name).unwrap();
+        let (az, status) = (col("azimuth_rad"), col("azimuth_status"));
+        assert_eq!((rows[1][az], rows[1][status]), ("", "undetermined"));
+        let wrapped: f64 = rows[2][az].parse().unwrap();
+        assert!(
+            (wrapped - (std::f64::consts::TAU - 1.0)).abs() < 1e-6,
+            "{wrapped}"
+        );
+        assert_eq!(rows[2][status], "determined");
+        assert_eq!((rows[3][az], rows[3][status]), ("", "n/a"));
+        assert_eq!(rows[1][col("roll_rad")], "0.1");
     }
 
     #[test]

@@ -9,21 +9,24 @@
 //! of QEMU's probe, or a test's byte slice. A read timeout is not the end of
 //! the stream; end of file, a read error (a pty whose other side closed
 //! reports EIO, a USB adapter pulled reports an I/O error) or the time limit
-//! is.
+//! is, and so are a silence longer than `--silence`, SIGINT/SIGTERM and
+//! `--duration`. The bytes (`--save`) and the replayed rows (`--csv`) are
+//! written as they arrive, so an interrupted session keeps them.
 
-use mwd_core::calibration::ProbeCalibration;
-use mwd_core::probe::Navigator;
 use std::fmt;
-use std::io::{self, ErrorKind, Read};
+use std::io::{self, ErrorKind, Read, Write};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::nav_mode;
 use mwd_core::protocol::{Decoder, DecoderStats, Frame, NavSolution};
 
 use crate::capture::Capture;
-use crate::replay::{ReplayRow, ReplaySummary, Replayer};
+use crate::display;
+use crate::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
 
 /// Why a live replay stopped.
 #[derive(Debug)]
@@ -34,6 +37,13 @@ pub enum StreamEnd {
     Closed(io::Error),
     /// `--duration` elapsed.
     TimeLimit,
+    /// No byte for the silence limit.
+    Silent(Duration),
+    /// Asked to stop (SIGINT, SIGTERM).
+    Interrupted,
+    /// Writing the CSV or the saved bytes failed: what was written so far
+    /// is kept.
+    OutputFailed(io::Error),
 }
 
 impl fmt::Display for StreamEnd {
@@ -42,6 +52,9 @@ impl fmt::Display for StreamEnd {
             Self::EndOfFile => write!(f, "end of file"),
             Self::Closed(e) => write!(f, "port closed ({e})"),
             Self::TimeLimit => write!(f, "time limit reached"),
+            Self::Silent(d) => write!(f, "no byte for {:.1} s", d.as_secs_f64()),
+            Self::Interrupted => write!(f, "interrupted"),
+            Self::OutputFailed(e) => write!(f, "writing output failed ({e})"),
         }
     }
 }
@@ -60,28 +73,38 @@ impl fmt::Display for LiveStatus {
         let s = &self.solution;
         let deg = |a: f32| f64::from(a).to_degrees();
         let [roll, pitch, heading] = s.attitude.map(f64::from);
-        // Drilling terms come from the one module that owns the conventions.
+        // Drilling terms come from the one module that owns the conventions;
+        // NaN (no estimate yet) stays NaN, an azimuth only shows when
+        // determined (`display`).
         let drilling = DrillingAngles::from_euler(&Euler::new(roll, pitch, heading));
+        let toolface = if roll.is_finite() {
+            display::deg_0_360(roll)
+        } else {
+            f64::NAN
+        };
+        let azimuth = display::azimuth_text(heading, f64::from(s.attitude_std[2]), 2);
         let l = &self.link;
         write!(
             f,
-            "t {:8.2} s {} | roll {:7.2} pitch {:7.2} hdg {:7.2} (+/-{:.2}) deg | \
-             inc {:6.2} az {:6.2} tf {:6.2} deg | frames {} lost {} crc {} | parity {}/{}",
+            "t {:8.2} s {} | roll {:7.2} pitch {:7.2} deg | inc {:6.2} tf {:6.2} deg az {azimuth} | \
+             frames {} lost {} crc {} restarts {} | parity {}/{}",
             s.time_us as f64 * 1e-6,
             mode_name(s.mode),
             deg(s.attitude[0]),
             deg(s.attitude[1]),
-            deg(s.attitude[2]),
-            deg(s.attitude_std[2]),
             drilling.inclination.to_degrees(),
-            drilling.azimuth.to_degrees(),
-            drilling.toolface.to_degrees(),
+            toolface,
             l.good_frames(),
             l.lost,
             l.crc_errors,
+            l.sequence_restarts,
             self.replay.matched,
             self.replay.matched + self.replay.mismatched,
-        )
+        )?;
+        if self.replay.unchecked > 0 {
+            write!(f, " ({} unchecked)", self.replay.unchecked)?;
+        }
+        Ok(())
     }
 }
 
@@ -101,6 +124,9 @@ pub fn mode_name(mode: u8) -> &'static str {
 pub struct LiveOptions {
     /// Stop after this long (wall clock) even if the stream goes on.
     pub duration: Option<Duration>,
+    /// Stop when no byte came for this long, counted from the first byte
+    /// (before it the replay waits: a probe may be powered up late).
+    pub silence: Option<Duration>,
     /// Shortest time between two status lines.
     pub display_interval: Duration,
     /// The probe's sensor calibration, for the replay (identity: none).
@@ -111,10 +137,23 @@ impl Default for LiveOptions {
     fn default() -> Self {
         Self {
             duration: None,
+            silence: None,
             display_interval: Duration::from_millis(250),
             calibration: ProbeCalibration::default(),
         }
     }
+}
+
+/// Where a live replay writes as it goes: the bytes as they arrive
+/// (`--save`) and the replayed rows as they settle (`--csv`, header
+/// included), each flushed at once so that nothing is lost when the
+/// session ends however it ends.
+#[derive(Default)]
+pub struct LiveSinks<'a> {
+    pub save: Option<&'a mut dyn Write>,
+    pub csv: Option<&'a mut dyn Write>,
+    /// Set (by a signal handler) to end the session cleanly.
+    pub stop: Option<&'a AtomicBool>,
 }
 
 /// The result of a live replay: as a file replay gives, and why it ended.
@@ -122,44 +161,70 @@ pub struct LiveOutcome {
     pub capture: Capture,
     pub rows: Vec<ReplayRow>,
     pub summary: ReplaySummary,
+    pub step_losses: Vec<StepLoss>,
     pub end: StreamEnd,
 }
 
 /// Reads `source` until the stream ends, replaying every raw frame as it
-/// arrives and calling `show` with the running status at most once per
-/// `options.display_interval`.
+/// arrives, writing to `sinks` as it goes, and calling `show` with the
+/// running status at most once per `options.display_interval`.
 pub fn run(
     mut source: impl Read,
     position: Position,
     options: LiveOptions,
+    mut sinks: LiveSinks<'_>,
     mut show: impl FnMut(&LiveStatus),
 ) -> LiveOutcome {
     let started = Instant::now();
+    let mut last_byte: Option<Instant> = None;
     let mut last_shown: Option<Instant> = None;
     let mut decoder = Decoder::new();
-    let mut replayer =
-        Replayer::with_navigator(Navigator::with_calibration(position, options.calibration));
+    let mut replayer = Replayer::with_calibration(position, options.calibration);
     let mut frames: Vec<Frame> = Vec::new();
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];
+    if let Some(csv) = sinks.csv.as_mut() {
+        if let Err(e) = writeln!(csv, "{}", replay::CSV_HEADER).and_then(|()| csv.flush()) {
+            return outcome(decoder, frames, replayer, StreamEnd::OutputFailed(e));
+        }
+    }
     let end = loop {
+        if sinks.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            break StreamEnd::Interrupted;
+        }
         if options.duration.is_some_and(|d| started.elapsed() >= d) {
             break StreamEnd::TimeLimit;
+        }
+        if let (Some(limit), Some(t)) = (options.silence, last_byte) {
+            if t.elapsed() >= limit {
+                break StreamEnd::Silent(limit);
+            }
         }
         let n = match source.read(&mut buf) {
             Ok(0) => break StreamEnd::EndOfFile,
             Ok(n) => n,
-            // A quiet line: keep waiting (and check the time limit).
+            // A quiet line: keep waiting (and check the limits).
             Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => 0,
             Err(e) if e.kind() == ErrorKind::Interrupted => 0,
             Err(e) => break StreamEnd::Closed(e),
         };
+        if n > 0 {
+            last_byte = Some(Instant::now());
+        }
+        if let Some(save) = sinks.save.as_mut() {
+            if let Err(e) = save.write_all(&buf[..n]).and_then(|()| save.flush()) {
+                break StreamEnd::OutputFailed(e);
+            }
+        }
         let first_new = frames.len();
         decoder.feed(&buf[..n], |frame| frames.push(frame));
         for frame in &frames[first_new..] {
             if let Some(solution) = replayer.push(frame) {
                 latest = Some(solution);
             }
+        }
+        if let Err(e) = write_settled(&mut replayer, sinks.csv.as_mut(), false) {
+            break StreamEnd::OutputFailed(e);
         }
         let due = last_shown.is_none_or(|t| t.elapsed() >= options.display_interval);
         if let (true, Some(solution)) = (due, latest) {
@@ -171,13 +236,44 @@ pub fn run(
             last_shown = Some(Instant::now());
         }
     };
+    let end = match write_settled(&mut replayer, sinks.csv.as_mut(), true) {
+        Err(e) if !matches!(end, StreamEnd::OutputFailed(_)) => StreamEnd::OutputFailed(e),
+        _ => end,
+    };
+    outcome(decoder, frames, replayer, end)
+}
+
+/// Writes the rows whose comparison is settled (all of them at the end).
+fn write_settled(
+    replayer: &mut Replayer,
+    csv: Option<&mut &mut dyn Write>,
+    all: bool,
+) -> io::Result<()> {
+    let rows = replayer.settled_rows(all);
+    match csv {
+        Some(out) if !rows.is_empty() => {
+            replay::write_csv_rows(rows, &mut **out)?;
+            out.flush()
+        }
+        _ => Ok(()),
+    }
+}
+
+fn outcome(
+    mut decoder: Decoder,
+    frames: Vec<Frame>,
+    replayer: Replayer,
+    end: StreamEnd,
+) -> LiveOutcome {
     decoder.finish();
     let stats = *decoder.stats();
+    let step_losses = replayer.step_losses().to_vec();
     let (rows, summary) = replayer.finish();
     LiveOutcome {
         capture: Capture { frames, stats },
         rows,
         summary,
+        step_losses,
         end,
     }
 }
@@ -249,9 +345,13 @@ mod tests {
             ..LiveOptions::default()
         };
         let mut shown = Vec::new();
-        let outcome = run(source, Position::paper_site(), options, |s| {
-            shown.push(s.to_string())
-        });
+        let outcome = run(
+            source,
+            Position::paper_site(),
+            options,
+            LiveSinks::default(),
+            |s| shown.push(s.to_string()),
+        );
         assert!(
             matches!(outcome.end, StreamEnd::Closed(_)),
             "{}",
@@ -276,9 +376,206 @@ mod tests {
             duration: Some(Duration::from_millis(50)),
             ..LiveOptions::default()
         };
-        let outcome = run(endless, Position::paper_site(), options, |_| {});
+        let outcome = run(
+            endless,
+            Position::paper_site(),
+            options,
+            LiveSinks::default(),
+            |_| {},
+        );
         assert!(matches!(outcome.end, StreamEnd::TimeLimit));
         assert_eq!(outcome.rows.len(), 0);
         assert!(outcome.capture.stats.bytes > 0);
+    }
+
+    /// Hands out `bytes` in pieces, then stays silent (read timeouts) and
+    /// sets `stop` after `stop_after` silent reads (a signal arriving).
+    struct ThenSilent<'a> {
+        bytes: Vec<u8>,
+        at: usize,
+        silent_reads: usize,
+        stop_after: Option<(usize, &'a AtomicBool)>,
+    }
+
+    impl Read for ThenSilent<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            if self.at < self.bytes.len() {
+                let n = buf.len().min(100).min(self.bytes.len() - self.at);
+                buf[..n].copy_from_slice(&self.bytes[self.at..self.at + n]);
+                self.at += n;
+                return Ok(n);
+            }
+            self.silent_reads += 1;
+            if let Some((after, stop)) = self.stop_after {
+                if self.silent_reads >= after {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+            std::thread::sleep(Duration::from_millis(1));
+            Err(ErrorKind::TimedOut.into())
+        }
+    }
+
+    #[test]
+    fn an_interrupt_ends_cleanly_with_every_row_and_byte_written() {
+        let bytes = still_capture(150);
+        let stop = AtomicBool::new(false);
+        let source = ThenSilent {
+            bytes: bytes.clone(),
+            at: 0,
+            silent_reads: 0,
+            stop_after: Some((3, &stop)),
+        };
+        let (mut csv, mut saved) = (Vec::new(), Vec::new());
+        let sinks = LiveSinks {
+            save: Some(&mut saved),
+            csv: Some(&mut csv),
+            stop: Some(&stop),
+        };
+        let outcome = run(
+            source,
+            Position::paper_site(),
+            LiveOptions::default(),
+            sinks,
+            |_| {},
+        );
+        assert!(
+            matches!(outcome.end, StreamEnd::Interrupted),
+            "{}",
+            outcome.end
+        );
+        assert_eq!(saved, bytes);
+        assert_eq!(outcome.rows.len(), 150);
+        let text = String::from_utf8(csv).unwrap();
+        assert_eq!(text.lines().count(), 1 + 150);
+        assert!(text.starts_with(replay::CSV_HEADER));
+    }
+
+    /// A sink that records what had been written when the source is read:
+    /// rows must reach it while the stream goes on, not at its end.
+    #[test]
+    fn rows_are_written_while_the_stream_goes_on() {
+        use std::sync::{Arc, Mutex};
+        #[derive(Clone, Default)]
+        struct Shared(Arc<Mutex<Vec<u8>>>);
+        impl Write for Shared {
+            fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+                self.0.lock().unwrap().extend_from_slice(buf);
+                Ok(buf.len())
+            }
+            fn flush(&mut self) -> io::Result<()> {
+                Ok(())
+            }
+        }
+        struct Watching {
+            inner: Trickle,
+            csv: Shared,
+            lines_seen: Vec<usize>,
+        }
+        impl Read for Watching {
+            fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+                let lines = self
+                    .csv
+                    .0
+                    .lock()
+                    .unwrap()
+                    .iter()
+                    .filter(|b| **b == b'\n')
+                    .count();
+                self.lines_seen.push(lines);
+                self.inner.read(buf)
+            }
+        }
+        let csv = Shared::default();
+        let mut watching = Watching {
+            inner: Trickle {
+                bytes: still_capture(200),
+                at: 0,
+                timed_out: false,
+            },
+            csv: csv.clone(),
+            lines_seen: Vec::new(),
+        };
+        let mut sink = csv.clone();
+        let sinks = LiveSinks {
+            csv: Some(&mut sink),
+            ..LiveSinks::default()
+        };
+        let outcome = run(
+            &mut watching,
+            Position::paper_site(),
+            LiveOptions::default(),
+            sinks,
+            |_| {},
+        );
+        assert_eq!(outcome.rows.len(), 200);
+        // Without probe solutions to wait for, a row settles once 64 later
+        // samples came: by the last read, all but those were written.
+        let before_end = *watching.lines_seen.last().unwrap();
+        assert!(before_end >= 1 + 200 - 65, "{before_end}");
+        assert_eq!(
+            csv.0
+                .lock()
+                .unwrap()
+                .iter()
+                .filter(|b| **b == b'\n')
+                .count(),
+            201
+        );
+    }
+
+    #[test]
+    fn a_silent_stream_ends_the_session() {
+        let source = ThenSilent {
+            bytes: still_capture(30),
+            at: 0,
+            silent_reads: 0,
+            stop_after: None,
+        };
+        let options = LiveOptions {
+            silence: Some(Duration::from_millis(30)),
+            ..LiveOptions::default()
+        };
+        let outcome = run(
+            source,
+            Position::paper_site(),
+            options,
+            LiveSinks::default(),
+            |_| {},
+        );
+        assert!(
+            matches!(outcome.end, StreamEnd::Silent(_)),
+            "{}",
+            outcome.end
+        );
+        assert_eq!(outcome.rows.len(), 30);
+    }
+
+    #[test]
+    fn the_status_line_shows_placeholders_and_no_undetermined_azimuth() {
+        let solution = NavSolution {
+            attitude: [0.1, -0.2, -1.0],
+            attitude_std: [0.01, 0.01, f32::INFINITY],
+            ..NavSolution::default()
+        };
+        let status = LiveStatus {
+            solution,
+            link: DecoderStats::default(),
+            replay: ReplaySummary::default(),
+        };
+        let line = status.to_string();
+        assert!(line.contains("az undetermined"), "{line}");
+        assert!(!line.contains("-57.30"), "{line}");
+        let mut coarse = status;
+        coarse.solution.attitude = [f32::NAN; 3];
+        coarse.solution.attitude_std = [f32::NAN; 3];
+        let line = coarse.to_string();
+        assert!(line.contains("az n/a"), "{line}");
+        assert!(line.contains("roll     NaN"), "{line}");
+        let mut determined = status;
+        determined.solution.attitude_std[2] = 0.01;
+        let line = determined.to_string();
+        assert!(line.contains("az 302.70 +- 0.57 deg"), "{line}");
+        assert!(line.contains("tf   5.73"), "{line}");
     }
 }

@@ -1,13 +1,17 @@
 //! `host-sim`: the host tool of the gyro MWD probe. Each subcommand lives in
 //! its own module under `commands/`.
 use clap::Parser;
+use std::process::ExitCode;
 
 mod commands;
 
-fn main() {
+fn main() -> ExitCode {
     let cli = commands::Cli::parse();
-    if let Err(err) = commands::run(cli) {
-        eprintln!("error: {err:#}");
-        std::process::exit(1);
+    match commands::run(cli) {
+        Ok(status) => status,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
     }
 }

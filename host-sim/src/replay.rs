@@ -2,22 +2,40 @@
 //! the probe's own navigation code (`mwd_core::probe::Navigator`, the same
 //! source the firmware runs), and where the capture also holds the probe's
 //! navigation frames, each replayed solution is compared with the probe's
-//! bit for bit (as encoded frames, so NaN fields compare too).
+//! bit for bit (as encoded frames, so NaN placeholders compare equal).
+//!
+//! The comparison only means something while the replay's navigator has
+//! seen exactly the samples the probe's did. A boot event starts a new run
+//! (a new navigator, as the probe rebooted); a raw frame lost in a sequence
+//! gap (the sample counter skips where frames were lost), a capture that
+//! starts after the probe's first sample, or samples the probe's own
+//! navigation dropped (a samples-dropped event) put the replay out of step:
+//! from there to the next boot its solutions are still given, but not
+//! compared, and the summary says from which sample.
 
 use std::collections::HashMap;
 use std::io::{self, Write};
 
+use mwd_core::calibration::ProbeCalibration;
+use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
+use mwd_core::protocol::decoder::starts_a_run;
 use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
-use mwd_core::protocol::{encode_body, Frame, NavSolution, Payload};
+use mwd_core::protocol::{encode_body, EventKind, Frame, NavSolution, Payload};
 
-/// One replayed solution and, if the capture had one, whether the probe's
-/// own solution for the same sample was identical.
+use crate::display;
+
+/// One replayed solution and how it compares with the probe's own.
 #[derive(Debug, Clone, Copy)]
 pub struct ReplayRow {
     pub solution: NavSolution,
+    /// Whether the probe's solution for the same sample was identical;
+    /// `None` while it has not arrived (or never did), and always for a
+    /// row replayed out of step.
     pub matches_probe: Option<bool>,
+    /// The replay had seen the same samples as the probe's navigation.
+    pub in_step: bool,
 }
 
 /// What a replay did.
@@ -28,60 +46,154 @@ pub struct ReplaySummary {
     /// Replayed solutions identical to the probe's / different from it.
     pub matched: u64,
     pub mismatched: u64,
+    /// Probe solutions not compared: the replay was out of step.
+    pub unchecked: u64,
     /// Raw frames with a part's data not valid (skipped or faulty samples).
     pub degraded: u64,
+    /// Boot events after the first frame: the probe restarted, and so did
+    /// the replay's navigation.
+    pub restarts: u64,
+}
+
+/// Why and where the replay went out of step with the probe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepLoss {
+    /// The run (0 before the first restart).
+    pub run: u64,
+    /// The first sample not compared.
+    pub from_sample: u32,
+    pub reason: StepLossReason,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepLossReason {
+    /// Raw frames were lost (a sequence gap, and the sample counter skips).
+    RawFramesLost,
+    /// The capture starts after the probe's first sample.
+    StartsMidRun,
+    /// The probe's navigation dropped samples (a samples-dropped event).
+    ProbeDroppedSamples,
+}
+
+impl std::fmt::Display for StepLoss {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = match self.reason {
+            StepLossReason::RawFramesLost => "raw frames lost before it",
+            StepLossReason::StartsMidRun => "the capture starts after the probe's first sample",
+            StepLossReason::ProbeDroppedSamples => "the probe's navigation dropped samples",
+        };
+        write!(
+            f,
+            "run {}: not compared from sample {} on ({why})",
+            self.run, self.from_sample
+        )
+    }
 }
 
 /// Replays every raw frame of `frames` through the navigation, starting at
 /// `position` (the probe's configured site), with uncalibrated sensors.
 pub fn replay(frames: &[Frame], position: Position) -> (Vec<ReplayRow>, ReplaySummary) {
-    replay_with(frames, Navigator::new(position))
+    replay_with(frames, position, ProbeCalibration::default())
 }
 
-/// The same through a given navigator (e.g. one holding the probe's
-/// calibration, `Navigator::with_calibration`).
-pub fn replay_with(frames: &[Frame], navigator: Navigator) -> (Vec<ReplayRow>, ReplaySummary) {
-    let mut replayer = Replayer::with_navigator(navigator);
+/// The same with the probe's sensor calibration (what
+/// `Navigator::with_calibration` is given).
+pub fn replay_with(
+    frames: &[Frame],
+    position: Position,
+    calibration: ProbeCalibration,
+) -> (Vec<ReplayRow>, ReplaySummary) {
+    let mut replayer = Replayer::with_calibration(position, calibration);
     for frame in frames {
         replayer.push(frame);
     }
     replayer.finish()
 }
 
+/// Rows of a live replay still waiting for the probe's solution after this
+/// many later samples are written without it: more than the probe's
+/// navigation inbox can hold back (32 samples).
+const SETTLE_AFTER_SAMPLES: usize = 64;
+
 /// The replay one frame at a time, for a live stream: a raw frame is
 /// replayed as soon as it arrives. The probe sends a sample's navigation
 /// frame after its raw frame, but nothing here relies on that order: a
 /// solution waits for its partner on either side.
 pub struct Replayer {
+    position: Position,
+    calibration: ProbeCalibration,
     navigator: Navigator,
     rows: Vec<ReplayRow>,
     /// Rows (index into `rows`) of replayed samples the probe's solution
-    /// has not arrived for yet.
+    /// has not arrived for yet, by sample counter (of the current run).
     awaiting_probe: HashMap<u32, usize>,
     /// The probe's solutions whose raw frame has not arrived yet.
     early_probe: HashMap<u32, NavSolution>,
     summary: ReplaySummary,
+    step: StepTracker,
+    step_losses: Vec<StepLoss>,
+    /// Rows already handed out by [`Replayer::settled_rows`].
+    settled: usize,
+}
+
+/// Whether the replay has seen what the probe's navigation saw.
+#[derive(Debug, Clone, Copy, Default)]
+struct StepTracker {
+    seen_any: bool,
+    expected_seq: Option<u16>,
+    /// A sequence gap since the last raw frame.
+    gap_since_raw: bool,
+    /// The probe reported dropping samples since the last raw frame.
+    dropped_since_raw: bool,
+    last_counter: Option<u32>,
+    /// This run began with its boot event in the capture.
+    from_boot: bool,
+    in_step: bool,
 }
 
 impl Replayer {
     pub fn new(position: Position) -> Self {
-        Self::with_navigator(Navigator::new(position))
+        Self::with_calibration(position, ProbeCalibration::default())
     }
 
-    pub fn with_navigator(navigator: Navigator) -> Self {
+    pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
         Self {
-            navigator,
+            position,
+            calibration,
+            navigator: Navigator::with_calibration(position, calibration),
             rows: Vec::new(),
             awaiting_probe: HashMap::new(),
             early_probe: HashMap::new(),
             summary: ReplaySummary::default(),
+            step: StepTracker {
+                in_step: true,
+                ..StepTracker::default()
+            },
+            step_losses: Vec::new(),
+            settled: 0,
         }
     }
 
     /// Takes one decoded frame; returns the replayed solution if it was a
     /// raw sample.
     pub fn push(&mut self, frame: &Frame) -> Option<NavSolution> {
+        if let Some(expected) = self.step.expected_seq {
+            self.step.gap_since_raw |= frame.seq != expected;
+        }
+        self.step.expected_seq = Some(frame.seq.wrapping_add(1));
+        let seen_before = std::mem::replace(&mut self.step.seen_any, true);
         match frame.payload {
+            _ if starts_a_run(frame.seq, &frame.payload) => {
+                if seen_before {
+                    self.summary.restarts += 1;
+                }
+                self.restart_navigation();
+                None
+            }
+            Payload::Event(e) if e.kind == EventKind::SamplesDropped => {
+                self.step.dropped_since_raw = true;
+                None
+            }
             Payload::Nav(on_board) => {
                 self.summary.probe_solutions += 1;
                 match self.awaiting_probe.remove(&on_board.sample_counter) {
@@ -94,6 +206,7 @@ impl Replayer {
             }
             Payload::Raw(raw) => {
                 self.summary.raw_frames += 1;
+                self.check_step(raw.sample_counter);
                 let solution = self.navigator.step(&raw);
                 if solution.flags & nav_flags::SENSOR_DEGRADED != 0 {
                     self.summary.degraded += 1;
@@ -102,6 +215,7 @@ impl Replayer {
                 self.rows.push(ReplayRow {
                     solution,
                     matches_probe: None,
+                    in_step: self.step.in_step,
                 });
                 match self.early_probe.remove(&raw.sample_counter) {
                     Some(on_board) => self.compare(index, &on_board),
@@ -111,12 +225,67 @@ impl Replayer {
                 }
                 Some(solution)
             }
-            _ => None,
+            Payload::Event(_) => None,
+        }
+    }
+
+    /// A boot event: the probe started again, so does the replay.
+    fn restart_navigation(&mut self) {
+        self.navigator = Navigator::with_calibration(self.position, self.calibration);
+        // Sample counters start again at 0: older partners can never match;
+        // a probe solution whose raw frame was lost was not compared.
+        self.summary.unchecked += self.early_probe.len() as u64;
+        self.awaiting_probe.clear();
+        self.early_probe.clear();
+        self.step = StepTracker {
+            seen_any: true,
+            expected_seq: self.step.expected_seq,
+            from_boot: true,
+            in_step: true,
+            ..StepTracker::default()
+        };
+    }
+
+    /// Whether the raw frame of sample `counter` keeps the replay in step.
+    fn check_step(&mut self, counter: u32) {
+        let step = &mut self.step;
+        let reason = match step.last_counter {
+            // The navigator starts where the probe's did: at its boot event
+            // with nothing lost since, or (no boot event) at sample 0.
+            None if step.from_boot && step.gap_since_raw && counter != 0 => {
+                Some(StepLossReason::RawFramesLost)
+            }
+            None if !step.from_boot && counter != 0 => Some(StepLossReason::StartsMidRun),
+            None => None,
+            // A skip with no frame lost is the probe's own (a resync): its
+            // navigation saw the same samples.
+            Some(last) if step.gap_since_raw && counter != last.wrapping_add(1) => {
+                Some(StepLossReason::RawFramesLost)
+            }
+            Some(_) if step.dropped_since_raw => Some(StepLossReason::ProbeDroppedSamples),
+            Some(_) => None,
+        };
+        step.last_counter = Some(counter);
+        step.gap_since_raw = false;
+        step.dropped_since_raw = false;
+        if let (true, Some(reason)) = (step.in_step, reason) {
+            step.in_step = false;
+            self.step_losses.push(StepLoss {
+                run: self.summary.restarts,
+                from_sample: counter,
+                reason,
+            });
         }
     }
 
     fn compare(&mut self, index: usize, on_board: &NavSolution) {
-        let row = &mut self.rows[index];
+        let Some(row) = self.rows.get_mut(index) else {
+            return;
+        };
+        if !row.in_step {
+            self.summary.unchecked += 1;
+            return;
+        }
         let same = encoded(on_board) == encoded(&row.solution);
         row.matches_probe = Some(same);
         if same {
@@ -131,9 +300,36 @@ impl Replayer {
         &self.summary
     }
 
+    /// Where the replay went out of step with the probe, in order.
+    pub fn step_losses(&self) -> &[StepLoss] {
+        &self.step_losses
+    }
+
+    /// Rows not handed out before whose comparison is settled (compared,
+    /// out of step, or left without the probe's solution for
+    /// [`SETTLE_AFTER_SAMPLES`] samples), in order: what a live replay can
+    /// write now. `all` settles every row (the stream ended).
+    pub fn settled_rows(&mut self, all: bool) -> &[ReplayRow] {
+        let from = self.settled;
+        let newest = self.rows.len();
+        let settled = self.rows[from..]
+            .iter()
+            .enumerate()
+            .take_while(|(i, row)| {
+                all || row.matches_probe.is_some()
+                    || !row.in_step
+                    || newest - (from + i) > SETTLE_AFTER_SAMPLES
+            })
+            .count();
+        self.settled = from + settled;
+        &self.rows[from..self.settled]
+    }
+
     /// The replayed rows (one per raw frame, in arrival order) and the
-    /// summary.
-    pub fn finish(self) -> (Vec<ReplayRow>, ReplaySummary) {
+    /// summary (probe solutions whose raw frame never came count as
+    /// unchecked).
+    pub fn finish(mut self) -> (Vec<ReplayRow>, ReplaySummary) {
+        self.summary.unchecked += self.early_probe.len() as u64;
         (self.rows, self.summary)
     }
 }
@@ -144,39 +340,82 @@ fn encoded(nav: &NavSolution) -> Vec<u8> {
     body[..len].to_vec()
 }
 
-/// CSV columns of [`write_csv`]: SI inside, degrees at this edge.
-pub const CSV_HEADER: &str = "sample,time_s,mode,flags,roll_deg,pitch_deg,heading_deg,\
-vn_m_s,ve_m_s,vd_m_s,lat_deg,lon_deg,height_m,roll_std_deg,pitch_std_deg,heading_std_deg,\
+/// CSV columns of [`write_csv`]: SI inside, degrees at this edge. Azimuth
+/// and toolface in [0, 360); the azimuth is empty unless determined
+/// (`azimuth_status`: determined, undetermined, n/a); NaN is a placeholder
+/// (no estimate yet). `matches_probe`: yes, no, unchecked (the replay was
+/// out of step), empty (no probe solution).
+pub const CSV_HEADER: &str = "sample,time_s,mode,flags,roll_deg,pitch_deg,\
+inclination_deg,azimuth_deg,azimuth_status,toolface_deg,\
+vn_m_s,ve_m_s,vd_m_s,lat_deg,lon_deg,height_m,roll_std_deg,pitch_std_deg,azimuth_std_deg,\
 matches_probe";
 
 /// Writes the replayed solutions as CSV, one row per raw frame.
 pub fn write_csv(rows: &[ReplayRow], mut out: impl Write) -> io::Result<()> {
     writeln!(out, "{CSV_HEADER}")?;
+    write_csv_rows(rows, &mut out)?;
+    out.flush()
+}
+
+/// Writes rows without the header (a live replay writes them as they
+/// settle).
+pub fn write_csv_rows(rows: &[ReplayRow], mut out: impl Write) -> io::Result<()> {
     for row in rows {
         let s = &row.solution;
         let deg = |a: f32| f64::from(a).to_degrees();
-        let [roll, pitch, heading] = s.attitude.map(deg);
+        let [roll, pitch, heading] = s.attitude.map(f64::from);
         let [roll_std, pitch_std, heading_std] = s.attitude_std.map(deg);
+        let drilling = DrillingAngles::from_euler(&Euler::new(roll, pitch, heading));
+        let sigma = f64::from(s.attitude_std[2]);
+        let (azimuth, status) = azimuth_cells(heading, sigma);
         let [vn, ve, vd] = s.velocity_ned;
-        let matches = match row.matches_probe {
-            Some(true) => "yes",
-            Some(false) => "no",
-            None => "",
+        let matches = match (row.in_step, row.matches_probe) {
+            (false, _) => "unchecked",
+            (true, Some(true)) => "yes",
+            (true, Some(false)) => "no",
+            (true, None) => "",
         };
         writeln!(
             out,
-            "{},{:.6},{},{},{roll:.6},{pitch:.6},{heading:.6},{vn},{ve},{vd},{:.9},{:.9},{},\
+            "{},{:.6},{},{},{:.6},{:.6},{:.6},{azimuth},{status},{:.6},{vn},{ve},{vd},{:.9},{:.9},{},\
              {roll_std:.6},{pitch_std:.6},{heading_std:.6},{matches}",
             s.sample_counter,
             s.time_us as f64 * 1e-6,
             s.mode,
             s.flags,
+            roll.to_degrees(),
+            pitch.to_degrees(),
+            drilling.inclination.to_degrees(),
+            angle_0_360(roll),
             s.latitude.to_degrees(),
             s.longitude.to_degrees(),
             s.height,
         )?;
     }
     Ok(())
+}
+
+/// Toolface (or any angle) in [0, 360) deg, NaN kept as the placeholder.
+fn angle_0_360(angle_rad: f64) -> f64 {
+    if angle_rad.is_finite() {
+        display::deg_0_360(angle_rad)
+    } else {
+        f64::NAN
+    }
+}
+
+/// The azimuth cell (empty unless determined) and its status.
+pub fn azimuth_cells(azimuth_rad: f64, sigma_rad: f64) -> (String, &'static str) {
+    if !azimuth_rad.is_finite() || sigma_rad.is_nan() {
+        (String::new(), "n/a")
+    } else if !display::azimuth_is_determined(sigma_rad) {
+        (String::new(), "undetermined")
+    } else {
+        (
+            format!("{:.6}", display::deg_0_360(azimuth_rad)),
+            "determined",
+        )
+    }
 }
 
 #[cfg(test)]
@@ -212,15 +451,11 @@ mod tests {
         let (first, _) = replay(&raws, site);
         let mut capture = Vec::new();
         for (frame, row) in raws.iter().zip(&first) {
-            capture.push(*frame);
             let mut nav = row.solution;
             if nav.sample_counter == 120 {
                 nav.attitude[2] += 1e-6;
             }
-            capture.push(Frame {
-                seq: 0,
-                payload: Payload::Nav(nav),
-            });
+            capture.extend(numbered(capture.len(), [frame.payload, Payload::Nav(nav)]));
         }
         let (rows, summary) = replay(&capture, site);
         assert_eq!(rows.len(), 150);
@@ -231,7 +466,9 @@ mod tests {
                 probe_solutions: 150,
                 matched: 149,
                 mismatched: 1,
+                unchecked: 0,
                 degraded: 0,
+                restarts: 0,
             }
         );
         let mut csv = Vec::new();
@@ -239,6 +476,174 @@ mod tests {
         let text = String::from_utf8(csv).unwrap();
         assert_eq!(text.lines().count(), 151);
         assert!(text.lines().nth(121).unwrap().ends_with(",no"));
+    }
+
+    /// Frames numbered from `first` on, as the probe numbers them.
+    fn numbered(first: usize, payloads: impl IntoIterator<Item = Payload>) -> Vec<Frame> {
+        (first..)
+            .zip(payloads)
+            .map(|(seq, payload)| Frame {
+                seq: seq as u16,
+                payload,
+            })
+            .collect()
+    }
+
+    /// A probe run as the probe sends it: boot event, then per sample the
+    /// raw frame and its navigation frame, numbered from 0.
+    fn probe_run(samples: u32) -> Vec<Frame> {
+        let site = Position::paper_site();
+        let mut navigator = Navigator::new(site);
+        let boot = Payload::Event(mwd_core::protocol::Event {
+            time_us: 0,
+            kind: EventKind::Boot,
+            part: mwd_core::protocol::frame::NO_PART,
+            code: 1,
+            value: 0,
+        });
+        let payloads = std::iter::once(boot).chain((0..samples).flat_map(|n| {
+            let Payload::Raw(r) = raw(n).payload else {
+                unreachable!()
+            };
+            [Payload::Raw(r), Payload::Nav(navigator.step(&r))]
+        }));
+        numbered(0, payloads.collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn a_lost_raw_frame_stops_the_comparison_there_and_a_boot_restarts_it() {
+        let site = Position::paper_site();
+        // Raw frame of sample 69 lost (frame 139: boot, then two per sample).
+        let mut capture = probe_run(130);
+        capture.remove(139);
+        // The probe reboots and runs again.
+        capture.extend(probe_run(130));
+        let mut replayer = Replayer::new(site);
+        for frame in &capture {
+            replayer.push(frame);
+        }
+        assert_eq!(
+            replayer.step_losses(),
+            &[StepLoss {
+                run: 0,
+                from_sample: 70,
+                reason: StepLossReason::RawFramesLost
+            }]
+        );
+        let (rows, summary) = replayer.finish();
+        assert_eq!(
+            summary,
+            ReplaySummary {
+                raw_frames: 129 + 130,
+                probe_solutions: 260,
+                // 0..=68 of the first run, all 130 of the second.
+                matched: 69 + 130,
+                mismatched: 0,
+                // 70..130 of the first run, and sample 69's own.
+                unchecked: 60 + 1,
+                degraded: 0,
+                restarts: 1,
+            }
+        );
+        assert!(rows[69..129]
+            .iter()
+            .all(|r| !r.in_step && r.matches_probe.is_none()));
+        assert!(rows[129..]
+            .iter()
+            .all(|r| r.in_step && r.matches_probe == Some(true)));
+    }
+
+    #[test]
+    fn samples_the_probe_skipped_itself_keep_the_replay_in_step() {
+        // A resynchronisation: no raw frame for samples 51 and 52, no
+        // frame lost (the numbers run on).
+        let mut navigator = Navigator::new(Position::paper_site());
+        let payloads = (0..100u32).filter(|n| !(51..53).contains(n)).flat_map(|n| {
+            let Payload::Raw(r) = raw(n).payload else {
+                unreachable!()
+            };
+            [Payload::Raw(r), Payload::Nav(navigator.step(&r))]
+        });
+        let capture = numbered(0, payloads.collect::<Vec<_>>());
+        let mut replayer = Replayer::new(Position::paper_site());
+        for frame in &capture {
+            replayer.push(frame);
+        }
+        assert!(replayer.step_losses().is_empty());
+        let (_, summary) = replayer.finish();
+        assert_eq!((summary.matched, summary.unchecked), (98, 0));
+    }
+
+    #[test]
+    fn a_capture_that_starts_mid_run_is_not_compared() {
+        let capture = probe_run(120);
+        let mut replayer = Replayer::new(Position::paper_site());
+        for frame in &capture[21..] {
+            replayer.push(frame);
+        }
+        assert_eq!(replayer.step_losses()[0].from_sample, 10);
+        let (_, summary) = replayer.finish();
+        assert_eq!((summary.matched, summary.mismatched), (0, 0));
+    }
+
+    #[test]
+    fn lost_navigation_frames_alone_keep_the_replay_in_step() {
+        let mut capture = probe_run(120);
+        capture.retain(|f| f.seq % 10 != 4);
+        let mut replayer = Replayer::new(Position::paper_site());
+        for frame in &capture {
+            replayer.push(frame);
+        }
+        assert!(replayer.step_losses().is_empty());
+        let (_, summary) = replayer.finish();
+        assert_eq!(
+            (summary.matched, summary.mismatched, summary.unchecked),
+            (96, 0, 0)
+        );
+    }
+
+    #[test]
+    fn the_csv_never_shows_an_undetermined_azimuth_and_reads_0_to_360() {
+        let solution = NavSolution {
+            attitude: [-0.5, 0.1, -1.0],
+            attitude_std: [0.01, 0.01, f32::INFINITY],
+            ..NavSolution::default()
+        };
+        let row = ReplayRow {
+            solution,
+            matches_probe: Some(true),
+            in_step: true,
+        };
+        let mut determined = row;
+        determined.solution.attitude_std[2] = 0.01;
+        let mut placeholder = row;
+        placeholder.solution.attitude = [f32::NAN; 3];
+        let mut csv = Vec::new();
+        write_csv(&[row, determined, placeholder], &mut csv).unwrap();
+        let text = String::from_utf8(csv).unwrap();
+        let cells: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+        let col = |name: &str| cells[0].iter().position(|c| *c == name).unwrap();
+        let (az, status, tf) = (
+            col("azimuth_deg"),
+            col("azimuth_status"),
+            col("toolface_deg"),
+        );
+        assert_eq!((cells[1][az], cells[1][status]), ("", "undetermined"));
+        assert_eq!(cells[2][status], "determined");
+        let azimuth: f64 = cells[2][az].parse().unwrap();
+        assert!(
+            (azimuth - (360.0 - 1f64.to_degrees())).abs() < 1e-4,
+            "{azimuth}"
+        );
+        let toolface: f64 = cells[1][tf].parse().unwrap();
+        assert!(
+            (toolface - (360.0 - 0.5f64.to_degrees())).abs() < 1e-4,
+            "{toolface}"
+        );
+        assert_eq!(
+            (cells[3][az], cells[3][status], cells[3][tf]),
+            ("", "n/a", "NaN")
+        );
     }
 
     #[test]
@@ -259,7 +664,7 @@ mod tests {
             ..ProbeCalibration::default()
         };
         let (plain, _) = replay(&raws, site);
-        let (calibrated, _) = replay_with(&raws, Navigator::with_calibration(site, calibration));
+        let (calibrated, _) = replay_with(&raws, site, calibration);
         let roll = |rows: &[ReplayRow]| f64::from(rows[110].solution.attitude[0]);
         let expected = (bias / f64::from(STANDARD_GRAVITY_M_S2)).atan();
         assert!(roll(&plain).abs() < 1e-3, "{}", roll(&plain));

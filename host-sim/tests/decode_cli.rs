@@ -21,7 +21,6 @@ fn decode_summarises_a_damaged_capture_and_exports_csv() {
         frame_starts.push(writer.bytes_written() as usize);
         let sample = SiSample {
             index: i,
-            time_s: f64::from(i) * 0.05,
             gyro_body_xz_rad_s: [0.01, -0.02],
             accel_body_m_s2: [[0.0, 0.0, 9.8]; 2],
             temperature_degc: 25.0,

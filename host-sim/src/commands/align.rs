@@ -76,7 +76,7 @@ pub fn run(args: Args) -> Result<()> {
     .with_heading_prior(args.prior_heading.map(|h| h * DEG));
     let spans = coarse::find_segments(&records);
     let report = coarse::align(&records, &spans, &config)?;
-    print!("{}", report.render());
+    out!("{}", report.render());
     Ok(())
 }
 

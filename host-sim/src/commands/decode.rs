@@ -17,15 +17,14 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let cap = capture::read_capture(&args.file)
-        .with_context(|| format!("reading {}", args.file.display()))?;
-    println!("capture          {}", args.file.display());
-    println!("{cap}");
+    let cap = capture::read_probe_capture(&args.file)?;
+    outln!("capture          {}", args.file.display());
+    outln!("{cap}");
     if let Some(out) = &args.csv {
         let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
         capture::write_csv(&cap.frames, BufWriter::new(file))
             .with_context(|| format!("writing {}", out.display()))?;
-        println!(
+        outln!(
             "csv              {} ({} rows)",
             out.display(),
             cap.frames.len()

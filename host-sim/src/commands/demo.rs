@@ -32,9 +32,9 @@ fn run_case(title: &str, records: &[Record], config: &AlignmentConfig) -> Result
         .collect();
     let spans = coarse::find_segments(&records);
     let report = coarse::align(&records, &spans, config)?;
-    println!("== {title}");
-    print!("{}", report.render());
-    println!();
+    outln!("== {title}");
+    out!("{}", report.render());
+    outln!();
     Ok(())
 }
 
@@ -70,7 +70,7 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Where the simulated probe is and how it sits.
 fn print_setup(traj: &Trajectory) {
-    println!(
+    outln!(
         "Simulated SCC1300 probe at rest, {:.5} N {:.6} E {:.0} m; truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result).",
         traj.position.lat / DEG,
         traj.position.lon / DEG,
@@ -79,7 +79,7 @@ fn print_setup(traj: &Trajectory) {
         traj.start.pitch / DEG,
         traj.start.heading / DEG
     );
-    println!("Prior heading for the north/south ambiguity: truth + 30 deg.\n");
+    outln!("Prior heading for the north/south ambiguity: truth + 30 deg.\n");
 }
 
 /// `seconds` of the SCC1300 model on `trajectory`.

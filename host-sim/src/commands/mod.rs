@@ -1,5 +1,18 @@
 //! The CLI: one module per subcommand, each with its clap `Args` and a `run`.
 use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// `println!` for command output that a closed pipe (`| head -1`) does not
+/// turn into a panic: see [`print_out`].
+macro_rules! outln {
+    () => { $crate::commands::print_line(format_args!("")) };
+    ($($arg:tt)*) => { $crate::commands::print_line(format_args!($($arg)*)) };
+}
+
+/// `print!` through [`print_out`], as [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => { $crate::commands::print_text(format_args!($($arg)*)) };
+}
 
 mod align;
 mod allan;
@@ -48,26 +61,49 @@ pub enum Command {
     Paper(paper::PaperCommand),
 }
 
-/// Prints to stdout; a closed pipe (`| head`) ends the output quietly.
+/// Prints to stdout; a closed pipe (`| head`) ends the output quietly: the
+/// command goes on (files it writes are still written, its exit status
+/// still tells), only what nobody reads is dropped.
 fn print_out(text: &str) -> anyhow::Result<()> {
     use std::io::Write;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         other => Ok(other?),
     }
 }
 
-pub fn run(cli: Cli) -> anyhow::Result<()> {
+/// What [`outln!`] calls: one line through [`print_out`]. Another write
+/// error than a closed pipe (a full disk behind a redirection) is said on
+/// stderr rather than panicking as `println!` would.
+pub fn print_line(args: std::fmt::Arguments<'_>) {
+    print_text(format_args!("{args}\n"));
+}
+
+/// What [`out!`] calls.
+pub fn print_text(args: std::fmt::Arguments<'_>) {
+    if let Err(e) = print_out(&args.to_string()) {
+        eprintln!("error: writing to standard output: {e:#}");
+    }
+}
+
+/// Runs a command; its exit status (only `replay` has others than 0: see
+/// its `--help`).
+pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    let done = |result: anyhow::Result<()>| result.map(|()| ExitCode::SUCCESS);
     match cli.command {
-        Command::Demo(args) => demo::run(args),
-        Command::Simulate(args) => simulate::run(args),
-        Command::Decode(args) => decode::run(args),
+        Command::Demo(args) => done(demo::run(args)),
+        Command::Simulate(args) => done(simulate::run(args)),
+        Command::Decode(args) => done(decode::run(args)),
         Command::Replay(args) => replay::run(args),
-        Command::Align(args) => align::run(args),
-        Command::Allan(args) => allan::run(args),
-        Command::Arfit(args) => arfit::run(args),
-        Command::Calibrate(args) => calibrate::run(args),
-        Command::Observability(args) => observability::run(args),
-        Command::Paper(cmd) => paper::run(cmd),
+        Command::Align(args) => done(align::run(args)),
+        Command::Allan(args) => done(allan::run(args)),
+        Command::Arfit(args) => done(arfit::run(args)),
+        Command::Calibrate(args) => done(calibrate::run(args)),
+        Command::Observability(args) => done(observability::run(args)),
+        Command::Paper(cmd) => done(paper::run(cmd)),
     }
 }

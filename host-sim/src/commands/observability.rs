@@ -58,15 +58,15 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Ranks, each state's unobservable share and the unobservable directions.
 fn report(args: &Args, a: &Analysis) {
-    println!(
+    outln!(
         "{} states, {} toolface segment(s) {:?} deg, measurements: {}",
         a.states,
         args.toolfaces.len(),
         args.toolfaces,
         args.measurements
     );
-    println!("rank of each segment's obsv(F, H): {:?}", a.segment_ranks);
-    println!(
+    outln!("rank of each segment's obsv(F, H): {:?}", a.segment_ranks);
+    outln!(
         "rank of the stripped observability matrix: {} of {} (stripping condition {})",
         a.stripped_rank,
         a.states,
@@ -78,9 +78,9 @@ fn report(args: &Args, a: &Analysis) {
     );
     // Shares are of each state's unit vector (states scaled to 1 mrad,
     // 1 cm/s, 1 cm, 1 mg, 2 deg/h) lying in the unobservable subspace.
-    println!("\n{:<28} {:>13}", "state", "unobservable");
+    outln!("\n{:<28} {:>13}", "state", "unobservable");
     for (i, name) in STATE_NAMES.iter().enumerate().take(a.states) {
-        println!(
+        outln!(
             "{:<28} {:>12.0}%",
             name,
             100.0 * a.report.unobservable_share[i]
@@ -93,6 +93,6 @@ fn report(args: &Args, a: &Analysis) {
             .filter(|(_, c)| c.abs() > 0.1)
             .map(|(i, c)| format!("{c:+.2} {}", STATE_NAMES[i]))
             .collect();
-        println!("unobservable direction {}: {}", k + 1, parts.join(", "));
+        outln!("unobservable direction {}: {}", k + 1, parts.join(", "));
     }
 }

@@ -57,9 +57,9 @@ pub fn run(args: MgwdArgs) -> Result<()> {
     ]);
     let lines = consistency(args.runs, &model)?;
     print_consistency(args.runs, &lines, loaded.is_some());
-    println!("{WHY}");
+    outln!("{WHY}");
     write_figures(&args.plots, &test.runs)?;
-    println!(
+    outln!(
         "Plots of Figures 13-15 for each setting in {}",
         args.plots.display()
     );
@@ -99,19 +99,19 @@ fn print_static_test(
 ) {
     let (site, t) = (Position::paper_site(), truth());
     let (coarse, sigma) = (test.coarse, test.coarse_sigma);
-    println!(
+    outln!(
         "MGWD paper, section 4: 60 s static at {:.5} N {:.6} E {:.0} m, SCC1300 model (seed {seed}).",
         site.lat / DEG,
         site.lon / DEG,
         site.height,
     );
-    println!(
+    outln!(
         "Truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result, used as our truth).",
         t.roll / DEG,
         t.pitch / DEG,
         t.heading / DEG
     );
-    println!(
+    outln!(
         "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4}, azimuth {:.3} +- {:.3} deg (1 sigma)\n",
         coarse.roll / DEG,
         sigma[0] / DEG,
@@ -120,7 +120,7 @@ fn print_static_test(
         coarse.heading / DEG,
         sigma[2] / DEG
     );
-    println!("{}", model_source(model, loaded));
+    outln!("{}", model_source(model, loaded));
     print_final_table(&test.runs);
 }
 
@@ -166,7 +166,7 @@ fn model_source(model: &AugmentedModel, loaded: Option<&LoadedModels>) -> String
 /// Each setting's sigmas and errors at the end of the test, beside the
 /// paper's figures.
 fn print_final_table(runs: &[(Settings, History)]) {
-    println!(
+    outln!(
         "{:<34} {:>10} {:>22} {:>22} {:>22}",
         "at 60 s (1 sigma)",
         "paper",
@@ -175,7 +175,7 @@ fn print_final_table(runs: &[(Settings, History)]) {
         runs[2].0.name()
     );
     let row = |label: &str, paper: String, f: &dyn Fn(&History) -> String| {
-        println!(
+        outln!(
             "{label:<34} {paper:>10} {:>22} {:>22} {:>22}",
             f(&runs[0].1),
             f(&runs[1].1),
@@ -233,9 +233,9 @@ fn coupling_name(coupling: Coupling) -> &'static str {
 /// Section 2.4's ranks per coupling, and what the data alone say about the
 /// azimuth (from the last coupling's, the physical one).
 fn print_ranks(ranks: &[Ranks]) {
-    println!("\nRank of ctrb(Phi, Gamma) and obsv(Phi, H), 33-state model (MATLAB tolerance; the paper: both full rank):");
+    outln!("\nRank of ctrb(Phi, Gamma) and obsv(Phi, H), 33-state model (MATLAB tolerance; the paper: both full rank):");
     for r in ranks {
-        println!(
+        outln!(
             "  {:<30} ctrb {:>2}/33  obsv {:>2}/33",
             coupling_name(r.coupling),
             r.controllability,
@@ -243,7 +243,7 @@ fn print_ranks(ranks: &[Ranks]) {
         );
     }
     if let Some(r) = ranks.last() {
-        println!(
+        outln!(
             "  azimuth from 60 s of ZUPT + zero position alone (9 states, no noise on the rates): {:.3} deg; tilts far better",
             r.azimuth_sigma_from_data_deg
         );
@@ -252,10 +252,10 @@ fn print_ranks(ranks: &[Ranks]) {
 
 /// The consistency check, one line per setting and sensor model.
 fn print_consistency(runs: usize, lines: &[Consistency], loaded: bool) {
-    println!("\nConsistency over {runs} seeded runs: final roll and pitch errors both inside the filter's 3 sigma");
+    outln!("\nConsistency over {runs} seeded runs: final roll and pitch errors both inside the filter's 3 sigma");
     for line in lines {
         let mc = &line.result;
-        println!(
+        outln!(
             "  {:<22} {:>2} states  {:<34} {:>3}/{} inside; RMS error roll {:.4} pitch {:.4} az {:.2} deg; mean sigma {:.4} {:.4} {:.2}",
             line.settings.name(),
             line.settings.states(),

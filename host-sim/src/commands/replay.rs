@@ -9,26 +9,52 @@
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::capture::Capture;
-use host_sim::live::{self, LiveOptions};
-use host_sim::replay::{self, ReplayRow, ReplaySummary};
+use host_sim::capture::{self, Capture};
+use host_sim::display;
+use host_sim::live::{self, LiveOptions, LiveSinks};
+use host_sim::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
-use mwd_core::probe::Navigator;
 
 use super::site::SiteArgs;
 
+/// Exit statuses of `replay` (also in its `--help`).
+mod status {
+    /// Every probe solution compared was identical, none left unchecked (or
+    /// the run was post-processed with another calibration or site).
+    pub const PARITY: u8 = 0;
+    /// Replayed solutions differ from the probe's.
+    pub const DIFFERENT: u8 = 3;
+    /// Everything compared was identical, but some probe solutions could
+    /// not be compared (frames lost, the capture starts mid-run, the probe
+    /// dropped samples).
+    pub const INCOMPLETE: u8 = 4;
+}
+
 #[derive(clap::Args, Debug)]
+#[command(
+    after_help = "Exit status: 0 every probe solution compared was identical (or the \
+replay was post-processed with --calibration-file or a site option: differences are then \
+expected and reported, not a failure); 1 error (unreadable file, not a probe capture, bad \
+argument); 2 bad command line; 3 replayed solutions differ from the probe's; 4 all compared \
+solutions identical but some could not be compared (frames lost: the replay stops comparing \
+from the first sample after the loss and starts again at the probe's next boot event)."
+)]
 pub struct Args {
     /// Capture of the probe's UART bytes (`.bin`).
     #[arg(required_unless_present = "port", conflicts_with = "port")]
     pub file: Option<PathBuf>,
     /// Read a live stream from this serial port instead (e.g. /dev/ttyUSB0,
-    /// or the /dev/pts/N QEMU prints for `-serial pty`).
+    /// or the /dev/pts/N QEMU prints for `-serial pty`). Ends at end of
+    /// stream, --duration, --silence, or Ctrl-C / SIGTERM, each with the
+    /// summary.
     #[arg(long, value_name = "PATH")]
     pub port: Option<String>,
     /// Baud rate of the serial port (the probe sends at 115200).
@@ -38,7 +64,21 @@ pub struct Args {
     /// stream ends).
     #[arg(long, value_name = "SECONDS", requires = "port")]
     pub duration: Option<f64>,
-    /// Write the replayed navigation solutions as CSV here.
+    /// End a live replay when no byte came for this many seconds (counted
+    /// from the first byte).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 10.0,
+        requires = "port"
+    )]
+    pub silence: f64,
+    /// Live: record the port's raw bytes here as they arrive (a capture
+    /// `decode` and `replay` read).
+    #[arg(long, value_name = "FILE", requires = "port")]
+    pub save: Option<PathBuf>,
+    /// Write the replayed navigation solutions as CSV here (live: each row
+    /// as soon as its comparison is settled).
     #[arg(long, value_name = "OUT")]
     pub csv: Option<PathBuf>,
     /// The probe's site (the QEMU probe's is the MGWD paper's).
@@ -48,9 +88,9 @@ pub struct Args {
     #[arg(long = "site", num_args = 3, value_names = ["LAT", "LON", "HEIGHT"],
           allow_negative_numbers = true, conflicts_with_all = ["lat", "lon", "height"])]
     pub site_numbers: Option<Vec<f64>>,
-    /// The probe's sensor calibration (`host-sim calibrate`'s JSON): the
-    /// replay applies it as the probe does. Default: none (the QEMU probe
-    /// runs uncalibrated).
+    /// A sensor calibration (`host-sim calibrate`'s JSON) the replay
+    /// applies as the probe does. Default: none (the QEMU probe runs
+    /// uncalibrated).
     #[arg(long, value_name = "PATH")]
     pub calibration_file: Option<PathBuf>,
 }
@@ -62,9 +102,12 @@ struct Replayed {
     capture: Capture,
     rows: Vec<ReplayRow>,
     summary: ReplaySummary,
+    step_losses: Vec<StepLoss>,
+    /// Live: the CSV was written while streaming.
+    csv_written: bool,
 }
 
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let site = match args.site_numbers.as_deref() {
         Some(&[lat, lon, height]) => Position::from_degrees(lat, lon, height),
         _ => args.site.position(),
@@ -78,7 +121,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(file)) => replay_file(file, site, calibration)?,
         (None, None) => anyhow::bail!("give a capture file or --port"),
     };
-    report(&replayed, args.csv.as_ref())
+    // Another calibration or site than the QEMU probe's (none, the
+    // paper's site; the site defaults are the paper's to the bit) is
+    // post-processing, not a parity check.
+    let post_processed = args.calibration_file.is_some() || site != Position::paper_site();
+    report(&replayed, args.csv.as_ref(), post_processed)
 }
 
 /// Replays a capture file.
@@ -87,90 +134,167 @@ fn replay_file(
     site: Position,
     calibration: ProbeCalibration,
 ) -> anyhow::Result<Replayed> {
-    let capture = host_sim::capture::read_capture(file)
-        .with_context(|| format!("reading {}", file.display()))?;
-    let navigator = Navigator::with_calibration(site, calibration);
-    let (rows, summary) = replay::replay_with(&capture.frames, navigator);
+    let capture = capture::read_probe_capture(file)?;
+    let mut replayer = Replayer::with_calibration(site, calibration);
+    for frame in &capture.frames {
+        replayer.push(frame);
+    }
+    let step_losses = replayer.step_losses().to_vec();
+    let (rows, summary) = replayer.finish();
     Ok(Replayed {
         source: file.display().to_string(),
         capture,
         rows,
         summary,
+        step_losses,
+        csv_written: false,
     })
 }
 
+fn seconds(name: &str, value: f64) -> anyhow::Result<Duration> {
+    anyhow::ensure!(
+        value.is_finite() && value > 0.0 && value < 1e9,
+        "--{name} must be a positive number of seconds below 1e9, not {value}"
+    );
+    Ok(Duration::from_secs_f64(value))
+}
+
+/// Creates an output file for a live session.
+fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
+    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    Ok(BufWriter::new(file))
+}
+
 /// Replays the live stream of a serial port until it ends (or
-/// `--duration`), with a status line a few times a second.
+/// `--duration`, `--silence`, SIGINT/SIGTERM), with a status line a few
+/// times a second, writing `--save` and `--csv` as it goes.
 fn replay_live(
     args: &Args,
     port: &str,
     site: Position,
     calibration: ProbeCalibration,
 ) -> anyhow::Result<Replayed> {
-    let duration = match args.duration {
-        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
-        Some(s) => anyhow::bail!("--duration must be a positive number of seconds, not {s}"),
-        None => None,
-    };
-    // A short timeout keeps the time limit responsive on a quiet line.
+    let duration = args.duration.map(|s| seconds("duration", s)).transpose()?;
+    let silence = seconds("silence", args.silence)?;
+    let mut save = args.save.as_deref().map(create).transpose()?;
+    let mut csv = args.csv.as_deref().map(create).transpose()?;
+    // Ctrl-C or SIGTERM ends the session like the end of the stream.
+    let stop = Arc::new(AtomicBool::new(false));
+    let handler_stop = Arc::clone(&stop);
+    ctrlc::set_handler(move || handler_stop.store(true, Ordering::Relaxed))
+        .context("installing the SIGINT/SIGTERM handler")?;
+    // A short timeout keeps the limits and the stop flag responsive.
     let serial = serialport::new(port, args.baud)
         .timeout(Duration::from_millis(100))
         .open()
         .with_context(|| format!("opening serial port {port}"))?;
     // Tools driving this (tests, scripts) wait for this line before
     // letting the probe run.
-    println!("listening on {port} at {} baud", args.baud);
-    std::io::stdout().flush()?;
+    outln!("listening on {port} at {} baud", args.baud);
     let options = LiveOptions {
         duration,
+        silence: Some(silence),
         calibration,
         ..LiveOptions::default()
     };
-    let outcome = live::run(serial, site, options, |status| println!("{status}"));
-    println!("end of stream    {}", outcome.end);
+    let sinks = LiveSinks {
+        save: save.as_mut().map(|w| w as &mut dyn Write),
+        csv: csv.as_mut().map(|w| w as &mut dyn Write),
+        stop: Some(&stop),
+    };
+    let outcome = live::run(serial, site, options, sinks, |status| outln!("{status}"));
+    outln!("end of stream    {}", outcome.end);
+    if let Some(path) = &args.save {
+        outln!(
+            "saved            {} ({} bytes)",
+            path.display(),
+            outcome.capture.stats.bytes
+        );
+    }
+    if let live::StreamEnd::OutputFailed(e) = &outcome.end {
+        anyhow::bail!("writing the live session's output: {e}");
+    }
     Ok(Replayed {
         source: port.to_string(),
         capture: outcome.capture,
         rows: outcome.rows,
         summary: outcome.summary,
+        step_losses: outcome.step_losses,
+        csv_written: args.csv.is_some(),
     })
 }
 
-/// The summary both modes end with, and the CSV.
-fn report(replayed: &Replayed, csv: Option<&PathBuf>) -> anyhow::Result<()> {
+/// The summary both modes end with, the CSV, and the exit status.
+fn report(
+    replayed: &Replayed,
+    csv: Option<&PathBuf>,
+    post_processed: bool,
+) -> anyhow::Result<ExitCode> {
     let Replayed {
         source,
         capture: cap,
         rows,
         summary,
+        step_losses,
+        csv_written,
     } = replayed;
-    println!("capture          {source}");
-    println!("{cap}");
-    println!("raw frames       {}", summary.raw_frames);
-    println!("degraded samples {}", summary.degraded);
-    println!("probe solutions  {}", summary.probe_solutions);
-    println!(
-        "replay parity    {} identical, {} different",
-        summary.matched, summary.mismatched
+    outln!("capture          {source}");
+    outln!("{cap}");
+    outln!("raw frames       {}", summary.raw_frames);
+    outln!("degraded samples {}", summary.degraded);
+    outln!("probe solutions  {}", summary.probe_solutions);
+    outln!(
+        "probe restarts   {} (the replay restarted with it)",
+        summary.restarts
     );
+    outln!(
+        "replay parity    {} identical, {} different, {} not compared",
+        summary.matched,
+        summary.mismatched,
+        summary.unchecked
+    );
+    for loss in step_losses {
+        outln!("out of step      {loss}");
+    }
     if let Some(last) = rows.last() {
-        let [r, p, h] = last.solution.attitude.map(|a| f64::from(a).to_degrees());
-        let h_std = f64::from(last.solution.attitude_std[2]).to_degrees();
-        println!(
-            "last attitude    roll {r:.3} pitch {p:.3} heading {h:.2} (+/- {h_std:.2} deg 1-sigma)"
+        let s = &last.solution;
+        let [r, p, h] = s.attitude.map(f64::from);
+        outln!(
+            "last attitude    roll {:.3} pitch {:.3} deg, azimuth {}",
+            r.to_degrees(),
+            p.to_degrees(),
+            display::azimuth_text(h, f64::from(s.attitude_std[2]), 2)
         );
     }
     if let Some(out) = csv {
-        let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
-        replay::write_csv(rows, BufWriter::new(file))
-            .with_context(|| format!("writing {}", out.display()))?;
-        println!("csv              {} ({} rows)", out.display(), rows.len());
+        if !csv_written {
+            let file = create(out)?;
+            replay::write_csv(rows, file).with_context(|| format!("writing {}", out.display()))?;
+        }
+        outln!("csv              {} ({} rows)", out.display(), rows.len());
+    }
+    if post_processed {
+        if summary.mismatched > 0 {
+            outln!(
+                "post-processed   with another calibration or site than the probe's defaults: \
+                 differences from the probe's solutions are expected, not a parity failure"
+            );
+        }
+        return Ok(ExitCode::from(status::PARITY));
     }
     if summary.mismatched > 0 {
-        anyhow::bail!(
-            "{} replayed solutions differ from the probe's",
+        eprintln!(
+            "error: {} replayed solutions differ from the probe's",
             summary.mismatched
         );
+        return Ok(ExitCode::from(status::DIFFERENT));
     }
-    Ok(())
+    if summary.unchecked > 0 || !step_losses.is_empty() {
+        eprintln!(
+            "warning: {} probe solutions could not be compared (see \"out of step\")",
+            summary.unchecked
+        );
+        return Ok(ExitCode::from(status::INCOMPLETE));
+    }
+    Ok(ExitCode::from(status::PARITY))
 }

@@ -141,7 +141,7 @@ pub enum OutputFormat {
 pub fn run(args: Args) -> Result<()> {
     if args.print_sensor_model {
         let file = SensorModelFile::from_model(&SensorModel::scc1300(args.seed));
-        println!("{}", serde_json::to_string_pretty(&file)?);
+        outln!("{}", serde_json::to_string_pretty(&file)?);
         return Ok(());
     }
     let trajectory = args.trajectory.trajectory();
@@ -168,7 +168,13 @@ pub fn run(args: Args) -> Result<()> {
                 output.display()
             );
         }
-        OutputFormat::Csv if to_stdout => samples_csv::write(std::io::stdout().lock(), samples)?,
+        OutputFormat::Csv if to_stdout => {
+            // A reader that stopped (`| head`) ends the run quietly.
+            match samples_csv::write(std::io::stdout().lock(), samples) {
+                Err(e) if is_broken_pipe(&e) => {}
+                other => other?,
+            }
+        }
         OutputFormat::Csv => {
             write_csv(output, samples)?;
             eprintln!(
@@ -178,6 +184,15 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Whether `error` is standard output's reader having gone.
+fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 /// The simulated probe: `--sensor` or `--sensor-model`, with the

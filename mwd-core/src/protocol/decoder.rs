@@ -5,9 +5,11 @@
 //! chunk either decodes (COBS, CRC-32C, version, kind, length) or is
 //! discarded whole. Garbage, a truncated frame or a bit flip therefore costs
 //! the chunk it sits in and nothing after the next delimiter. Lost frames are
-//! counted from gaps in the sequence numbers.
+//! counted from gaps in the sequence numbers, runs (probe restarts) from
+//! boot events, and a large gap is checked against the raw frames' sample
+//! counters (`docs/protocol.md`, "Losses").
 
-use super::frame::{decode_body, Frame, FrameError, MAX_BODY_LEN};
+use super::frame::{decode_body, EventKind, Frame, FrameError, Payload, MAX_BODY_LEN};
 use super::wire::{wire_len, DELIMITER};
 
 /// Largest chunk kept between delimiters: the longest valid encoded body.
@@ -34,7 +36,8 @@ pub struct DecoderStats {
     pub unsupported_version: u64,
     /// Frames missing according to sequence-number gaps.
     pub lost: u64,
-    /// Times the sequence went backwards (probe restart or duplicate).
+    /// Probe restarts: a boot event after other frames, or (its boot event
+    /// lost) a sample counter or sequence that went backwards.
     pub sequence_restarts: u64,
     /// Bytes of all discarded chunks (garbage).
     pub garbage_bytes: u64,
@@ -62,7 +65,20 @@ pub struct Decoder {
     /// The current chunk outgrew `chunk`: discard it at the next delimiter.
     overflowed: bool,
     expected_seq: Option<u16>,
+    /// Sequence number and sample counter of the last raw frame of the
+    /// current run, and what was counted since: the cross-check's anchor.
+    last_raw: Option<(u16, u32)>,
+    since_raw: SinceRaw,
     stats: DecoderStats,
+}
+
+/// What the sequence rule counted since the last raw frame, so that the
+/// next raw frame's sample counter can correct it.
+#[derive(Debug, Clone, Copy, Default)]
+struct SinceRaw {
+    good_frames: u64,
+    lost: u64,
+    restarts: u64,
 }
 
 impl Default for Decoder {
@@ -74,6 +90,17 @@ impl Default for Decoder {
 /// Gaps of at least this size are taken as the sequence going backwards.
 const BACKWARDS: u16 = 0x8000;
 
+/// Frames lost between two raw frames from which the count is checked
+/// against their sample counters: 64 frames, 1.6 s of the probe's traffic.
+/// Below it the sequence numbers alone are exact; above it the 16-bit
+/// sequence may have wrapped (an outage of more than 32767 frames) or the
+/// probe restarted with its boot event lost.
+const CROSS_CHECK_GAP: u64 = 64;
+
+/// Frames the probe sends per sample: a raw and a navigation frame
+/// (events are rare). Only used to count whole wraps of the sequence.
+const FRAMES_PER_SAMPLE: u64 = 2;
+
 impl Decoder {
     pub const fn new() -> Self {
         Self {
@@ -81,6 +108,12 @@ impl Decoder {
             len: 0,
             overflowed: false,
             expected_seq: None,
+            last_raw: None,
+            since_raw: SinceRaw {
+                good_frames: 0,
+                lost: 0,
+                restarts: 0,
+            },
             stats: DecoderStats {
                 frames: [0; 3],
                 unknown_kind: 0,
@@ -167,7 +200,7 @@ impl Decoder {
         let result = chunk.get(..body_len).map(decode_body);
         match result {
             Some(Ok(frame)) => {
-                self.note_sequence(frame.seq);
+                self.note_sequence(frame.seq, Some(&frame.payload));
                 let index = frame.payload.kind().index();
                 if let Some(count) = self.stats.frames.get_mut(index) {
                     *count += 1;
@@ -175,7 +208,7 @@ impl Decoder {
                 Some(frame)
             }
             Some(Err(FrameError::UnknownKind { seq, .. })) => {
-                self.note_sequence(seq);
+                self.note_sequence(seq, None);
                 self.stats.unknown_kind += 1;
                 None
             }
@@ -195,17 +228,71 @@ impl Decoder {
         }
     }
 
-    fn note_sequence(&mut self, seq: u16) {
+    /// The loss rule of `docs/protocol.md` ("Losses"): sequence gaps, a
+    /// boot event starting a new run, large gaps checked against the sample
+    /// counters of the raw frames around them.
+    fn note_sequence(&mut self, seq: u16, payload: Option<&Payload>) {
+        if payload.is_some_and(|p| starts_a_run(seq, p)) {
+            // The probe numbers its first frame, the boot event, 0: a new
+            // run. What its previous run sent after the last frame seen
+            // cannot be known.
+            if self.expected_seq.is_some() {
+                self.stats.sequence_restarts += 1;
+            }
+            self.expected_seq = Some(seq.wrapping_add(1));
+            self.last_raw = None;
+            self.since_raw = SinceRaw::default();
+            return;
+        }
         if let Some(expected) = self.expected_seq {
             let gap = seq.wrapping_sub(expected);
             if gap >= BACKWARDS {
                 self.stats.sequence_restarts += 1;
+                self.since_raw.restarts += 1;
             } else {
                 self.stats.lost += u64::from(gap);
+                self.since_raw.lost += u64::from(gap);
             }
         }
         self.expected_seq = Some(seq.wrapping_add(1));
+        let Some(Payload::Raw(raw)) = payload else {
+            self.since_raw.good_frames += 1;
+            return;
+        };
+        let counter = raw.sample_counter;
+        if let Some((raw_seq, raw_counter)) = self.last_raw {
+            let since = self.since_raw;
+            if since.lost >= CROSS_CHECK_GAP || since.restarts > 0 {
+                // Undo what the sequence alone said since the last raw frame.
+                self.stats.lost -= since.lost;
+                self.stats.sequence_restarts -= since.restarts;
+                if counter <= raw_counter {
+                    // The sample counter went back: a restart whose boot
+                    // event was lost; the frames lost around it cannot be
+                    // counted.
+                    self.stats.sequence_restarts += 1;
+                } else {
+                    // The same run: the counter tells how many times the
+                    // 16-bit sequence wrapped in between.
+                    let advance = u64::from(seq.wrapping_sub(raw_seq));
+                    let by_counter = FRAMES_PER_SAMPLE * u64::from(counter - raw_counter);
+                    let wraps = (by_counter.saturating_sub(advance) + 0x8000) / 0x1_0000;
+                    let sent_between = advance + wraps * 0x1_0000 - 1;
+                    self.stats.lost += sent_between.saturating_sub(since.good_frames);
+                }
+            }
+        }
+        self.last_raw = Some((seq, counter));
+        self.since_raw = SinceRaw::default();
     }
+}
+
+/// Whether a frame starts a probe run: a boot event numbered 0 and stamped
+/// 0 us, the first frame a probe sends after it starts
+/// (`firmware::app::SharedProbe::announce_boot`). The one rule for the
+/// decoder's restarts and the host's replay.
+pub fn starts_a_run(seq: u16, payload: &Payload) -> bool {
+    matches!(payload, Payload::Event(e) if e.kind == EventKind::Boot && e.time_us == 0 && seq == 0)
 }
 
 #[cfg(test)]
@@ -283,6 +370,77 @@ mod tests {
         assert_eq!(dec.stats().lost, 2);
         assert_eq!(dec.stats().sequence_restarts, 1);
         assert_eq!(dec.stats().good_frames(), 6);
+    }
+
+    fn raw(counter: u32) -> Payload {
+        Payload::Raw(super::super::frame::RawSample {
+            sample_counter: counter,
+            ..Default::default()
+        })
+    }
+
+    fn boot() -> Payload {
+        Payload::Event(Event {
+            time_us: 0,
+            kind: EventKind::Boot,
+            part: NO_PART,
+            code: 1,
+            value: 0,
+        })
+    }
+
+    /// Decodes frames given as (sequence number, payload).
+    fn stats_of(frames: impl IntoIterator<Item = (u16, Payload)>) -> DecoderStats {
+        let mut buf = [0u8; MAX_WIRE_LEN];
+        let mut dec = Decoder::new();
+        for (seq, payload) in frames {
+            let n = super::super::wire::encode_frame(seq, &payload, &mut buf).unwrap();
+            dec.feed(&buf[..n], |_| {});
+        }
+        *dec.stats()
+    }
+
+    /// A probe run: its boot event, then `samples` raw and navigation
+    /// frames (the navigation ones stand in as events here), from `from`.
+    fn run(samples: u32) -> impl Iterator<Item = (u16, Payload)> {
+        core::iter::once((0, boot())).chain((0..samples).flat_map(|n| {
+            let seq = (1 + 2 * n) as u16;
+            [(seq, raw(n)), (seq.wrapping_add(1), event(n))]
+        }))
+    }
+
+    #[test]
+    fn a_reboot_after_a_long_run_is_a_restart_not_a_loss() {
+        // 18000 samples (15 min, 36001 frames) twice, as `cat a.bin a.bin`.
+        let stats = stats_of(run(18_000).chain(run(18_000)));
+        assert_eq!((stats.lost, stats.sequence_restarts), (0, 1), "{stats:?}");
+    }
+
+    #[test]
+    fn a_reboot_whose_boot_event_was_lost_is_found_by_the_sample_counter() {
+        let stats = stats_of(run(18_000).chain(run(100).skip(1)));
+        assert_eq!(stats.sequence_restarts, 1, "{stats:?}");
+        assert_eq!(stats.lost, 0, "{stats:?}");
+    }
+
+    #[test]
+    fn an_outage_longer_than_the_sequence_is_counted_from_the_sample_counter() {
+        // 40000 samples (80000 frames, more than the 16-bit sequence) lost
+        // after sample 100, then 5 % more lost in small gaps.
+        let frames = run(50_000).filter(|(_, p)| match p {
+            Payload::Raw(r) => !(101..40_101).contains(&r.sample_counter),
+            Payload::Event(e) if e.kind != EventKind::Boot => !(101..40_101).contains(&e.value),
+            _ => true,
+        });
+        let stats = stats_of(frames);
+        assert_eq!(
+            (stats.lost, stats.sequence_restarts),
+            (80_000, 0),
+            "{stats:?}"
+        );
+        // Small gaps stay exact without any raw frame to check them.
+        let stats = stats_of(run(100).filter(|(seq, _)| seq % 20 != 7));
+        assert_eq!((stats.lost, stats.sequence_restarts), (10, 0), "{stats:?}");
     }
 
     #[test]
