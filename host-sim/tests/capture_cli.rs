@@ -147,7 +147,9 @@ fn replay_exit_statuses_tell_parity_restart_loss_and_post_processing_apart() {
     for frame in capture::decode_bytes(&bytes).frames {
         let mut payload = frame.payload;
         if let Payload::Nav(nav) = &mut payload {
-            if nav.sample_counter == 50 {
+            // A fine-alignment sample: during the coarse alignment the
+            // attitude is a NaN placeholder, which no offset changes.
+            if nav.sample_counter == 150 {
                 nav.attitude[0] += 1e-6;
             }
         }

@@ -96,7 +96,6 @@ fn a_day_of_navigation_never_reports_a_sigma_the_error_exceeds() {
         let [a, b] = parts.each_mut().map(|p| p.body_sample(n * period_ns));
         let si = SiSample {
             index: n as u32,
-            time_s: n as f64 / SAMPLE_RATE_HZ,
             gyro_body_xz_rad_s: [a.rate_rad_s[0], b.rate_rad_s[2]].map(f64::from),
             accel_body_m_s2: [a, b].map(|p| p.specific_force_m_s2.map(f64::from)),
             temperature_degc: f64::from(a.temperature_degc),
@@ -178,7 +177,6 @@ fn with_part_1_dead_from_boot_roll_and_pitch_stay_within_their_sigmas() {
         let b = part_2.body_sample(n * period_ns);
         let si = SiSample {
             index: n as u32,
-            time_s: n as f64 / SAMPLE_RATE_HZ,
             gyro_body_xz_rad_s: [0.0, f64::from(b.rate_rad_s[2])],
             accel_body_m_s2: [b.specific_force_m_s2.map(f64::from); 2],
             temperature_degc: f64::from(b.temperature_degc),
