@@ -1,11 +1,15 @@
 //! Numeric column files (CSV, semicolon, tab or whitespace separated) as
 //! the analysis commands read them: an optional header line, `#` comments,
 //! every data field a finite number. Errors name the file, the line and
-//! the field, so a bad export is found without a debugger.
+//! the field, so a bad export is found without a debugger; they quote at
+//! most a short excerpt of the input.
 
+pub use super::text_records::excerpt;
+use super::text_records::for_each_record;
 use super::units::InputUnit;
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
+use std::io::Read;
 use std::path::Path;
 
 /// A table of finite numbers, one `Vec` per column.
@@ -146,9 +150,9 @@ pub fn read_columns(path: &Path) -> Result<Columns> {
     {
         return capture_columns(path);
     }
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    parse_columns(&text).with_context(|| format!("in {}", path.display()))
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    read_table(file).with_context(|| format!("in {}", path.display()))
 }
 
 /// The raw-sample frames of a capture, converted to SI in body axes by the
@@ -206,33 +210,23 @@ fn capture_columns(path: &Path) -> Result<Columns> {
     })
 }
 
-fn split_fields(line: &str) -> Vec<&str> {
-    if line.contains(',') {
-        line.split(',').map(str::trim).collect()
-    } else if line.contains(';') {
-        line.split(';').map(str::trim).collect()
-    } else {
-        line.split_whitespace().collect()
-    }
+/// Parses the text of a numeric column file (see [`read_table`]).
+pub fn parse_columns(text: &str) -> Result<Columns> {
+    read_table(text.as_bytes())
 }
 
-/// Parses the text of a numeric column file. The first non-comment line is
-/// a header when any of its fields is not a number.
-pub fn parse_columns(text: &str) -> Result<Columns> {
+/// Reads a numeric column file as it streams in (see
+/// [`text_records`](super::text_records) for the separators and limits).
+/// The first record is a header when any of its fields is not a number.
+pub fn read_table<R: Read>(input: R) -> Result<Columns> {
     let mut names: Option<Vec<String>> = None;
     let mut data: Vec<Vec<f64>> = Vec::new();
-    for (index, raw) in text.lines().enumerate() {
-        let line_no = index + 1;
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let fields = split_fields(line);
-        let first_content_line = names.is_none() && data.is_empty();
-        if first_content_line && fields.iter().any(|f| f.parse::<f64>().is_err()) {
+    for_each_record(input, |line_no, fields| {
+        let first_record = names.is_none() && data.is_empty();
+        if first_record && fields.iter().any(|f| f.parse::<f64>().is_err()) {
             names = Some(fields.iter().map(|f| f.to_string()).collect());
             data = vec![Vec::new(); fields.len()];
-            continue;
+            return Ok(());
         }
         if data.is_empty() {
             data = vec![Vec::new(); fields.len()];
@@ -247,19 +241,22 @@ pub fn parse_columns(text: &str) -> Result<Columns> {
         for (col, field) in fields.iter().enumerate() {
             let value: f64 = field.parse().map_err(|_| {
                 anyhow::anyhow!(
-                    "line {line_no}, column {}: `{field}` is not a number",
-                    col + 1
+                    "line {line_no}, column {}: `{}` is not a number",
+                    col + 1,
+                    excerpt(field)
                 )
             })?;
             if !value.is_finite() {
                 bail!(
-                    "line {line_no}, column {}: `{field}` is not finite",
-                    col + 1
+                    "line {line_no}, column {}: `{}` is not finite",
+                    col + 1,
+                    excerpt(field)
                 );
             }
             data[col].push(value);
         }
-    }
+        Ok(())
+    })?;
     if data.first().is_none_or(Vec::is_empty) {
         bail!("no data rows");
     }
