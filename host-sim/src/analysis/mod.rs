@@ -27,6 +27,7 @@ pub mod calibration_file;
 pub mod csv_input;
 pub mod paper_tls;
 pub mod plot;
+pub mod ranges;
 pub mod six_position;
 pub mod stats;
 pub mod text_records;
