@@ -156,3 +156,68 @@ fn a_byte_order_mark_and_a_quoted_header_read_as_plain_csv() {
     assert_eq!(names(&odd), names(&plain), "time and truth are not sensors");
     assert!(plain == odd, "the same analysis");
 }
+
+/// Roll and pitch of `align`'s first segment row.
+fn segment_roll_pitch(report: &str) -> (f64, f64) {
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("1 "))
+        .unwrap_or_else(|| panic!("no segment row in {report}"));
+    let numbers: Vec<f64> = row
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    // seg, roll, pitch (the time span and +- bounds are not plain numbers).
+    (numbers[1], numbers[2])
+}
+
+#[test]
+fn align_reads_the_probes_own_capture() {
+    let dir = scratch("bin");
+    let (bin, csv) = (dir.join("run.bin"), dir.join("run.csv"));
+    for out in [&bin, &csv] {
+        let run = host_sim(&["simulate", "--duration", "30", "-o", s(out)]);
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+    }
+    let from_bin = host_sim(&["align", s(&bin)]);
+    assert_eq!(from_bin.code, Some(0), "{}", from_bin.stderr);
+    let from_csv = host_sim(&["align", s(&csv)]);
+    let (rb, pb) = segment_roll_pitch(&from_bin.stdout);
+    let (rc, pc) = segment_roll_pitch(&from_csv.stdout);
+    // The capture holds the same samples quantised to sensor counts.
+    assert!(
+        (rb - rc).abs() < 0.01 && (pb - pc).abs() < 0.01,
+        "{rb} {pb} vs {rc} {pc}"
+    );
+    let garbage = dir.join("garbage.bin");
+    std::fs::write(&garbage, b"time_s,gyro\n1,2\n").unwrap();
+    refused(
+        &host_sim(&["align", s(&garbage)]),
+        "no valid raw-sample frame",
+    );
+}
+
+#[test]
+fn huge_values_give_finite_deviations_or_a_clear_failure() {
+    let dir = scratch("huge");
+    let file = dir.join("huge.csv");
+    let mut text = String::from("time_s,gyro_x_rad_s\n");
+    for i in 0..400u32 {
+        // 1e200 with a +-1e199 wobble: squares overflow, deviations do not.
+        let wobble = f64::from((i * 7919) % 13) - 6.0;
+        text += &format!("{},{:e}\n", f64::from(i) * 0.05, 1e200 + 1e199 * wobble);
+    }
+    std::fs::write(&file, text).unwrap();
+    let run = host_sim(&["allan", s(&file), "--rate", "20", "--json", "--no-plot"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let v: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let oadev = v["sensors"][0]["points"][0]["oadev"].as_f64();
+    assert!(
+        oadev.is_some_and(|d| d.is_finite() && d > 1e198),
+        "{oadev:?}"
+    );
+    let model = dir.join("huge.ar.json");
+    let run = host_sim(&["arfit", s(&file), "--rate", "20", "--output", s(&model)]);
+    refused(&run, "not a finite number");
+    assert!(!model.exists(), "no model of NaNs written");
+}

@@ -7,6 +7,7 @@
 pub use super::text_records::excerpt;
 use super::text_records::for_each_record;
 use super::units::InputUnit;
+use crate::samples_csv::Record;
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use std::io::Read;
@@ -144,10 +145,7 @@ pub fn read_analysis_input(
 /// Reads a numeric column file from disk, or a probe capture (`.bin`, the
 /// UART bytes of `docs/protocol.md`) as SI body-frame columns.
 pub fn read_columns(path: &Path) -> Result<Columns> {
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bin"))
-    {
+    if is_capture(path) {
         return capture_columns(path);
     }
     let file =
@@ -155,34 +153,38 @@ pub fn read_columns(path: &Path) -> Result<Columns> {
     read_table(file).with_context(|| format!("in {}", path.display()))
 }
 
-/// The raw-sample frames of a capture, converted to SI in body axes by the
-/// probe's own conversion (`mwd_core::probe::body_sample`), in
-/// columns named with their units: time_s, gyro_x_rad_s, gyro_z_rad_s,
-/// accel_{x,y,z}_m_s2. Samples with a faulty part are left out (and
-/// counted on standard error), as are CRC failures and other corrupt frames.
-fn capture_columns(path: &Path) -> Result<Columns> {
+/// Whether `path` names a probe capture (`.bin`) rather than a text table.
+pub fn is_capture(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bin"))
+}
+
+/// The raw-sample frames of a capture as samples, converted to SI in body
+/// axes by the probe's own conversion (`mwd_core::probe::body_sample`),
+/// uncalibrated (the tools apply their own calibration, as they do to a
+/// simulated CSV). Samples with a faulty part are left out (and counted on
+/// standard error), as are CRC failures and other corrupt frames.
+pub fn capture_records(path: &Path) -> Result<Vec<Record>> {
     use mwd_core::protocol::Payload;
     let capture = crate::capture::read_capture(path)
         .with_context(|| format!("cannot read capture {}", path.display()))?;
-    let mut data = vec![Vec::new(); 6];
+    let mut records = Vec::new();
     let mut skipped = 0usize;
     for frame in &capture.frames {
         let Payload::Raw(raw) = frame.payload else {
             continue;
         };
-        // The raw sensor, uncalibrated: noise analysis characterises it as it is.
         let Some(sample) = mwd_core::probe::body_sample(&raw, &ProbeCalibration::default()) else {
             skipped += 1;
             continue;
         };
-        let f = sample.specific_force;
-        let time = raw.time_us as f64 * 1e-6;
-        let row = [time, sample.rate_x(), sample.rate_z(), f.x, f.y, f.z];
-        for (column, value) in data.iter_mut().zip(row) {
-            column.push(value);
-        }
+        records.push(Record {
+            time: raw.time_us as f64 * 1e-6,
+            sample,
+            truth: None,
+        });
     }
-    if data[0].is_empty() {
+    if records.is_empty() {
         bail!(
             "{}: no valid raw-sample frame ({} frames decoded, {} CRC failures)",
             path.display(),
@@ -195,6 +197,20 @@ fn capture_columns(path: &Path) -> Result<Columns> {
             "{}: {skipped} raw samples with a faulty part left out",
             path.display()
         );
+    }
+    Ok(records)
+}
+
+/// A capture's samples ([`capture_records`]) as SI columns named with their
+/// units: time_s, gyro_x_rad_s, gyro_z_rad_s, accel_{x,y,z}_m_s2.
+fn capture_columns(path: &Path) -> Result<Columns> {
+    let mut data = vec![Vec::new(); 6];
+    for r in capture_records(path)? {
+        let f = r.sample.specific_force;
+        let row = [r.time, r.sample.rate_x(), r.sample.rate_z(), f.x, f.y, f.z];
+        for (column, value) in data.iter_mut().zip(row) {
+            column.push(value);
+        }
     }
     let names = [
         "time_s",
