@@ -66,8 +66,9 @@ cal 0.01 1.0 z "$I" 1e-5 0 >cal-no-triads.json
 : >empty.json
 printf 'not json' >text.json
 head -c 4096 /dev/urandom >random.json
+head -c 2097152 /dev/zero | tr '\0' ' ' >big.json
 for f in cal-scale-neg cal-scale-tiny cal-singular cal-huge-matrix cal-accel-bias cal-gyro-bias \
-  cal-axis cal-extra-triads cal-no-triads empty text random; do
+  cal-axis cal-extra-triads cal-no-triads empty text random big; do
   run fail align good.csv --calibration-file "$f.json"
   run fail simulate --duration 1 -o sim.csv --calibration-file "$f.json"
   run fail replay good.bin --calibration-file "$f.json"
@@ -96,7 +97,7 @@ ar 0.003 -0.9999999,0,0,0 >ar-near-unit-root.json
 ar 0.003 0,0,0,-1.5 >ar-not-stationary.json
 ar 0.003 null,0,0,0 >ar-null.json
 for f in ar-huge-variance ar-zero-variance ar-negative-variance ar-near-unit-root ar-not-stationary \
-  ar-null empty text random; do
+  ar-null empty text random big; do
   run fail paper mgwd --ar-models "$f.json" --paper-derived-rate
 done
 run ok paper mgwd --ar-models ar-good.json --paper-derived-rate
@@ -105,7 +106,7 @@ run ok paper mgwd --ar-models ar-good.json --paper-derived-rate
 sed 's/"correlation_time_s": 100.0/"correlation_time_s": 0.0/' model.json >model-tau0.json
 sed 's/"arw_deg_per_sqrt_h": [0-9.e-]*/"arw_deg_per_sqrt_h": 1e300/' model.json >model-arw.json
 sed 's/"residual_bias_mg": [0-9.e-]*/"residual_bias_mg": -1/' model.json >model-negative.json
-for f in model-tau0 model-arw model-negative empty text random; do
+for f in model-tau0 model-arw model-negative empty text random big; do
   run fail simulate --duration 1 -o sim.csv --sensor-model "$f.json"
   run fail align good.csv --sensor-model "$f.json"
 done

@@ -221,3 +221,17 @@ fn huge_values_give_finite_deviations_or_a_clear_failure() {
     refused(&run, "not a finite number");
     assert!(!model.exists(), "no model of NaNs written");
 }
+
+#[test]
+fn a_huge_json_file_is_refused_unread() {
+    let dir = scratch("json");
+    let big = dir.join("big.cal.json");
+    std::fs::write(&big, " ".repeat(2 << 20)).unwrap();
+    let csv = dir.join("run.csv");
+    let run = host_sim(&["simulate", "--duration", "2", "-o", s(&csv)]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    refused(
+        &host_sim(&["align", s(&csv), "--calibration-file", s(&big)]),
+        "more than the 1048576",
+    );
+}

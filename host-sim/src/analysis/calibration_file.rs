@@ -198,7 +198,7 @@ impl CalibrationFile {
 
     /// Loads a calibration file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::analysis::text_records::read_small_file(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
         Self::parse(&text).with_context(|| format!("in {}", path.display()))
     }

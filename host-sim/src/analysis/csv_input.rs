@@ -4,8 +4,8 @@
 //! the field, so a bad export is found without a debugger; they quote at
 //! most a short excerpt of the input.
 
-pub use super::text_records::excerpt;
 use super::text_records::for_each_record;
+pub use super::text_records::{excerpt, name_list};
 use super::units::InputUnit;
 use crate::samples_csv::Record;
 use anyhow::{bail, Context, Result};
@@ -39,7 +39,7 @@ impl Columns {
             Some(i) => Ok(&self.data[i]),
             None => bail!(
                 "no column named `{name}` (columns: {})",
-                self.names.join(", ")
+                name_list(&self.names)
             ),
         }
     }
@@ -63,7 +63,7 @@ pub fn select_columns(
                     anyhow::anyhow!(
                         "no column `{}` (columns: {})",
                         n.trim(),
-                        table.names.join(", ")
+                        name_list(&table.names)
                     )
                 })
             })

@@ -34,6 +34,34 @@ pub fn excerpt(text: &str) -> String {
     out
 }
 
+/// The largest JSON file (calibration, AR models, sensor model) read: the
+/// real ones are a few kB.
+pub const MAX_JSON_BYTES: u64 = 1 << 20;
+
+/// The text of a small file, refused unread when larger than `MAX_JSON_BYTES`.
+pub fn read_small_file(path: &std::path::Path) -> Result<String> {
+    let file = std::fs::File::open(path)?;
+    let size = file.metadata()?.len();
+    if size > MAX_JSON_BYTES {
+        bail!("{size} bytes, more than the {MAX_JSON_BYTES} such a file can be");
+    }
+    let mut text = String::new();
+    file.take(MAX_JSON_BYTES)
+        .read_to_string(&mut text)
+        .map_err(|_| anyhow::anyhow!("not UTF-8 text"))?;
+    Ok(text)
+}
+
+/// At most the first ten of `names`, then how many there are in all.
+pub fn name_list(names: &[String]) -> String {
+    let shown: Vec<String> = names.iter().take(10).map(|n| excerpt(n)).collect();
+    if names.len() > shown.len() {
+        format!("{}, ... ({} in all)", shown.join(", "), names.len())
+    } else {
+        shown.join(", ")
+    }
+}
+
 /// A reader that fails on a line longer than [`MAX_LINE_BYTES`] or a NUL
 /// byte, and turns every blank or `#` comment line into a line holding
 /// `#` alone: the `csv` reader skips empty lines without counting them,

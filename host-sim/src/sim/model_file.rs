@@ -231,8 +231,8 @@ impl SensorModelFile {
     }
 
     pub fn load(path: &std::path::Path, seed: u64) -> Result<SensorModel> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let text = crate::analysis::text_records::read_small_file(path)
+            .with_context(|| format!("reading {}", path.display()))?;
         let file: SensorModelFile = serde_json::from_str(&text)
             .with_context(|| format!("{} is not a sensor model JSON", path.display()))?;
         file.to_model(seed)
