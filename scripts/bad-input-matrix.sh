@@ -3,7 +3,7 @@
 # arguments and counts, per case, a panic (exit 101), a silent acceptance
 # (exit 0 where the input must be refused), an unbounded error (more than
 # 4 KiB on standard error) and, for the good controls, a refusal of good
-# input. Prints one line per failing case and the counts; exits 1 if any
+# input. Each run is limited to 1 GiB of output file and 120 s. Prints one line per failing case and the counts; exits 1 if any
 # count is not zero.
 #   scripts/bad-input-matrix.sh [path/to/host-sim]   (default: builds target/debug/host-sim)
 set -uo pipefail
@@ -23,10 +23,14 @@ cases=0 panics=0 silent=0 noisy=0 refused_good=0
 run() {
   local expect="$1"; shift
   cases=$((cases + 1))
-  "$bin" "$@" >out.txt 2>err.txt </dev/null
+  # A run without bound (a file past 1 GiB, more than 120 s) is stopped
+  # and counted as accepted: it should have been refused at once.
+  (ulimit -f 1048576; exec timeout 120 "$bin" "$@") >out.txt 2>err.txt </dev/null
   local code=$? size
   size=$(wc -c <err.txt)
-  if [ "$code" = 101 ]; then
+  if [ "$code" = 124 ] || [ "$code" = 153 ]; then
+    silent=$((silent + 1)); echo "UNBOUNDED  $* (stopped: exit $code)"
+  elif [ "$code" = 101 ]; then
     panics=$((panics + 1)); echo "PANIC      $*"
   elif [ "$expect" = fail ] && [ "$code" = 0 ]; then
     silent=$((silent + 1)); echo "ACCEPTED   $*"
@@ -149,7 +153,7 @@ run ok align good.bin
 for a in "--lat 95" "--lat nan" "--lat -91" "--lon 1e9" "--lon nan" "--height nan" "--height 1e9" \
   "--duration 1e9" "--duration 0" "--duration -1" "--duration nan" "--duration inf" \
   "--motion rotate --body-rate 0,3" "--motion rotate --body-rate 0,0,nan" \
-  "--motion rotate --body-rate 0,0,1e6"; do
+  "--motion rotate --body-rate 0,0,1e6" "--motion toolface --dwell 1e9"; do
   # shellcheck disable=SC2086
   run fail simulate -o sim.csv $a
 done

@@ -60,7 +60,7 @@ pub struct TrajectoryArgs {
     #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
     pub step: f64,
     /// Toolface indexing / six-position: time at rest at each position, seconds.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = limits::duration_s)]
     pub dwell: f64,
     /// Toolface indexing: number of turns.
     #[arg(long, default_value_t = 1)]
