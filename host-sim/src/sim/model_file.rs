@@ -179,8 +179,9 @@ impl SensorModelFile {
             sv.max() / sv.min(),
         )?;
         for i in 0..3 {
-            ar_from_file(&g.ar4[i], DEG, ArQuantity::AngularRate)
-                .with_context(|| format!("gyro.ar4[{i}]"))?;
+            ar_from_file(&g.ar4[i], DEG, ArQuantity::AngularRate).with_context(|| {
+                format!("gyro.ar4[{i}] (its noise_variance, in (deg/s)^2, checked in SI)")
+            })?;
             ar_from_file(&a.ar4[i], 1.0, ArQuantity::SpecificForce)
                 .with_context(|| format!("accel.ar4[{i}]"))?;
         }
@@ -310,7 +311,7 @@ mod tests {
         );
         refused(
             &|f| f.gyro.ar4[1].as_mut().unwrap().noise_variance = 1e300,
-            "gyro.ar4[1]: `noise_variance` is",
+            "gyro.ar4[1] (its noise_variance, in (deg/s)^2, checked in SI): `noise_variance` is",
         );
         refused(
             &|f| f.accel.scale_misalignment[0][1] = 1e300,
