@@ -236,7 +236,9 @@ fn ram_footprint_fits_the_probe() {
          decoder {decoder} B, encoder {} B, tx buffer {MAX_WIRE_LEN} B",
         size_of::<FrameEncoder>()
     );
-    // Two parts, their mocks, a decoder and a transmit buffer: well under
-    // 1 KiB of the probe's 32 KiB.
-    assert!(2 * (driver + mock + reading) + decoder + MAX_WIRE_LEN < 1024);
+    // Two parts, their mocks, a decoder and a transmit buffer: under
+    // 1.5 KiB of the probe's 32 KiB (the decoder grew when it learned to
+    // tell restarts and long outages apart by the raw frames' counters;
+    // the probe's whole RAM is measured by scripts/probe-budgets.sh).
+    assert!(2 * (driver + mock + reading) + decoder + MAX_WIRE_LEN < 1536);
 }

@@ -2,12 +2,13 @@
 //! reads until the binary UART capture takes over. One row per 20 Hz sample,
 //! SI units named in the header; the truth columns are present in simulated
 //! files only.
+use crate::analysis::text_records::{excerpt, for_each_record};
 use crate::sim::SimSample;
 use anyhow::{bail, Context, Result};
 use mwd_core::conventions::Euler;
 use mwd_core::probe_sample::ProbeSample;
 use nalgebra::Vector3;
-use std::io::{BufRead, Write};
+use std::io::{Read, Write};
 
 const MEASURED: [&str; 6] = [
     "time_s",
@@ -72,61 +73,52 @@ pub fn write<W: Write>(mut out: W, samples: impl IntoIterator<Item = SimSample>)
     Ok(())
 }
 
-/// Reads a sample CSV, checking every row; a bad value names its line and
-/// column.
-pub fn read<R: BufRead>(input: R) -> Result<Vec<Record>> {
-    let mut lines = input.lines().enumerate();
-    let header = match lines.next() {
-        Some((_, line)) => line.context("reading the header")?,
-        None => bail!("empty file: expected a header starting with `time_s`"),
-    };
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |name: &str| names.iter().position(|n| *n == name);
-    let mut measured = [0usize; 6];
-    for (slot, name) in measured.iter_mut().zip(MEASURED) {
-        *slot = find(name).with_context(|| {
-            format!("not a probe sample CSV: no `{name}` column in the header `{header}`")
-        })?;
-    }
-    let truth: Option<Vec<usize>> = TRUTH.iter().map(|n| find(n)).collect();
+/// Reads a sample CSV as it streams in (separators, quoting, BOM and the
+/// line-length limit of [`crate::analysis::text_records`]), checking every
+/// row; a bad value names its line and column.
+pub fn read<R: Read>(input: R) -> Result<Vec<Record>> {
+    let mut header: Option<Header> = None;
     let mut records = Vec::new();
-    for (index, line) in lines {
-        let line = line.with_context(|| format!("reading line {}", index + 1))?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+    for_each_record(input, |line, fields| {
+        let Some(Header {
+            names,
+            measured,
+            truth,
+        }) = &header
+        else {
+            header = Some(parse_header(fields)?);
+            return Ok(());
+        };
         let value = |col: usize| -> Result<f64> {
             let text = fields.get(col).with_context(|| {
                 format!(
-                    "line {}: {} fields, expected {}",
-                    index + 1,
+                    "line {line}: {} fields, expected {}",
                     fields.len(),
                     names.len()
                 )
             })?;
             let v: f64 = text.parse().with_context(|| {
                 format!(
-                    "line {}, column `{}`: `{text}` is not a number",
-                    index + 1,
-                    names[col]
+                    "line {line}, column `{}`: `{}` is not a number",
+                    names[col],
+                    excerpt(text)
                 )
             })?;
             if !v.is_finite() {
                 bail!(
-                    "line {}, column `{}`: `{text}` is not finite",
-                    index + 1,
-                    names[col]
+                    "line {line}, column `{}`: `{}` is not finite",
+                    names[col],
+                    excerpt(text)
                 );
             }
             Ok(v)
         };
-        let m: Vec<f64> = measured.iter().map(|&c| value(c)).collect::<Result<_>>()?;
-        let truth = match &truth {
-            Some(cols) => {
-                let t: Vec<f64> = cols.iter().map(|&c| value(c)).collect::<Result<_>>()?;
-                Some(Euler::new(t[0], t[1], t[2]))
-            }
+        let mut m = [0.0; 6];
+        for (slot, &col) in m.iter_mut().zip(measured) {
+            *slot = value(col)?;
+        }
+        let truth = match truth {
+            Some([r, p, h]) => Some(Euler::new(value(*r)?, value(*p)?, value(*h)?)),
             None => None,
         };
         records.push(Record {
@@ -134,11 +126,45 @@ pub fn read<R: BufRead>(input: R) -> Result<Vec<Record>> {
             sample: ProbeSample::new(m[1], m[2], Vector3::new(m[3], m[4], m[5])),
             truth,
         });
+        Ok(())
+    })?;
+    if header.is_none() {
+        bail!("empty file: expected a header starting with `time_s`");
     }
     if records.is_empty() {
         bail!("no samples after the header");
     }
     Ok(records)
+}
+
+/// The header's names and the columns of the measured and truth values.
+struct Header {
+    names: Vec<String>,
+    measured: [usize; 6],
+    truth: Option<[usize; 3]>,
+}
+
+fn parse_header(fields: &[&str]) -> Result<Header> {
+    let find = |name: &str| fields.iter().position(|n| *n == name);
+    let mut measured = [0usize; 6];
+    for (slot, name) in measured.iter_mut().zip(MEASURED) {
+        *slot = find(name).with_context(|| {
+            format!(
+                "not a probe sample CSV: no `{name}` column in the header `{}`",
+                excerpt(&fields.join(","))
+            )
+        })?;
+    }
+    let truth = match TRUTH.map(find) {
+        [Some(r), Some(p), Some(h)] => Some([r, p, h]),
+        _ => None,
+    };
+    let names = fields.iter().map(|f| f.to_string()).collect();
+    Ok(Header {
+        names,
+        measured,
+        truth,
+    })
 }
 
 #[cfg(test)]

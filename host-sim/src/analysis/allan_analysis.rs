@@ -7,7 +7,9 @@
 use super::allan::{allan_deviation, averaging_factors, AllanPoint, TauSet};
 use super::allan_fit::{bias_instability_factor, fit_noise, NoiseCoefficients};
 use super::csv_input::AnalysisInput;
+use super::stats::power_of_two_scale;
 use super::units::{report_noise, InputUnit, Quantity, Reported};
+use anyhow::{bail, Result};
 use serde::Serialize;
 
 /// One column's analysis.
@@ -50,22 +52,50 @@ pub fn work(input: &AnalysisInput, set: TauSet) -> u64 {
 
 /// Analyses every selected column of `input` (sampled at `rate_hz`) in SI
 /// units at the taus of `set`. `on_column` hears each column's name as it
-/// starts, `on_work` the work done (see [`work`]).
+/// starts, `on_work` the work done (see [`work`]). Each column is analysed
+/// scaled by a power of two ([`power_of_two_scale`], exact) so that no sum
+/// of squares overflows; a column whose deviations are still not finite
+/// numbers is an error, never a table of `inf`.
 pub fn analyse_columns(
     input: &AnalysisInput,
     rate_hz: f64,
     set: TauSet,
     mut on_column: impl FnMut(&str),
     mut on_work: impl FnMut(u64),
-) -> Vec<SensorAllan> {
+) -> Result<Vec<SensorAllan>> {
     input
         .si_columns()
         .map(|(name, unit, y)| {
             on_column(name);
-            let points = allan_deviation(&y, rate_hz, set, &mut on_work);
-            let fit = fit_noise(&points);
+            let scale = power_of_two_scale(&y);
+            let scaled: Vec<f64> = y.iter().map(|v| v * scale).collect();
+            let mut points = allan_deviation(&scaled, rate_hz, set, &mut on_work);
+            // Deviations and the noise coefficients go with the data's scale.
+            let mut fit = fit_noise(&points);
+            for p in &mut points {
+                p.oadev /= scale;
+                p.adev = p.adev.map(|d| d / scale);
+                p.ci_low /= scale;
+                p.ci_high /= scale;
+            }
+            for c in [
+                &mut fit.quantization,
+                &mut fit.random_walk,
+                &mut fit.bias_instability,
+                &mut fit.rate_random_walk,
+            ] {
+                *c /= scale;
+            }
+            let finite = points.iter().all(|p| {
+                [p.oadev, p.ci_low, p.ci_high, p.adev.unwrap_or(0.0)]
+                    .iter()
+                    .all(|v| v.is_finite())
+            });
+            if !finite {
+                bail!("column {name}: the Allan deviations are not finite numbers");
+            }
             let quantity = unit.quantity();
-            SensorAllan {
+            Ok(SensorAllan {
                 name: name.to_string(),
                 input_unit: unit,
                 oadev_unit: match quantity {
@@ -82,7 +112,7 @@ pub fn analyse_columns(
                 ),
                 points,
                 fit,
-            }
+            })
         })
         .collect()
 }

@@ -12,6 +12,7 @@
 //! ```
 
 use super::arfit::{ArFit, ArMethod};
+use super::text_records::excerpt;
 use super::units::Quantity;
 use anyhow::{bail, Context, Result};
 use mwd_core::ar::{Ar4, ArModel};
@@ -129,6 +130,145 @@ impl ArModelEntry {
     }
 }
 
+/// The physical range of every field (README, "Sensor-noise analysis and
+/// calibration"), for the AR models of this file and of the sensor-model
+/// file (`sim::model_file`).
+pub mod limits {
+    use crate::analysis::ranges::Range;
+    use mwd_core::conventions::DEG;
+    use mwd_core::sensor_units::{
+        ACCEL_LSB_PER_G, ACCEL_RANGE_G, GYRO_LSB_PER_DEG_S, GYRO_RANGE_DEG_S, STANDARD_GRAVITY,
+    };
+
+    /// Model orders a file may hold (the filter takes 4).
+    pub const ORDER: std::ops::RangeInclusive<usize> = 1..=64;
+    /// Sample rates of the data a model describes.
+    pub const SAMPLE_RATE_HZ: Range = Range::new(1e-3, 1e4, "Hz");
+    /// Largest modulus of a root of the AR polynomial: strictly inside the
+    /// unit circle with a margin, so that the model is stationary and its
+    /// correlation time, -1 / (rate ln r), at most ~1000 samples (50 s at
+    /// 20 Hz; slower drifts belong to the bias states, not the AR ones).
+    pub const MAX_ROOT_MODULUS: f64 = 0.999;
+
+    /// Innovation variance of an accelerometer, (m/s^2)^2: from a
+    /// thousandth of an LSB (1/650 g) squared, below which the output
+    /// cannot show it, to the full scale (6 g) squared.
+    pub fn specific_force_variance() -> Range {
+        let lsb = STANDARD_GRAVITY / f64::from(ACCEL_LSB_PER_G);
+        let full = f64::from(ACCEL_RANGE_G) * STANDARD_GRAVITY;
+        Range::new((1e-3 * lsb).powi(2), full * full, "(m/s^2)^2")
+    }
+
+    /// Innovation variance of a gyro, (rad/s)^2: a thousandth of an LSB
+    /// (1/18 deg/s) squared to the full scale (300 deg/s) squared.
+    pub fn angular_rate_variance() -> Range {
+        let lsb = DEG / f64::from(GYRO_LSB_PER_DEG_S);
+        let full = f64::from(GYRO_RANGE_DEG_S) * DEG;
+        Range::new((1e-3 * lsb).powi(2), full * full, "(rad/s)^2")
+    }
+
+    /// Innovation variance of a channel of unknown unit: positive, at most
+    /// 1e12 (no SCC1300 output, raw counts included, comes near).
+    pub const OTHER_VARIANCE: Range = Range::new(f64::MIN_POSITIVE, 1e12, "(u)^2");
+}
+
+/// Checks one AR model: order, finite coefficients, roots at most
+/// [`limits::MAX_ROOT_MODULUS`], the innovation variance (SI) in the
+/// range of `quantity`.
+pub fn check_ar(coefficients: &[f64], noise_variance: f64, quantity: ArQuantity) -> Result<()> {
+    if !limits::ORDER.contains(&coefficients.len()) {
+        bail!(
+            "order {} outside {} to {}",
+            coefficients.len(),
+            limits::ORDER.start(),
+            limits::ORDER.end()
+        );
+    }
+    for (i, &a) in coefficients.iter().enumerate() {
+        if !a.is_finite() {
+            bail!("`coefficients[{i}]` is {a}, not a finite number");
+        }
+    }
+    let modulus = largest_root_modulus(coefficients);
+    if modulus >= 1.0 {
+        bail!(
+            "the model is not stationary: a root of its AR polynomial has modulus >= 1 \
+             (the limit is {})",
+            limits::MAX_ROOT_MODULUS
+        );
+    }
+    if modulus > limits::MAX_ROOT_MODULUS {
+        bail!(
+            "a root of the AR polynomial has modulus {modulus:.6}, beyond {}: too near the \
+             unit circle (the model must be stationary with a margin)",
+            limits::MAX_ROOT_MODULUS
+        );
+    }
+    let range = match quantity {
+        ArQuantity::SpecificForce => limits::specific_force_variance(),
+        ArQuantity::AngularRate => limits::angular_rate_variance(),
+        ArQuantity::Other => limits::OTHER_VARIANCE,
+    };
+    range.check("noise_variance", noise_variance)?;
+    Ok(())
+}
+
+/// The largest modulus of the roots of z^p + a_1 z^(p-1) + ... + a_p, to
+/// 1e-6, found by bisection on r: every root is inside the circle of radius
+/// r exactly when the model with coefficients a_i / r^i is stationary
+/// (all its reflection coefficients below 1 in magnitude, the step-down
+/// test). At least 1 when the model is not stationary.
+pub fn largest_root_modulus(a: &[f64]) -> f64 {
+    let inside = |r: f64| {
+        let scaled: Vec<f64> = a
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v / r.powi(i as i32 + 1))
+            .collect();
+        let k = super::arfit::reflection_from_coefficients(&scaled);
+        k.iter().all(|k| k.is_finite() && k.abs() < 1.0)
+    };
+    if !inside(1.0) {
+        return 1.0;
+    }
+    let (mut low, mut high) = (0.0, 1.0);
+    while high - low > 1e-7 {
+        let mid = 0.5 * (low + high);
+        if mid > 0.0 && inside(mid) {
+            high = mid;
+        } else {
+            low = mid;
+        }
+    }
+    high
+}
+
+impl ArModelEntry {
+    /// Checks the entry against [`limits`].
+    pub fn check(&self) -> Result<()> {
+        if self.coefficients.len() != self.order {
+            bail!(
+                "`order` is {} but there are {} coefficients",
+                self.order,
+                self.coefficients.len()
+            );
+        }
+        limits::SAMPLE_RATE_HZ.check("sample_rate_hz", self.sample_rate_hz)?;
+        check_ar(&self.coefficients, self.noise_variance, self.quantity)?;
+        for (i, &e) in self.std_errors.iter().enumerate() {
+            if !(e.is_finite() && e >= 0.0) {
+                bail!("`std_errors[{i}]` is {e}, not a standard error");
+            }
+        }
+        for (i, &k) in self.reflection.iter().enumerate() {
+            if !(k.is_finite() && k.abs() < 1.0) {
+                bail!("`reflection[{i}]` is {k}, outside -1 to 1");
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The whole file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ArModelFile {
@@ -152,7 +292,7 @@ impl ArModelFile {
 
     /// Loads and checks a model file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::analysis::text_records::read_small_file(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
         Self::parse(&text).with_context(|| format!("in {}", path.display()))
     }
@@ -176,25 +316,9 @@ impl ArModelFile {
         }
         let file: Self = serde_json::from_str(text)
             .with_context(|| format!("malformed {FORMAT} v{VERSION} file"))?;
-        for m in &file.models {
-            let finite = m.coefficients.iter().all(|c| c.is_finite());
-            if m.coefficients.len() != m.order || !finite {
-                bail!(
-                    "sensor {}: {} finite coefficients expected",
-                    m.sensor,
-                    m.order
-                );
-            }
-            if !(m.noise_variance.is_finite() && m.noise_variance >= 0.0) {
-                bail!(
-                    "sensor {}: noise variance {} is not a variance",
-                    m.sensor,
-                    m.noise_variance
-                );
-            }
-            if !(m.sample_rate_hz.is_finite() && m.sample_rate_hz > 0.0) {
-                bail!("sensor {}: bad sample rate {}", m.sensor, m.sample_rate_hz);
-            }
+        for (i, m) in file.models.iter().enumerate() {
+            m.check()
+                .with_context(|| format!("`models[{i}]` (sensor {})", excerpt(&m.sensor)))?;
         }
         Ok(file)
     }
@@ -522,6 +646,57 @@ mod tests {
         assert!(err(&f, true).contains("needs an angular rate"));
     }
 
+    /// The audit's bad files (issue 11 item 10).
+    #[test]
+    fn models_outside_the_physical_ranges_are_refused() {
+        let refused = |edit: &dyn Fn(&mut ArModelEntry), needle: &str| {
+            let mut e = entry();
+            edit(&mut e);
+            let text = serde_json::to_string(&ArModelFile::new(vec![e])).unwrap();
+            let err = format!("{:#}", ArModelFile::parse(&text).unwrap_err());
+            assert!(err.contains(needle), "{needle:?} not in {err}");
+            assert!(err.contains("models[0]"), "{err}");
+        };
+        refused(
+            &|e| e.noise_variance = 1e300,
+            "`noise_variance` is 1e300 (m/s^2)^2, outside",
+        );
+        refused(
+            &|e| e.noise_variance = 0.0,
+            "`noise_variance` is 0 (m/s^2)^2, outside",
+        );
+        refused(
+            &|e| {
+                e.coefficients = vec![-0.9999999];
+                e.order = 1;
+            },
+            "modulus 1.000000, beyond 0.999",
+        );
+        refused(&|e| e.coefficients[3] = -1.5, "not stationary");
+        refused(&|e| e.sample_rate_hz = 0.0, "`sample_rate_hz` is 0 Hz");
+        refused(
+            &|e| e.order = 3,
+            "`order` is 3 but there are 4 coefficients",
+        );
+        refused(&|e| e.reflection = vec![1.5], "`reflection[0]` is 1.5");
+        // Every model the paper gives is inside the ranges.
+        for m in mwd_core::ar::ACCEL_DEFAULTS.iter() {
+            check_ar(&m.coefficients, m.noise_variance, ArQuantity::SpecificForce).unwrap();
+        }
+        for m in mwd_core::ar::GYRO_DEFAULTS.iter() {
+            check_ar(&m.coefficients, m.noise_variance, ArQuantity::AngularRate).unwrap();
+        }
+    }
+
+    #[test]
+    fn the_largest_root_modulus() {
+        // z^2 - 0.25 = (z - 0.5)(z + 0.5); z + 0.9; complex pair of modulus 0.8.
+        assert!((largest_root_modulus(&[0.0, -0.25]) - 0.5).abs() < 1e-6);
+        assert!((largest_root_modulus(&[0.9]) - 0.9).abs() < 1e-6);
+        assert!((largest_root_modulus(&[0.0, 0.64]) - 0.8).abs() < 1e-6);
+        assert_eq!(largest_root_modulus(&[-1.0]), 1.0);
+    }
+
     #[test]
     fn rejects_bad_files() {
         assert!(ArModelFile::parse("{}").is_err());
@@ -530,10 +705,10 @@ mod tests {
         assert!(ArModelFile::parse(&serde_json::to_string(&f).unwrap()).is_err());
         let mut g = ArModelFile::new(vec![entry()]);
         g.models[0].coefficients = vec![1.5, 0.0, 0.0, 0.0];
-        let g = ArModelFile::parse(&serde_json::to_string(&g).unwrap()).unwrap();
         assert!(
-            g.models[0].to_core::<4>().is_err(),
+            ArModelFile::parse(&serde_json::to_string(&g).unwrap()).is_err(),
             "|k| > 1 is not stationary"
         );
+        assert!(g.models[0].to_core::<4>().is_err());
     }
 }

@@ -7,6 +7,7 @@
 //! coefficient a_m of the order-m model (MATLAB's `rc`); the partial
 //! autocorrelation at lag m is -k_m.
 
+use super::stats::power_of_two_scale;
 use anyhow::{bail, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -89,6 +90,19 @@ pub fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
 }
 
 /// The series minus its mean.
+/// The series scaled by [`power_of_two_scale`] (exact), then demeaned if
+/// asked: sums of squares of any finite data stay in range. Returns the
+/// data and the scale.
+fn scaled(x: &[f64], demean: bool) -> (Vec<f64>, f64) {
+    let scale = power_of_two_scale(x);
+    let data: Vec<f64> = x.iter().map(|v| v * scale).collect();
+    if demean {
+        (demeaned(&data), scale)
+    } else {
+        (data, scale)
+    }
+}
+
 pub fn demeaned(x: &[f64]) -> Vec<f64> {
     let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
     x.iter().map(|v| v - mean).collect()
@@ -228,8 +242,8 @@ fn standard_errors(x: &[f64], p: usize, variance: f64) -> Vec<f64> {
 /// 1..11 is done without).
 pub fn fit_ar(x: &[f64], p: usize, method: ArMethod, demean: bool) -> Result<ArFit> {
     check_input(x, p)?;
-    let data = if demean { demeaned(x) } else { x.to_vec() };
-    let (coefficients, noise_variance, reflection) = match method {
+    let (data, scale) = scaled(x, demean);
+    let (coefficients, scaled_variance, reflection) = match method {
         ArMethod::YuleWalker => {
             let (a, v, k) = levinson_durbin(&autocovariance(&data, p), p)?;
             (a, v[p - 1], k)
@@ -244,9 +258,23 @@ pub fn fit_ar(x: &[f64], p: usize, method: ArMethod, demean: bool) -> Result<ArF
             (a, v, k)
         }
     };
+    // The coefficients and their standard errors do not depend on the
+    // data's scale; the variance goes with its square.
+    let noise_variance = scaled_variance / (scale * scale);
+    let std_errors = standard_errors(&data, p, scaled_variance);
+    let finite = coefficients
+        .iter()
+        .chain(&std_errors)
+        .all(|v| v.is_finite());
+    if !(finite && noise_variance.is_finite()) {
+        bail!(
+            "the AR({p}) fit is not a finite number (innovation variance {noise_variance:e}): \
+             the data's variance is beyond what a number holds, or the data are degenerate"
+        );
+    }
     Ok(ArFit {
         method,
-        std_errors: standard_errors(&data, p, noise_variance),
+        std_errors,
         coefficients,
         noise_variance,
         reflection,
@@ -262,7 +290,7 @@ pub fn order_scores(
     demean: bool,
 ) -> Result<Vec<OrderScore>> {
     check_input(x, max_order)?;
-    let data = if demean { demeaned(x) } else { x.to_vec() };
+    let (data, scale) = scaled(x, demean);
     let (variances, reflection) = match method {
         ArMethod::YuleWalker => {
             let (_, v, k) = levinson_durbin(&autocovariance(&data, max_order), max_order)?;
@@ -290,12 +318,14 @@ pub fn order_scores(
         .enumerate()
         .map(|(i, (&v, &k))| {
             let p = (i + 1) as f64;
+            // ln of the unscaled variance, finite even when it is not.
+            let ln_variance = v.ln() - 2.0 * scale.ln();
             OrderScore {
                 order: i + 1,
-                noise_variance: v,
+                noise_variance: v / (scale * scale),
                 reflection: k,
-                aic: n * v.ln() + 2.0 * p,
-                bic: n * v.ln() + p * n.ln(),
+                aic: n * ln_variance + 2.0 * p,
+                bic: n * ln_variance + p * n.ln(),
             }
         })
         .collect())

@@ -1,11 +1,16 @@
 //! Numeric column files (CSV, semicolon, tab or whitespace separated) as
 //! the analysis commands read them: an optional header line, `#` comments,
 //! every data field a finite number. Errors name the file, the line and
-//! the field, so a bad export is found without a debugger.
+//! the field, so a bad export is found without a debugger; they quote at
+//! most a short excerpt of the input.
 
+use super::text_records::for_each_record;
+pub use super::text_records::{excerpt, name_list};
 use super::units::InputUnit;
+use crate::samples_csv::Record;
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
+use std::io::Read;
 use std::path::Path;
 
 /// A table of finite numbers, one `Vec` per column.
@@ -34,7 +39,7 @@ impl Columns {
             Some(i) => Ok(&self.data[i]),
             None => bail!(
                 "no column named `{name}` (columns: {})",
-                self.names.join(", ")
+                name_list(&self.names)
             ),
         }
     }
@@ -58,7 +63,7 @@ pub fn select_columns(
                     anyhow::anyhow!(
                         "no column `{}` (columns: {})",
                         n.trim(),
-                        table.names.join(", ")
+                        name_list(&table.names)
                     )
                 })
             })
@@ -140,45 +145,46 @@ pub fn read_analysis_input(
 /// Reads a numeric column file from disk, or a probe capture (`.bin`, the
 /// UART bytes of `docs/protocol.md`) as SI body-frame columns.
 pub fn read_columns(path: &Path) -> Result<Columns> {
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bin"))
-    {
+    if is_capture(path) {
         return capture_columns(path);
     }
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    parse_columns(&text).with_context(|| format!("in {}", path.display()))
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    read_table(file).with_context(|| format!("in {}", path.display()))
 }
 
-/// The raw-sample frames of a capture, converted to SI in body axes by the
-/// probe's own conversion (`mwd_core::probe::body_sample`), in
-/// columns named with their units: time_s, gyro_x_rad_s, gyro_z_rad_s,
-/// accel_{x,y,z}_m_s2. Samples with a faulty part are left out (and
-/// counted on standard error), as are CRC failures and other corrupt frames.
-fn capture_columns(path: &Path) -> Result<Columns> {
+/// Whether `path` names a probe capture (`.bin`) rather than a text table.
+pub fn is_capture(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bin"))
+}
+
+/// The raw-sample frames of a capture as samples, converted to SI in body
+/// axes by the probe's own conversion (`mwd_core::probe::body_sample`),
+/// uncalibrated (the tools apply their own calibration, as they do to a
+/// simulated CSV). Samples with a faulty part are left out (and counted on
+/// standard error), as are CRC failures and other corrupt frames.
+pub fn capture_records(path: &Path) -> Result<Vec<Record>> {
     use mwd_core::protocol::Payload;
     let capture = crate::capture::read_capture(path)
         .with_context(|| format!("cannot read capture {}", path.display()))?;
-    let mut data = vec![Vec::new(); 6];
+    let mut records = Vec::new();
     let mut skipped = 0usize;
     for frame in &capture.frames {
         let Payload::Raw(raw) = frame.payload else {
             continue;
         };
-        // The raw sensor, uncalibrated: noise analysis characterises it as it is.
         let Some(sample) = mwd_core::probe::body_sample(&raw, &ProbeCalibration::default()) else {
             skipped += 1;
             continue;
         };
-        let f = sample.specific_force;
-        let time = raw.time_us as f64 * 1e-6;
-        let row = [time, sample.rate_x(), sample.rate_z(), f.x, f.y, f.z];
-        for (column, value) in data.iter_mut().zip(row) {
-            column.push(value);
-        }
+        records.push(Record {
+            time: raw.time_us as f64 * 1e-6,
+            sample,
+            truth: None,
+        });
     }
-    if data[0].is_empty() {
+    if records.is_empty() {
         bail!(
             "{}: no valid raw-sample frame ({} frames decoded, {} CRC failures)",
             path.display(),
@@ -191,6 +197,20 @@ fn capture_columns(path: &Path) -> Result<Columns> {
             "{}: {skipped} raw samples with a faulty part left out",
             path.display()
         );
+    }
+    Ok(records)
+}
+
+/// A capture's samples ([`capture_records`]) as SI columns named with their
+/// units: time_s, gyro_x_rad_s, gyro_z_rad_s, accel_{x,y,z}_m_s2.
+fn capture_columns(path: &Path) -> Result<Columns> {
+    let mut data = vec![Vec::new(); 6];
+    for r in capture_records(path)? {
+        let f = r.sample.specific_force;
+        let row = [r.time, r.sample.rate_x(), r.sample.rate_z(), f.x, f.y, f.z];
+        for (column, value) in data.iter_mut().zip(row) {
+            column.push(value);
+        }
     }
     let names = [
         "time_s",
@@ -206,33 +226,23 @@ fn capture_columns(path: &Path) -> Result<Columns> {
     })
 }
 
-fn split_fields(line: &str) -> Vec<&str> {
-    if line.contains(',') {
-        line.split(',').map(str::trim).collect()
-    } else if line.contains(';') {
-        line.split(';').map(str::trim).collect()
-    } else {
-        line.split_whitespace().collect()
-    }
+/// Parses the text of a numeric column file (see [`read_table`]).
+pub fn parse_columns(text: &str) -> Result<Columns> {
+    read_table(text.as_bytes())
 }
 
-/// Parses the text of a numeric column file. The first non-comment line is
-/// a header when any of its fields is not a number.
-pub fn parse_columns(text: &str) -> Result<Columns> {
+/// Reads a numeric column file as it streams in (see
+/// [`text_records`](super::text_records) for the separators and limits).
+/// The first record is a header when any of its fields is not a number.
+pub fn read_table<R: Read>(input: R) -> Result<Columns> {
     let mut names: Option<Vec<String>> = None;
     let mut data: Vec<Vec<f64>> = Vec::new();
-    for (index, raw) in text.lines().enumerate() {
-        let line_no = index + 1;
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let fields = split_fields(line);
-        let first_content_line = names.is_none() && data.is_empty();
-        if first_content_line && fields.iter().any(|f| f.parse::<f64>().is_err()) {
+    for_each_record(input, |line_no, fields| {
+        let first_record = names.is_none() && data.is_empty();
+        if first_record && fields.iter().any(|f| f.parse::<f64>().is_err()) {
             names = Some(fields.iter().map(|f| f.to_string()).collect());
             data = vec![Vec::new(); fields.len()];
-            continue;
+            return Ok(());
         }
         if data.is_empty() {
             data = vec![Vec::new(); fields.len()];
@@ -247,19 +257,22 @@ pub fn parse_columns(text: &str) -> Result<Columns> {
         for (col, field) in fields.iter().enumerate() {
             let value: f64 = field.parse().map_err(|_| {
                 anyhow::anyhow!(
-                    "line {line_no}, column {}: `{field}` is not a number",
-                    col + 1
+                    "line {line_no}, column {}: `{}` is not a number",
+                    col + 1,
+                    excerpt(field)
                 )
             })?;
             if !value.is_finite() {
                 bail!(
-                    "line {line_no}, column {}: `{field}` is not finite",
-                    col + 1
+                    "line {line_no}, column {}: `{}` is not finite",
+                    col + 1,
+                    excerpt(field)
                 );
             }
             data[col].push(value);
         }
-    }
+        Ok(())
+    })?;
     if data.first().is_none_or(Vec::is_empty) {
         bail!("no data rows");
     }

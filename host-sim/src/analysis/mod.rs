@@ -13,7 +13,8 @@
 //!   [`six_position`] runs it on a table's columns and makes the file.
 //! - [`tls`]: total least squares and Moore-Penrose reconstruction (TLS
 //!   paper eq. 14-23); [`paper_tls`] reproduces that paper's experiment.
-//! - [`csv_input`], [`plot`], [`stats`]: file input, SVG plots, chi-square.
+//! - [`csv_input`], [`text_records`], [`plot`], [`stats`]: file input
+//!   (streamed, bounded lines), SVG plots, chi-square.
 
 pub mod allan;
 pub mod allan_analysis;
@@ -26,7 +27,9 @@ pub mod calibration_file;
 pub mod csv_input;
 pub mod paper_tls;
 pub mod plot;
+pub mod ranges;
 pub mod six_position;
 pub mod stats;
+pub mod text_records;
 pub mod tls;
 pub mod units;

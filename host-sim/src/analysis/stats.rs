@@ -1,5 +1,22 @@
 //! Small statistical helpers: the chi-square distribution for Allan
-//! deviation confidence intervals (NIST SP 1065 section 5.3, eq. 45).
+//! deviation confidence intervals (NIST SP 1065 section 5.3, eq. 45), and
+//! the scale that keeps sums of squares of any finite data in range.
+
+/// A power of two that brings the largest magnitude of `x` into [0.5, 1):
+/// multiplying by it is exact in binary floating point, so an analysis of
+/// the scaled data, rescaled, gives the same bits as the unscaled one
+/// whenever that one does not overflow, and a finite answer whenever the
+/// answer itself is representable (data of 1e200 have squares of 1e400).
+/// 1 for data that are all zero.
+pub fn power_of_two_scale(x: &[f64]) -> f64 {
+    let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(largest.is_finite() && largest > 0.0) {
+        return 1.0;
+    }
+    let (_, exponent) = libm::frexp(largest);
+    // Subnormal data would need 2^1074, beyond f64: stop at 2^1023.
+    libm::ldexp(1.0, -exponent.clamp(-1023, 1023))
+}
 
 /// Regularized lower incomplete gamma function P(a, x), by its power series
 /// for x < a + 1 and by the continued fraction of Q = 1 - P otherwise (the
@@ -84,6 +101,16 @@ pub const ONE_SIGMA: f64 = 0.682_689_492_137_085_9;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_scale_is_a_power_of_two_bringing_the_data_below_one() {
+        assert_eq!(power_of_two_scale(&[3.0, -5.0]), 0.125);
+        assert_eq!(power_of_two_scale(&[0.0]), 1.0);
+        let s = power_of_two_scale(&[1e200, 1.0]);
+        assert!((0.5..1.0).contains(&(1e200 * s)));
+        let t = power_of_two_scale(&[1e-300]);
+        assert!((0.5..1.0).contains(&(1e-300 * t)));
+    }
 
     #[test]
     fn chi2_against_textbook_quantiles() {

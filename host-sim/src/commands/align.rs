@@ -1,6 +1,7 @@
 //! `host-sim align`: coarse alignment of a recorded or simulated static file.
 use anyhow::{bail, Context, Result};
 use host_sim::analysis::calibration_file::CalibrationFile;
+use host_sim::analysis::csv_input::{capture_records, is_capture};
 use host_sim::coarse;
 use host_sim::samples_csv::{self, Record};
 use host_sim::sim::{DeterministicErrors, SensorModel, SensorModelFile};
@@ -25,7 +26,8 @@ pub enum CalibrationKind {
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Sample CSV (as written by `host-sim simulate`).
+    /// Sample CSV (as written by `host-sim simulate`), or a probe capture
+    /// (`.bin`, the probe's UART bytes: its raw-sample frames are read).
     pub file: PathBuf,
     /// The site (coarse alignment uses its latitude).
     #[command(flatten)]
@@ -82,10 +84,13 @@ pub fn run(args: Args) -> Result<()> {
 
 /// The file's samples, or its first `--first` seconds.
 fn read_records(args: &Args) -> Result<Vec<Record>> {
-    let file = std::fs::File::open(&args.file)
-        .with_context(|| format!("opening {}", args.file.display()))?;
-    let mut records = samples_csv::read(std::io::BufReader::new(file))
-        .with_context(|| format!("reading {}", args.file.display()))?;
+    let mut records = if is_capture(&args.file) {
+        capture_records(&args.file)?
+    } else {
+        let file = std::fs::File::open(&args.file)
+            .with_context(|| format!("opening {}", args.file.display()))?;
+        samples_csv::read(file).with_context(|| format!("reading {}", args.file.display()))?
+    };
     if let Some(first) = args.first {
         let keep = (first / SAMPLE_INTERVAL_S).round() as usize;
         if keep == 0 {

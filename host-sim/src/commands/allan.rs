@@ -60,7 +60,7 @@ pub fn run(args: Args) -> Result<()> {
         set,
         |name| bar.set_message(name.to_string()),
         |k| bar.inc(k),
-    );
+    )?;
     bar.finish_and_clear();
     if !args.no_plot {
         let path = args

@@ -20,6 +20,7 @@ mod arfit;
 mod calibrate;
 mod decode;
 mod demo;
+mod limits;
 mod observability;
 mod paper;
 mod paper_mgwd;

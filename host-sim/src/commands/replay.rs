@@ -109,7 +109,7 @@ struct Replayed {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let site = match args.site_numbers.as_deref() {
-        Some(&[lat, lon, height]) => Position::from_degrees(lat, lon, height),
+        Some(&[lat, lon, height]) => super::site::checked_position(lat, lon, height)?,
         _ => args.site.position(),
     };
     let calibration = match &args.calibration_file {

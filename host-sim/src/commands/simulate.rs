@@ -16,6 +16,7 @@ use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use super::limits::{self, BodyRate};
 use super::site::SiteArgs;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -59,7 +60,7 @@ pub struct TrajectoryArgs {
     #[arg(long, default_value_t = 180.0, allow_hyphen_values = true)]
     pub step: f64,
     /// Toolface indexing / six-position: time at rest at each position, seconds.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = limits::duration_s)]
     pub dwell: f64,
     /// Toolface indexing: number of turns.
     #[arg(long, default_value_t = 1)]
@@ -68,8 +69,9 @@ pub struct TrajectoryArgs {
     #[arg(long, default_value_t = 30.0)]
     pub turn_rate: f64,
     /// Constant rotation: body rate x,y,z in degrees per second.
-    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.0, 1.0, 0.0], allow_hyphen_values = true)]
-    pub body_rate: Vec<f64>,
+    #[arg(long, value_name = "X,Y,Z", default_value_t = BodyRate([0.0, 1.0, 0.0]),
+          value_parser = BodyRate::parse, allow_hyphen_values = true)]
+    pub body_rate: BodyRate,
 }
 
 impl TrajectoryArgs {
@@ -103,7 +105,7 @@ pub struct Args {
     #[command(flatten)]
     pub trajectory: TrajectoryArgs,
     /// Length of the run, seconds (toolface indexing: at least its script).
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = limits::duration_s)]
     pub duration: f64,
     #[arg(long, value_enum, default_value_t = SensorKind::Scc1300)]
     pub sensor: SensorKind,

@@ -3,7 +3,9 @@
 //! `host-sim simulate --print-sensor-model` writes the defaults, and
 //! `--sensor-model FILE` (simulate, align) reads them back.
 use super::sensor::{DeterministicErrors, SensorModel};
-use anyhow::{ensure, Context, Result};
+use crate::analysis::ar_file::{check_ar, ArQuantity};
+use crate::analysis::calibration_file::limits as cal;
+use anyhow::{Context, Result};
 use mwd_core::ar::Ar4;
 use mwd_core::conventions::DEG;
 use mwd_core::sensor_noise::{
@@ -68,15 +70,38 @@ fn ar_to_file(ar: Option<Ar4>, unit: f64) -> Option<Ar4File> {
     })
 }
 
-fn ar_from_file(ar: &Option<Ar4File>, unit: f64) -> Result<Option<Ar4>> {
+/// An AR(4) model of the file in SI units, checked as the AR-model files
+/// are ([`check_ar`]); `unit` converts the file's variance unit to SI.
+fn ar_from_file(ar: &Option<Ar4File>, unit: f64, quantity: ArQuantity) -> Result<Option<Ar4>> {
     let Some(f) = ar else { return Ok(None) };
     let model = Ar4::new(f.a, f.noise_variance * unit * unit);
-    ensure!(
-        f.noise_variance >= 0.0 && model.is_stationary(),
-        "AR(4) model {:?} is not stationary or has a negative variance",
-        f.a
-    );
+    check_ar(&model.coefficients, model.noise_variance, quantity)?;
     Ok(Some(model))
+}
+
+/// The physical range of every figure of the file (README, "The host
+/// tool"): the SCC1300's datasheet figures (0.86 deg/sqrt(h), 2.1 deg/h,
+/// 100 s) lie well inside; a value outside is a unit mistake.
+pub mod limits {
+    use crate::analysis::ranges::Range;
+
+    /// Gyro angle random walk.
+    pub const ARW_DEG_PER_SQRT_H: Range = Range::new(0.0, 10.0, "deg/sqrt(h)");
+    /// Gyro bias instability and residual bias.
+    pub const GYRO_BIAS_DEG_PER_H: Range = Range::new(0.0, 1000.0, "deg/h");
+    /// Gauss-Markov correlation time: more than 0 (0 is white noise, which
+    /// the random walk figures describe), at most ~12 days.
+    pub const CORRELATION_TIME_S: Range = Range::new(0.1, 1e6, "s");
+    /// Deterministic gyro bias: 10 deg/s (the calibration file's limit).
+    pub const GYRO_OFFSET_DEG_PER_S: Range = Range::within(10.0, "deg/s");
+    /// Gyro scale-factor error: +-10 %.
+    pub const SCALE_FACTOR_PPM: Range = Range::within(1e5, "ppm");
+    /// Accelerometer velocity random walk.
+    pub const VRW_M_PER_S_PER_SQRT_H: Range = Range::new(0.0, 10.0, "m/s/sqrt(h)");
+    /// Accelerometer bias instability (0.1 g).
+    pub const ACCEL_BIAS_INSTABILITY_M_PER_S2: Range = Range::new(0.0, 1.0, "m/s^2");
+    /// Accelerometer residual bias after calibration.
+    pub const RESIDUAL_BIAS_MG: Range = Range::new(0.0, 1000.0, "mg");
 }
 
 impl SensorModelFile {
@@ -107,30 +132,68 @@ impl SensorModelFile {
         }
     }
 
-    /// The model, checked: finite, non-negative figures, stationary AR
-    /// models, an invertible accelerometer matrix.
-    pub fn to_model(&self, seed: u64) -> Result<SensorModel> {
+    /// Checks every figure against [`limits`], the accelerometer matrix K
+    /// as the calibration file's M = K^-1 is checked, and the AR models
+    /// as AR-model files are.
+    pub fn check(&self) -> Result<()> {
+        use limits::*;
         let g = &self.gyro;
         let a = &self.accel;
-        let figures = [
-            g.arw_deg_per_sqrt_h,
+        ARW_DEG_PER_SQRT_H.check("gyro.arw_deg_per_sqrt_h", g.arw_deg_per_sqrt_h)?;
+        GYRO_BIAS_DEG_PER_H.check(
+            "gyro.bias_instability_deg_per_h",
             g.bias_instability_deg_per_h,
-            g.correlation_time_s,
-            g.residual_bias_deg_per_h,
-            a.vrw_m_per_s_per_sqrt_h,
+        )?;
+        CORRELATION_TIME_S.check("gyro.correlation_time_s", g.correlation_time_s)?;
+        GYRO_BIAS_DEG_PER_H.check("gyro.residual_bias_deg_per_h", g.residual_bias_deg_per_h)?;
+        for (i, &b) in g.bias_deg_per_s.iter().enumerate() {
+            GYRO_OFFSET_DEG_PER_S.check(&format!("gyro.bias_deg_per_s[{i}]"), b)?;
+        }
+        for (i, &k) in g.scale_factor_ppm.iter().enumerate() {
+            SCALE_FACTOR_PPM.check(&format!("gyro.scale_factor_ppm[{i}]"), k)?;
+        }
+        VRW_M_PER_S_PER_SQRT_H.check("accel.vrw_m_per_s_per_sqrt_h", a.vrw_m_per_s_per_sqrt_h)?;
+        ACCEL_BIAS_INSTABILITY_M_PER_S2.check(
+            "accel.bias_instability_m_per_s2",
             a.bias_instability_m_per_s2,
-            a.correlation_time_s,
-            a.residual_bias_mg,
-        ];
-        ensure!(
-            figures.iter().all(|v| v.is_finite() && *v >= 0.0),
-            "noise figures must be finite and non-negative: {figures:?}"
-        );
+        )?;
+        CORRELATION_TIME_S.check("accel.correlation_time_s", a.correlation_time_s)?;
+        RESIDUAL_BIAS_MG.check("accel.residual_bias_mg", a.residual_bias_mg)?;
+        for (i, &b) in a.bias_m_per_s2.iter().enumerate() {
+            cal::ACCEL_BIAS_M_S2.check(&format!("accel.bias_m_per_s2[{i}]"), b)?;
+        }
+        for (r, row) in a.scale_misalignment.iter().enumerate() {
+            for (c, &k) in row.iter().enumerate() {
+                let range = if r == c {
+                    cal::CORRECTION_DIAGONAL
+                } else {
+                    cal::CORRECTION_OFF_DIAGONAL
+                };
+                range.check(&format!("accel.scale_misalignment[{r}][{c}]"), k)?;
+            }
+        }
         let k = Matrix3::from_fn(|r, c| a.scale_misalignment[r][c]);
-        ensure!(
-            k.iter().all(|v| v.is_finite()) && k.determinant().abs() > 1e-6,
-            "accelerometer scale_misalignment must be finite and invertible"
-        );
+        let sv = k.singular_values();
+        cal::CORRECTION_CONDITION.check(
+            "the condition number of accel.scale_misalignment",
+            sv.max() / sv.min(),
+        )?;
+        for i in 0..3 {
+            ar_from_file(&g.ar4[i], DEG, ArQuantity::AngularRate).with_context(|| {
+                format!("gyro.ar4[{i}] (its noise_variance, in (deg/s)^2, checked in SI)")
+            })?;
+            ar_from_file(&a.ar4[i], 1.0, ArQuantity::SpecificForce)
+                .with_context(|| format!("accel.ar4[{i}]"))?;
+        }
+        Ok(())
+    }
+
+    /// The model, checked ([`Self::check`]).
+    pub fn to_model(&self, seed: u64) -> Result<SensorModel> {
+        self.check()?;
+        let g = &self.gyro;
+        let a = &self.accel;
+        let k = Matrix3::from_fn(|r, c| a.scale_misalignment[r][c]);
         let mut noise = ImuNoise::NONE;
         for (i, axis) in noise.gyro.iter_mut().enumerate() {
             *axis = AxisNoise {
@@ -140,7 +203,7 @@ impl SensorModelFile {
                 } else {
                     arw_from_deg_per_sqrt_hour(g.arw_deg_per_sqrt_h)
                 },
-                coloured: ar_from_file(&g.ar4[i], DEG).context("gyro ar4")?,
+                coloured: ar_from_file(&g.ar4[i], DEG, ArQuantity::AngularRate)?,
                 bias_instability: rate_from_deg_per_hour(g.bias_instability_deg_per_h),
                 correlation_time: g.correlation_time_s,
                 residual_bias: rate_from_deg_per_hour(g.residual_bias_deg_per_h),
@@ -149,7 +212,7 @@ impl SensorModelFile {
         for (i, axis) in noise.accel.iter_mut().enumerate() {
             *axis = AxisNoise {
                 white_density: a.vrw_m_per_s_per_sqrt_h / 60.0,
-                coloured: ar_from_file(&a.ar4[i], 1.0).context("accel ar4")?,
+                coloured: ar_from_file(&a.ar4[i], 1.0, ArQuantity::SpecificForce)?,
                 bias_instability: a.bias_instability_m_per_s2,
                 correlation_time: a.correlation_time_s,
                 residual_bias: a.residual_bias_mg * 1e-3 * STANDARD_GRAVITY,
@@ -169,8 +232,8 @@ impl SensorModelFile {
     }
 
     pub fn load(path: &std::path::Path, seed: u64) -> Result<SensorModel> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let text = crate::analysis::text_records::read_small_file(path)
+            .with_context(|| format!("reading {}", path.display()))?;
         let file: SensorModelFile = serde_json::from_str(&text)
             .with_context(|| format!("{} is not a sensor model JSON", path.display()))?;
         file.to_model(seed)
@@ -215,9 +278,44 @@ mod tests {
             a: [-2.0, 1.0, 0.0, 0.0],
             noise_variance: 1.0,
         });
-        assert!(file.to_model(1).unwrap_err().to_string().contains("ar4"));
+        assert!(format!("{:#}", file.to_model(1).unwrap_err()).contains("accel.ar4[0]"));
         let mut file = SensorModelFile::from_model(&SensorModel::scc1300(1));
         file.accel.scale_misalignment = [[0.0; 3]; 3];
         assert!(file.to_model(1).is_err());
+    }
+
+    /// The audit's bad files (issue 11 item 10): refused, field and range named.
+    #[test]
+    fn figures_outside_the_physical_ranges_are_refused() {
+        let refused = |edit: &dyn Fn(&mut SensorModelFile), needle: &str| {
+            let mut file = SensorModelFile::from_model(&SensorModel::scc1300(1));
+            edit(&mut file);
+            let e = format!("{:#}", file.to_model(1).unwrap_err());
+            assert!(e.contains(needle), "{needle:?} not in {e}");
+        };
+        refused(
+            &|f| f.gyro.correlation_time_s = 0.0,
+            "`gyro.correlation_time_s` is 0 s, outside its range 0.1 to 1e6 s",
+        );
+        refused(
+            &|f| f.accel.correlation_time_s = 0.0,
+            "`accel.correlation_time_s` is 0 s",
+        );
+        refused(
+            &|f| f.gyro.arw_deg_per_sqrt_h = 1e300,
+            "`gyro.arw_deg_per_sqrt_h` is 1e300 deg/sqrt(h), outside its range 0 to 10",
+        );
+        refused(
+            &|f| f.accel.bias_m_per_s2[2] = 1e308,
+            "`accel.bias_m_per_s2[2]` is 1e308",
+        );
+        refused(
+            &|f| f.gyro.ar4[1].as_mut().unwrap().noise_variance = 1e300,
+            "gyro.ar4[1] (its noise_variance, in (deg/s)^2, checked in SI): `noise_variance` is",
+        );
+        refused(
+            &|f| f.accel.scale_misalignment[0][1] = 1e300,
+            "`accel.scale_misalignment[0][1]` is 1e300",
+        );
     }
 }
