@@ -36,3 +36,6 @@ cargo test --workspace
 # in release it runs in about 12 s (measured on a shared 2-core machine,
 # plus about 2 min to build the release test binary), so CI runs it here.
 cargo test --release -p mwd-core --test filter_long_run -- --ignored
+# Coarse alignment: determined headings covered by their bound in every
+# attitude class (issue 11 item 15; 3,840 seeded runs, about 30 s).
+cargo test --release -p system-tests --test alignment_classes -- --ignored
