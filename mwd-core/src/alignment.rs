@@ -72,6 +72,11 @@ const EDGE_ITERATIONS: usize = 10;
 const SELF_CONSISTENCY_ITERATIONS: usize = 4;
 
 const GRID_POINTS: usize = 72;
+/// Cells of the fine scan for a mirror minimum the grid merged (over four
+/// grid steps: 0.05 deg each), and bisections that bring the root to
+/// 0.05 deg / 2^40.
+const MIRROR_SCAN_CELLS: usize = 400;
+const MIRROR_BISECTIONS: usize = 40;
 /// Golden-section steps that bring the bracket (one grid step either side)
 /// to about 1e-4 rad, and Newton steps that take it from there to rounding
 /// (the misfit is smooth, and quadratic near its minimum).
@@ -340,7 +345,7 @@ pub fn gyrocompass(
         alternative: other.map(|o| wrap_pi(o.0)),
         ambiguous: other.is_some(),
         ill_conditioned: ill_conditioned(&model, (heading, allowed), other_allowed, config),
-        determined: determined(&model, sigma, (heading, allowed)),
+        determined: determined(sigma),
         gyro_bias: model.biases(heading),
     })
 }
@@ -393,7 +398,8 @@ pub fn analytical(
     // The two signs are distinct candidates when further apart than the
     // propagated sigma (the wider floor describes the data, not the signs).
     let ambiguous = alternative.is_some_and(|a| wrap_pi(a - heading).abs() > sigma);
-    let sigma = sigma.max(half_width(allowed) / COVERAGE_FACTOR);
+    let sigma =
+        model.self_consistent_sigma(centre, sigma.max(half_width(allowed) / COVERAGE_FACTOR));
     Ok(HeadingEstimate {
         heading: Uncertain {
             value: if heading.is_finite() { heading } else { 0.0 },
@@ -402,7 +408,7 @@ pub fn analytical(
         alternative: alternative.filter(|a| a.is_finite()),
         ambiguous,
         ill_conditioned: ill_conditioned(&model, (centre, allowed), None, config),
-        determined: determined(&model, sigma, (centre, allowed)),
+        determined: determined(sigma),
         gyro_bias: Vector3::zeros(),
     })
 }
@@ -468,25 +474,16 @@ fn ill_conditioned(
         || config.heading_prior.is_some_and(weak)
 }
 
-/// Determined when the heading's sigma is within [`MAX_DETERMINED_SIGMA`]
-/// and so is the expected (Cramer-Rao) sigma at every heading the data
-/// allow. The second test is what keeps the flag honest: where the
+/// Determined when the sigma is within [`MAX_DETERMINED_SIGMA`]. The
+/// sigma is self-consistent (`Misfit::self_consistent_sigma`): no heading
+/// inside its bound has a larger expected sigma. Without that, where the
 /// geometry gives a sigma above the limit (a tool at 60 deg inclination
-/// heading 135 deg after 600 s, say), a few noise draws still give a
-/// misfit that looks sharp and a sigma just under the limit, and among
-/// those runs, selected for looking sharp, the 2-sigma bound covered only
-/// 74 % of the errors (issue 11, item 15). The truth is among the allowed
-/// headings with about 95 % probability, so its geometry is checked
-/// instead of the noise's luck.
-fn determined(model: &Misfit, sigma: f64, (centre, allowed): (f64, Allowed)) -> bool {
-    let within = |s: f64| s.is_finite() && s <= MAX_DETERMINED_SIGMA;
-    within(sigma)
-        && match allowed {
-            Some((below, above)) => {
-                within(model.largest_cramer_rao_sigma(centre - below, centre + above))
-            }
-            None => false,
-        }
+/// heading 135 deg after 600 s, say), a few noise draws gave a misfit that
+/// looked sharp and a sigma just under the limit, and among those runs,
+/// selected for looking sharp, the 2-sigma bound covered only 74 % of the
+/// errors (issue 11, item 15).
+fn determined(sigma: f64) -> bool {
+    sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA
 }
 
 fn check_segment(segment: &StaticSegment) -> Result<(), AlignmentError> {
@@ -767,7 +764,85 @@ impl<'a> Misfit<'a> {
                 }
             }
         }
+        // Two minima closer than about a grid step share one grid minimum
+        // (a level tool heading 89 deg: its mirror is at 91): look for the
+        // other one next to the first.
+        if let [Some(a), None] = found {
+            if let Some(h) = self.merged_mirror(grid, a.0) {
+                let candidate = (h, self.cost(h));
+                found = if candidate.1 < a.1 {
+                    [Some(candidate), Some(a)]
+                } else {
+                    [Some(a), Some(candidate)]
+                };
+            }
+        }
         found
+    }
+
+    /// A second local minimum within two grid steps of the minimum at
+    /// `found`, which the grid cannot tell apart from it. The misfit is a
+    /// trigonometric polynomial of degree two in heading (a quadratic form
+    /// in cos and sin), so the grid gives its five coefficients exactly
+    /// (a discrete Fourier transform), and its slope is scanned finely
+    /// ([`MIRROR_SCAN_CELLS`] cells, about 0.05 deg each) for a change from
+    /// falling to rising away from `found`; that root is then bisected.
+    /// Mirrors within about two cells of each other (0.1 deg) are not told
+    /// apart. Costs no misfit evaluation: a few thousand flops.
+    fn merged_mirror(&self, grid: &[f64; GRID_POINTS], found: f64) -> Option<f64> {
+        if !grid.iter().all(|g| g.is_finite()) {
+            return None;
+        }
+        let step = TAU / GRID_POINTS as f64;
+        // cost(h) = c0 + c1 cos h + s1 sin h + c2 cos 2h + s2 sin 2h.
+        let (mut c1, mut s1, mut c2, mut s2) = (0.0, 0.0, 0.0, 0.0);
+        for (j, g) in grid.iter().enumerate() {
+            let (sn, cs) = (libm::sin(j as f64 * step), libm::cos(j as f64 * step));
+            c1 += g * cs;
+            s1 += g * sn;
+            c2 += g * (cs * cs - sn * sn);
+            s2 += g * 2.0 * sn * cs;
+        }
+        let scale = 2.0 / GRID_POINTS as f64;
+        let (c1, s1, c2, s2) = (c1 * scale, s1 * scale, c2 * scale, s2 * scale);
+        let slope_at = |sn: f64, cs: f64| {
+            -c1 * sn + s1 * cs - 2.0 * c2 * 2.0 * sn * cs + 2.0 * s2 * (cs * cs - sn * sn)
+        };
+        let slope = |h: f64| slope_at(libm::sin(h), libm::cos(h));
+        let start = found - 2.0 * step;
+        let cell = 4.0 * step / MIRROR_SCAN_CELLS as f64;
+        // sin/cos of the scanned headings by rotation (no libm call per
+        // cell: the probe computes in soft-float f64).
+        let (rot_s, rot_c) = (libm::sin(cell), libm::cos(cell));
+        let (mut sn, mut cs) = (libm::sin(start), libm::cos(start));
+        let mut previous = slope_at(sn, cs);
+        let mut best: Option<f64> = None;
+        for k in 1..=MIRROR_SCAN_CELLS {
+            (sn, cs) = (sn * rot_c + cs * rot_s, cs * rot_c - sn * rot_s);
+            let here = slope_at(sn, cs);
+            let h = start + k as f64 * cell;
+            let far = wrap_pi(h - found).abs() > 2.0 * cell
+                && wrap_pi(h - cell - found).abs() > 2.0 * cell;
+            if previous < 0.0 && here >= 0.0 && far {
+                let (mut lo, mut hi) = (h - cell, h);
+                for _ in 0..MIRROR_BISECTIONS {
+                    let mid = 0.5 * (lo + hi);
+                    if slope(mid) < 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let root = 0.5 * (lo + hi);
+                // The nearer of two would be the one the grid merged; at
+                // most one more exists (two minima in all).
+                if best.is_none_or(|b| wrap_pi(root - found).abs() < wrap_pi(b - found).abs()) {
+                    best = Some(root);
+                }
+            }
+            previous = here;
+        }
+        best
     }
 
     /// The minimum within one grid step of `start`: golden-section search,
