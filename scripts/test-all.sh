@@ -37,5 +37,6 @@ cargo test --workspace
 # plus about 2 min to build the release test binary), so CI runs it here.
 cargo test --release -p mwd-core --test filter_long_run -- --ignored
 # Coarse alignment: determined headings covered by their bound in every
-# attitude class (issue 11 item 15; 3,840 seeded runs, about 30 s).
+# attitude class (issue 11 item 15; 19,200 seeded runs, about 2 min in the
+# debug build on a shared 2-core machine).
 cargo test --release -p system-tests --test alignment_classes -- --ignored

@@ -67,9 +67,9 @@ const ALLOWED_CHI2: f64 = COVERAGE_FACTOR * COVERAGE_FACTOR;
 /// grid step / 2^10 (0.005 deg).
 const EDGE_ITERATIONS: usize = 10;
 
-/// Widenings of the bound to a self-consistent one (see
-/// `Misfit::self_consistent_sigma`).
-const SELF_CONSISTENCY_ITERATIONS: usize = 4;
+/// The headings the data allow at 3 sigma (chi-square, 1 degree of
+/// freedom, 99.7 %): where the expected sigma is checked.
+const WIDE_ALLOWED_CHI2: f64 = 9.0;
 
 const GRID_POINTS: usize = 72;
 /// Cells of the fine scan for a mirror minimum the grid merged (over four
@@ -331,9 +331,7 @@ pub fn gyrocompass(
     let sigma = propagated
         .max(model.cramer_rao_sigma(heading))
         .max(half_width(allowed) / COVERAGE_FACTOR);
-    // Every heading inside the printed bound must have an expected sigma
-    // the bound covers (see `Misfit::self_consistent_sigma`).
-    let sigma = model.self_consistent_sigma(heading, sigma);
+    let sigma = sigma.max(model.expected_sigma_allowed(&grid, heading, best.1));
     // The other candidate, when ambiguous, is allowed as well.
     let other_allowed =
         other.map(|o| (o.0, model.allowed_interval(&grid, o.0, o.1 + ALLOWED_CHI2)));
@@ -398,8 +396,9 @@ pub fn analytical(
     // The two signs are distinct candidates when further apart than the
     // propagated sigma (the wider floor describes the data, not the signs).
     let ambiguous = alternative.is_some_and(|a| wrap_pi(a - heading).abs() > sigma);
-    let sigma =
-        model.self_consistent_sigma(centre, sigma.max(half_width(allowed) / COVERAGE_FACTOR));
+    let sigma = sigma
+        .max(half_width(allowed) / COVERAGE_FACTOR)
+        .max(model.expected_sigma_allowed(&grid, centre, model.cost(centre)));
     Ok(HeadingEstimate {
         heading: Uncertain {
             value: if heading.is_finite() { heading } else { 0.0 },
@@ -474,14 +473,9 @@ fn ill_conditioned(
         || config.heading_prior.is_some_and(weak)
 }
 
-/// Determined when the sigma is within [`MAX_DETERMINED_SIGMA`]. The
-/// sigma is self-consistent (`Misfit::self_consistent_sigma`): no heading
-/// inside its bound has a larger expected sigma. Without that, where the
-/// geometry gives a sigma above the limit (a tool at 60 deg inclination
-/// heading 135 deg after 600 s, say), a few noise draws gave a misfit that
-/// looked sharp and a sigma just under the limit, and among those runs,
-/// selected for looking sharp, the 2-sigma bound covered only 74 % of the
-/// errors (issue 11, item 15).
+/// Determined when the sigma (which covers the expected sigma of every
+/// heading the data allow, see `Misfit::expected_sigma_allowed`) is
+/// within [`MAX_DETERMINED_SIGMA`].
 fn determined(sigma: f64) -> bool {
     sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA
 }
@@ -990,29 +984,23 @@ impl<'a> Misfit<'a> {
             })
     }
 
-    /// The smallest sigma (at least `sigma`) whose printed bound holds no
-    /// heading with a larger expected (Cramer-Rao) sigma: widened while a
-    /// heading within the bound has a larger one, a few times at most (each
-    /// widening is checked to the limit of a determined heading; beyond
-    /// it the heading is undetermined whatever the exact figure). Where
-    /// the geometry weakens across the bound (towards east/west), a noise
-    /// draw that makes the misfit look sharp otherwise gives a bound that
-    /// misses the truth (issue 11, item 15).
-    fn self_consistent_sigma(&self, centre: f64, sigma: f64) -> f64 {
-        let mut sigma = sigma;
-        for _ in 0..SELF_CONSISTENCY_ITERATIONS {
-            if !(sigma.is_finite() && sigma <= MAX_DETERMINED_SIGMA) {
-                return sigma;
-            }
-            let reach = COVERAGE_FACTOR * sigma;
-            let worst = self.largest_cramer_rao_sigma(centre - reach, centre + reach);
-            // Never NaN: `largest_cramer_rao_sigma` counts NaN as infinite.
-            if worst <= sigma {
-                return sigma;
-            }
-            sigma = worst;
+    /// The largest expected (Cramer-Rao) sigma among the headings the
+    /// data allow at [`WIDE_ALLOWED_CHI2`] around `centre` (whose misfit
+    /// is `misfit`): pi / 3 when they are the whole circle. The truth is
+    /// among them in all but 0.3 % of runs, so a sigma at least this large
+    /// is at least the truth's own. Without it, where the geometry weakens
+    /// towards east/west, a noise draw that lands the estimate in better
+    /// geometry and makes the misfit look sharp gave a sigma just under the
+    /// limit of a determined heading, and among those runs, selected for
+    /// looking sharp, the 2-sigma bound covered only 74 % of the errors
+    /// (issue 11, item 15).
+    fn expected_sigma_allowed(&self, grid: &[f64; GRID_POINTS], centre: f64, misfit: f64) -> f64 {
+        match self.allowed_interval(grid, centre, misfit + WIDE_ALLOWED_CHI2) {
+            Some((below, above)) => self.largest_cramer_rao_sigma(centre - below, centre + above),
+            // Every heading allowed at 3 sigma: at least a third of a
+            // half turn, so undetermined (finite: the data still exist).
+            None => PI / 3.0,
         }
-        sigma
     }
 
     /// Rate of change with heading of the predicted gyro means of segment

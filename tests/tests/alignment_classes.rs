@@ -5,6 +5,8 @@
 //! undetermined. The simulated SCC1300 (seeded), calibrated with the
 //! paper's Table 3, and a prior 20 deg off the truth (as the issue's
 //! reproduction gives `--prior-heading 155` for a tool heading 135).
+//! A class fails when its misses show a coverage below 90 % (see
+//! `below_ninety_percent`); every class's figures are printed.
 use host_sim::coarse;
 use host_sim::samples_csv::Record;
 use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory};
@@ -81,6 +83,29 @@ fn trial(inclination: f64, azimuth: f64, kind: Kind, seed: u64) -> (bool, bool, 
     (h.determined, error <= h.bound(), error / h.bound())
 }
 
+/// Whether `misses` among `n` determined runs show the coverage to be
+/// below 90 %: more than 10 % missed, and that many or more would happen
+/// with 90 % coverage with a probability under 1 % (binomial tail). A
+/// class with one determined run that misses is not evidence of a
+/// coverage below 90 % (it happens in one class of ten at exactly 90 %),
+/// and 40 or 200 seeds give classes of any size.
+fn below_ninety_percent(n: usize, misses: usize) -> bool {
+    if 10 * misses <= n {
+        return false;
+    }
+    // P(X >= misses), X ~ Binomial(n, 0.1).
+    let p: f64 = 0.1;
+    let tail: f64 = (misses..=n)
+        .map(|k| {
+            let ln_choose = (1..=k)
+                .map(|i| (((n - k + i) as f64) / i as f64).ln())
+                .sum::<f64>();
+            (ln_choose + k as f64 * p.ln() + (n - k) as f64 * (1.0 - p).ln()).exp()
+        })
+        .sum();
+    tail < 0.01
+}
+
 fn sweep(inclinations: &[f64], azimuths: &[f64], kinds: &[Kind], seeds: u64) -> Vec<String> {
     let mut failures = Vec::new();
     for &kind in kinds {
@@ -106,13 +131,39 @@ fn sweep(inclinations: &[f64], azimuths: &[f64], kinds: &[Kind], seeds: u64) -> 
                     t.worst_ratio
                 );
                 println!("{line}");
-                if 10 * t.covered < 9 * t.determined {
+                if below_ninety_percent(t.determined, t.determined - t.covered) {
                     failures.push(line);
                 }
             }
         }
     }
     failures
+}
+
+/// Seeds per class: 200, or `ALIGNMENT_CLASS_SEEDS`.
+fn seeds() -> u64 {
+    std::env::var("ALIGNMENT_CLASS_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200)
+}
+
+/// One class and kind, `ALIGNMENT_CLASS` = "kind inclination azimuth"
+/// (kind 60, 600 or indexed), for a closer look with many seeds.
+#[test]
+#[ignore]
+fn determined_headings_are_covered_in_one_class() {
+    let spec = std::env::var("ALIGNMENT_CLASS").unwrap_or_else(|_| "600 60 135".into());
+    let parts: Vec<&str> = spec.split_whitespace().collect();
+    let kind = match parts.first().copied() {
+        Some("60") => Kind::Static60,
+        Some("indexed") => Kind::Indexed,
+        _ => Kind::Static600,
+    };
+    let number =
+        |i: usize, default: f64| parts.get(i).and_then(|p| p.parse().ok()).unwrap_or(default);
+    let failures = sweep(&[number(1, 60.0)], &[number(2, 135.0)], &[kind], seeds());
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 /// The class (inclination 60, azimuth 135, roll 90: 9 of 34
@@ -134,7 +185,7 @@ fn determined_headings_are_covered_in_every_class() {
         &[5.0, 30.0, 60.0, 90.0],
         &azimuths,
         &[Kind::Static60, Kind::Static600, Kind::Indexed],
-        40,
+        seeds(),
     );
     assert!(failures.is_empty(), "{failures:#?}");
 }

@@ -214,12 +214,15 @@ fn toolface_indexed_heading_bounds_cover_the_errors() {
     println!("indexed: heading covered {heading:.3}, determined {determined:.3}, median bound {median:.1} deg");
     assert!(heading >= 0.9, "heading coverage {heading}");
     // Headings up to 45 deg from north or south at inclinations 70-110 deg:
-    // a bound that reaches towards east/west, where one position's geometry
-    // gives a sigma beyond the limit, is widened until it holds no heading
-    // of worse geometry (issue 11 item 15: the bounds of the runs that
-    // stopped short missed the truth), so about a quarter stay determined
-    // (70 % before that widening, not all of them honestly).
-    assert!(determined >= 0.2, "heading determined in only {determined}");
+    // the sigma covers the expected sigma of every heading the data allow
+    // at 3 sigma, which reach towards east/west (issue 11 item 15: the
+    // bounds of runs that looked sharp by luck missed the truth), so about
+    // a fifth stay determined (18 %; 70 % before, not all of them
+    // honestly: see tests/tests/alignment_classes.rs).
+    assert!(
+        determined >= 0.15,
+        "heading determined in only {determined}"
+    );
     assert!(median < 40.0, "median bound {median} deg");
     assert!(trials
         .iter()

@@ -30,8 +30,7 @@ fn run_case(title: &str, records: &[Record], config: &AlignmentConfig) -> Result
         .iter()
         .map(|r| coarse::calibrated(r, &cal))
         .collect();
-    let spans = coarse::find_segments(&records);
-    let report = coarse::align(&records, &spans, config)?;
+    let report = coarse::align_run(&records, config)?;
     println!("== {title}");
     print!("{}", report.render());
     println!();
@@ -77,7 +76,7 @@ fn print_setup(traj: &Trajectory) {
         traj.position.height,
         traj.start.roll / DEG,
         traj.start.pitch / DEG,
-        traj.start.heading / DEG
+        host_sim::display::deg_0_360(traj.start.heading)
     );
     println!("Prior heading for the north/south ambiguity: truth + 30 deg.\n");
 }

@@ -6,6 +6,7 @@
 use anyhow::{Context, Result};
 use host_sim::analysis::ar_file::{ArModelFile, AxisSource};
 use host_sim::analysis::plot::{line_svg, Curve, Labels};
+use host_sim::display::{azimuth_text, deg_0_360};
 use host_sim::paper_mgwd::{
     consistency, ranks, static_test, truth, Consistency, History, Ranks, Settings, StaticTest,
     PUBLISHED,
@@ -109,16 +110,17 @@ fn print_static_test(
         "Truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result, used as our truth).",
         t.roll / DEG,
         t.pitch / DEG,
-        t.heading / DEG
+        deg_0_360(t.heading)
     );
+    // An undetermined azimuth (5 s: gyro bias ~ earth rate) reads as such,
+    // never as a number (issue 11 item 18).
     println!(
-        "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4}, azimuth {:.3} +- {:.3} deg (1 sigma)\n",
+        "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4} deg (1 sigma), azimuth {}\n",
         coarse.roll / DEG,
         sigma[0] / DEG,
         coarse.pitch / DEG,
         sigma[1] / DEG,
-        coarse.heading / DEG,
-        sigma[2] / DEG
+        azimuth_text(coarse.heading, sigma[2], 3)
     );
     println!("{}", model_source(model, loaded));
     print_final_table(&test.runs);
