@@ -266,10 +266,11 @@ pub fn describe_heading(
         let _ = writeln!(
             s,
             "  azimuth undetermined: sigma {} exceeds {:.0} deg (bound +-180)",
-            if sigma.is_finite() {
+            // Beyond a half turn a sigma says only "any heading".
+            if sigma <= std::f64::consts::PI {
                 format!("{:.1} deg", deg(sigma))
             } else {
-                "infinite".to_string()
+                "over 180 deg".to_string()
             },
             deg(MAX_DETERMINED_SIGMA)
         );
@@ -359,6 +360,86 @@ mod tests {
         // Each segment lies inside a dwell (0-20 s, 26-46 s).
         assert!(recs[spans[0].end - 1].time <= 20.0);
         assert!(recs[spans[1].start].time >= 26.0);
+    }
+
+    fn estimate(value_deg: f64, sigma_deg: f64, determined: bool) -> HeadingEstimate {
+        HeadingEstimate {
+            heading: mwd_core::alignment::Uncertain {
+                value: value_deg * DEG,
+                sigma: sigma_deg * DEG,
+            },
+            alternative: Some((180.0 - value_deg) * DEG),
+            ambiguous: true,
+            ill_conditioned: false,
+            determined,
+            gyro_bias: Default::default(),
+        }
+    }
+
+    /// Issue 11 item 18: "azimuth 147.106 +- 163.653" must read
+    /// undetermined, with neither the estimate, its mirror nor an error
+    /// shown as a number.
+    #[test]
+    fn an_undetermined_azimuth_is_not_shown_as_a_number() {
+        let truth = Some(Euler::new(0.0, 0.0, 30.0 * DEG));
+        let text = describe_heading(&estimate(147.106, 163.653, false), 1, truth, true);
+        assert!(text.contains("azimuth undetermined"), "{text}");
+        for number in ["147.1", "32.8", "117.1", "error +", "error -"] {
+            assert!(!text.contains(number), "{number} in {text}");
+        }
+        let text = describe_heading(&estimate(147.106, 3.0, true), 1, truth, true);
+        assert!(text.contains("147.106 +- 3.000 deg (1 sigma)"), "{text}");
+    }
+
+    /// Issue 11 item 20: with a prior given, the text does not ask for one.
+    #[test]
+    fn a_given_prior_is_not_asked_for() {
+        let h = estimate(10.0, 3.0, true);
+        let with = describe_heading(&h, 1, None, true);
+        assert!(!with.contains("give --prior-heading"), "{with}");
+        assert!(with.contains("the prior chose"), "{with}");
+        let without = describe_heading(&h, 1, None, false);
+        assert!(
+            without.contains("give --prior-heading to choose"),
+            "{without}"
+        );
+    }
+
+    /// Issue 11 item 16: the report says how many samples were used and
+    /// names every range left out with its reason.
+    #[test]
+    fn samples_left_out_are_reported() {
+        let traj = Trajectory {
+            position: Position::paper_site(),
+            start: Euler::new(0.3, -0.1, 0.2),
+            motion: Motion::ToolfaceSteps {
+                step: std::f64::consts::PI,
+                turn_rate: 30.0 * DEG,
+                dwell: 20.0,
+                steps: 1,
+            },
+        };
+        let mut recs = records(
+            traj.clone(),
+            SensorModel::scc1300(3),
+            traj.scripted_duration(),
+        );
+        recs.truncate(recs.len() - 7);
+        let config = AlignmentConfig::probe(traj.position.lat);
+        let report = align_run(&recs, &config).expect("aligns");
+        let text = report.render();
+        let used: usize = report.spans.iter().map(|r| r.len()).sum();
+        let left: usize = report.left_out.iter().map(|(r, _)| r.len()).sum();
+        assert_eq!(used + left, recs.len(), "{text}");
+        assert!(
+            text.contains(&format!("Used {used} of {} samples", recs.len())),
+            "{text}"
+        );
+        assert!(
+            text.contains("left out samples") && text.contains("moving"),
+            "{text}"
+        );
+        assert!(text.contains("fewer than a 1 s block"), "{text}");
     }
 
     #[test]
