@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The bad-input matrix of issue 11: runs host-sim over bad files and bad
+# The bad-input matrix: runs host-sim over bad files and bad
 # arguments and counts, per case, a panic (exit 101), a silent acceptance
 # (exit 0 where the input must be refused), an unbounded error (more than
 # 4 KiB on standard error) and, for the good controls, a refusal of good

@@ -39,3 +39,6 @@ cargo test --release -p mwd-core --test filter_long_run -- --ignored
 # 24 h of the probe's own navigator on a still probe (about 7 s in release):
 # every finite sigma covers the actual error within 5 sigma.
 cargo test --release -p system-tests --test navigator_long_run -- --ignored
+# Coarse alignment: determined headings covered by their bound in every
+# attitude class (19,200 seeded runs; release).
+cargo test --release -p system-tests --test alignment_classes -- --ignored

@@ -1,25 +1,20 @@
 //! Coarse alignment of a recorded or simulated static run: calibration,
 //! splitting into static segments (toolface positions), and the core's
 //! levelling and heading estimators, with a report for people.
+use crate::display::{azimuth_is_determined, azimuth_text, deg_0_360};
 use crate::samples_csv::Record;
 use anyhow::{bail, Result};
 use mwd_core::alignment::{
     analytical, gyrocompass, level_segment, AlignmentConfig, HeadingEstimate, LevelEstimate,
-    SegmentSums, StaticSegment, COVERAGE_FACTOR, MAX_SEGMENTS,
+    SegmentSums, StaticSegment, COVERAGE_FACTOR, MAX_DETERMINED_SIGMA,
 };
-use mwd_core::attitude::level;
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{wrap_pi, DrillingAngles, Euler, DEG};
 use std::fmt::Write as _;
 use std::ops::Range;
 
-/// Samples per block when looking for static segments (1 s at 20 Hz).
-const BLOCK: usize = 20;
-/// Blocks whose mean roll moves more than this from the previous block's
-/// belong to a toolface change (rad).
-const TOOLFACE_CHANGE: f64 = 2.0 * DEG;
-/// Shortest static segment worth keeping (blocks).
-const MIN_SEGMENT_BLOCKS: usize = 3;
+mod segmentation;
+pub use segmentation::{segment_run, LeftOutReason, Segmentation, BLOCK, MIN_SEGMENT_BLOCKS};
 
 /// Applies the probe's calibration to one record as the probe does
 /// ([`ProbeCalibration::correct`]): the file's one accelerometer triad
@@ -43,39 +38,10 @@ pub fn segment(records: &[Record]) -> StaticSegment {
     sums.segment()
 }
 
-/// Finds the static segments of a run: 1 s blocks, split where the mean
-/// roll moves (toolface indexing), trimmed by a block at each end so the
-/// turns are left out. At most [`MAX_SEGMENTS`].
+/// The static segments of a run (see [`segment_run`]), at most
+/// [`mwd_core::alignment::MAX_SEGMENTS`].
 pub fn find_segments(records: &[Record]) -> Vec<Range<usize>> {
-    let blocks: Vec<Range<usize>> = (0..records.len() / BLOCK)
-        .map(|b| b * BLOCK..(b + 1) * BLOCK)
-        .collect();
-    let roll =
-        |range: &Range<usize>| level(&segment(&records[range.clone()]).mean.specific_force).roll;
-    let mut runs: Vec<Range<usize>> = Vec::new();
-    let mut start = 0;
-    for b in 1..=blocks.len() {
-        let split = b == blocks.len()
-            || wrap_pi(roll(&blocks[b]) - roll(&blocks[b - 1])).abs() > TOOLFACE_CHANGE;
-        if split {
-            runs.push(start..b);
-            start = b;
-        }
-    }
-    let single = runs.len() == 1;
-    runs.into_iter()
-        .filter_map(|run| {
-            // A whole-file static run keeps every block; runs next to a turn
-            // lose the block at each end.
-            let (first, last) = if single {
-                (run.start, run.end)
-            } else {
-                (run.start + 1, run.end.saturating_sub(1))
-            };
-            (last >= first + MIN_SEGMENT_BLOCKS).then(|| first * BLOCK..last * BLOCK)
-        })
-        .take(MAX_SEGMENTS)
-        .collect()
+    segment_run(records).spans
 }
 
 /// The result of a coarse alignment, per segment and overall.
@@ -89,6 +55,22 @@ pub struct CoarseReport {
     pub analytical: Option<HeadingEstimate>,
     /// Truth at the end of each segment, when the file has it.
     pub truth: Vec<Option<Euler>>,
+    /// Samples of the run not used, with the reason (empty when the
+    /// segments were given, not found).
+    pub left_out: Vec<(Range<usize>, LeftOutReason)>,
+    /// Samples in the run.
+    pub total_samples: usize,
+    /// Whether a heading prior chose between mirror candidates.
+    pub prior_given: bool,
+}
+
+/// Coarse alignment of a whole run: its static segments found on the
+/// physics ([`segment_run`]), every sample left out reported.
+pub fn align_run(records: &[Record], config: &AlignmentConfig) -> Result<CoarseReport> {
+    let segmentation = segment_run(records);
+    let mut report = align(records, &segmentation.spans, config)?;
+    report.left_out = segmentation.left_out;
+    Ok(report)
 }
 
 /// Coarse alignment of calibrated records over the given segments.
@@ -134,6 +116,9 @@ pub fn align(
         heading,
         analytical,
         truth,
+        left_out: Vec::new(),
+        total_samples: records.len(),
+        prior_given: config.heading_prior.is_some(),
     })
 }
 
@@ -186,10 +171,11 @@ impl CoarseReport {
                     deg(k * lev.pitch.sigma)
                 ),
                 deg(d.inclination),
-                deg(d.toolface),
+                deg_0_360(d.toolface),
                 truth
             );
         }
+        let _ = write!(s, "{}", self.render_left_out());
         let _ = writeln!(s);
         let _ = writeln!(
             s,
@@ -202,7 +188,8 @@ impl CoarseReport {
             describe_heading(
                 &self.heading,
                 self.levels.len(),
-                self.truth.last().copied().flatten()
+                self.truth.last().copied().flatten(),
+                self.prior_given
             )
         );
         if let Some(a) = &self.analytical {
@@ -213,7 +200,38 @@ impl CoarseReport {
             let _ = write!(
                 s,
                 "{}",
-                describe_heading(a, 1, self.truth.first().copied().flatten())
+                describe_heading(
+                    a,
+                    1,
+                    self.truth.first().copied().flatten(),
+                    self.prior_given
+                )
+            );
+        }
+        s
+    }
+}
+
+impl CoarseReport {
+    /// How many samples the segments use, and every sample left out with
+    /// its reason (nothing is dropped silently).
+    fn render_left_out(&self) -> String {
+        let mut s = String::new();
+        let used: usize = self.spans.iter().map(|r| r.len()).sum();
+        let _ = writeln!(
+            s,
+            "Used {used} of {} samples in {} static segment(s).",
+            self.total_samples,
+            self.spans.len()
+        );
+        for (range, reason) in &self.left_out {
+            let _ = writeln!(
+                s,
+                "  left out samples {}..{} ({} samples): {}",
+                range.start,
+                range.end,
+                range.len(),
+                reason.text()
             );
         }
         s
@@ -223,39 +241,55 @@ impl CoarseReport {
 /// Heading, azimuth, bound, flags and error against truth, as text.
 /// `segments`: how many static segments the estimate used; gyro biases are
 /// only separable from earth rate (and printed) with more than one.
-pub fn describe_heading(h: &HeadingEstimate, segments: usize, truth: Option<Euler>) -> String {
+/// `prior_given`: whether a heading prior chose between mirror candidates
+/// (then the text does not ask for one). An undetermined azimuth is never
+/// shown as a number ([`crate::display`]), nor is its mirror candidate.
+pub fn describe_heading(
+    h: &HeadingEstimate,
+    segments: usize,
+    truth: Option<Euler>,
+    prior_given: bool,
+) -> String {
     let mut s = String::new();
-    let azimuth = DrillingAngles::from_euler(&Euler::new(0.0, 0.0, h.heading.value)).azimuth;
-    if !h.heading.sigma.is_finite() {
-        let _ = writeln!(s, "  no solution: the gyro means are inconsistent with the earth rate (noise or bias dominates)");
-    } else if h.determined {
+    let sigma = h.heading.sigma;
+    let determined = h.determined && azimuth_is_determined(sigma);
+    if sigma.is_nan() || (!sigma.is_finite() && !h.heading.value.is_finite()) {
+        let _ = writeln!(s, "  azimuth n/a: no solution (the gyro means are inconsistent with the earth rate; noise or bias dominates)");
+    } else if determined {
         let _ = writeln!(
             s,
-            "  azimuth {:9.3} +-{:.3} (sigma {:.3})",
-            deg(azimuth),
-            deg(h.bound()),
-            deg(h.heading.sigma)
+            "  azimuth {}, bound +-{:.3} (2 sigma)",
+            azimuth_text(h.heading.value, sigma, 3),
+            deg(h.bound())
         );
     } else {
         let _ = writeln!(
             s,
-            "  azimuth {:9.3}, undetermined: sigma {:.1} exceeds {:.0} (bound +-180)",
-            deg(azimuth),
-            deg(h.heading.sigma),
-            deg(mwd_core::alignment::MAX_DETERMINED_SIGMA)
+            "  azimuth undetermined: sigma {} exceeds {:.0} deg (bound +-180)",
+            // Beyond a half turn a sigma says only "any heading".
+            if sigma <= std::f64::consts::PI {
+                format!("{:.1} deg", deg(sigma))
+            } else {
+                "over 180 deg".to_string()
+            },
+            deg(MAX_DETERMINED_SIGMA)
         );
     }
-    if let Some(alt) = h.alternative {
-        let alt_az = DrillingAngles::from_euler(&Euler::new(0.0, 0.0, alt)).azimuth;
+    if let (Some(alt), true) = (h.alternative, determined) {
+        let choice = if prior_given {
+            "north/south mirror; the prior chose the azimuth above"
+        } else {
+            "north/south mirror; give --prior-heading to choose"
+        };
         let _ = writeln!(
             s,
-            "  {} candidate {:.3} (north/south ambiguity; give --prior-heading to choose)",
+            "  {} candidate {:.3} ({choice})",
             if h.ambiguous {
                 "ambiguous: equally likely"
             } else {
                 "other"
             },
-            deg(alt_az),
+            deg_0_360(alt),
         );
     }
     if h.ill_conditioned {
@@ -270,18 +304,25 @@ pub fn describe_heading(h: &HeadingEstimate, segments: usize, truth: Option<Eule
         );
     }
     if let Some(t) = truth {
-        let err = wrap_pi(h.heading.value - t.heading);
-        let _ = writeln!(
-            s,
-            "  truth {:.3}, error {:+.3}{}",
-            deg(DrillingAngles::from_euler(&t).azimuth),
-            deg(err),
-            if err.abs() <= h.bound() {
-                " (within bound)"
-            } else {
-                " (OUTSIDE bound)"
-            }
-        );
+        let truth_az = deg_0_360(t.heading);
+        if determined {
+            let err = wrap_pi(h.heading.value - t.heading);
+            let _ = writeln!(
+                s,
+                "  truth {truth_az:.3}, error {:+.3}{}",
+                deg(err),
+                if err.abs() <= h.bound() {
+                    " (within bound)"
+                } else {
+                    " (OUTSIDE bound)"
+                }
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "  truth {truth_az:.3} (no error: the azimuth is undetermined)"
+            );
+        }
     }
     s
 }
@@ -319,6 +360,86 @@ mod tests {
         // Each segment lies inside a dwell (0-20 s, 26-46 s).
         assert!(recs[spans[0].end - 1].time <= 20.0);
         assert!(recs[spans[1].start].time >= 26.0);
+    }
+
+    fn estimate(value_deg: f64, sigma_deg: f64, determined: bool) -> HeadingEstimate {
+        HeadingEstimate {
+            heading: mwd_core::alignment::Uncertain {
+                value: value_deg * DEG,
+                sigma: sigma_deg * DEG,
+            },
+            alternative: Some((180.0 - value_deg) * DEG),
+            ambiguous: true,
+            ill_conditioned: false,
+            determined,
+            gyro_bias: Default::default(),
+        }
+    }
+
+    /// "azimuth 147.106 +- 163.653" must read
+    /// undetermined, with neither the estimate, its mirror nor an error
+    /// shown as a number.
+    #[test]
+    fn an_undetermined_azimuth_is_not_shown_as_a_number() {
+        let truth = Some(Euler::new(0.0, 0.0, 30.0 * DEG));
+        let text = describe_heading(&estimate(147.106, 163.653, false), 1, truth, true);
+        assert!(text.contains("azimuth undetermined"), "{text}");
+        for number in ["147.1", "32.8", "117.1", "error +", "error -"] {
+            assert!(!text.contains(number), "{number} in {text}");
+        }
+        let text = describe_heading(&estimate(147.106, 3.0, true), 1, truth, true);
+        assert!(text.contains("147.106 +- 3.000 deg (1 sigma)"), "{text}");
+    }
+
+    /// With a prior given, the text does not ask for one.
+    #[test]
+    fn a_given_prior_is_not_asked_for() {
+        let h = estimate(10.0, 3.0, true);
+        let with = describe_heading(&h, 1, None, true);
+        assert!(!with.contains("give --prior-heading"), "{with}");
+        assert!(with.contains("the prior chose"), "{with}");
+        let without = describe_heading(&h, 1, None, false);
+        assert!(
+            without.contains("give --prior-heading to choose"),
+            "{without}"
+        );
+    }
+
+    /// The report says how many samples were used and
+    /// names every range left out with its reason.
+    #[test]
+    fn samples_left_out_are_reported() {
+        let traj = Trajectory {
+            position: Position::paper_site(),
+            start: Euler::new(0.3, -0.1, 0.2),
+            motion: Motion::ToolfaceSteps {
+                step: std::f64::consts::PI,
+                turn_rate: 30.0 * DEG,
+                dwell: 20.0,
+                steps: 1,
+            },
+        };
+        let mut recs = records(
+            traj.clone(),
+            SensorModel::scc1300(3),
+            traj.scripted_duration(),
+        );
+        recs.truncate(recs.len() - 7);
+        let config = AlignmentConfig::probe(traj.position.lat);
+        let report = align_run(&recs, &config).expect("aligns");
+        let text = report.render();
+        let used: usize = report.spans.iter().map(|r| r.len()).sum();
+        let left: usize = report.left_out.iter().map(|(r, _)| r.len()).sum();
+        assert_eq!(used + left, recs.len(), "{text}");
+        assert!(
+            text.contains(&format!("Used {used} of {} samples", recs.len())),
+            "{text}"
+        );
+        assert!(
+            text.contains("left out samples") && text.contains("moving"),
+            "{text}"
+        );
+        assert!(text.contains("fewer than a 1 s block"), "{text}");
     }
 
     #[test]

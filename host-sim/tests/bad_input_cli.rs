@@ -1,4 +1,4 @@
-//! Bad input through the binary (issue 11 items 10, 11, 12 (align), 14):
+//! Bad input through the binary:
 //! every case fails with a short sentence naming what is wrong, never
 //! with a panic (exit 101) or a silent success, and text tables with a
 //! byte-order mark or a quoted header read as the plain ones do.

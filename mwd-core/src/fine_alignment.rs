@@ -483,7 +483,7 @@ mod tests {
     use nalgebra::UnitQuaternion;
 
     /// A negative or NaN attitude variance gives NaN Euler sigmas, never
-    /// the 0 the old `max(0.0)` made of it (issue 11, item 1).
+    /// the 0 the old `max(0.0)` made of it.
     #[test]
     fn an_invalid_attitude_variance_gives_nan_euler_sigmas() {
         let site = Position::paper_site();

@@ -331,7 +331,7 @@ fn chi_square_gate_rejects_outliers_and_passes_ordinary_data() {
 
 /// An invalid variance is never reported as a number: the old
 /// `std_dev` turned a negative or NaN variance into 0, the most confident
-/// sigma there is (issue 11, item 1).
+/// sigma there is.
 #[test]
 fn an_invalid_variance_gives_a_nan_sigma_and_fails_the_health_check() {
     let mut kf = KalmanFilter::<f32, 3>::from_diagonal(&SVector::from([4.0, 1.0, 9.0]));

@@ -213,7 +213,16 @@ fn toolface_indexed_heading_bounds_cover_the_errors() {
         .unwrap_or(f64::INFINITY);
     println!("indexed: heading covered {heading:.3}, determined {determined:.3}, median bound {median:.1} deg");
     assert!(heading >= 0.9, "heading coverage {heading}");
-    assert!(determined >= 0.5, "heading determined in only {determined}");
+    // Headings up to 45 deg from north or south at inclinations 70-110 deg:
+    // the sigma covers the expected sigma of every heading the data allow
+    // at 3 sigma, which reach towards east/west (the
+    // bounds of runs that looked sharp by luck missed the truth), so about
+    // a fifth stay determined (18 %; 70 % before, not all of them
+    // honestly: see tests/tests/alignment_classes.rs).
+    assert!(
+        determined >= 0.15,
+        "heading determined in only {determined}"
+    );
     assert!(median < 40.0, "median bound {median} deg");
     assert!(trials
         .iter()

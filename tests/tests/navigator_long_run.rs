@@ -161,7 +161,7 @@ fn a_day_of_navigation_never_reports_a_sigma_the_error_exceeds() {
     );
 }
 
-/// Issue 11, item 3, on the QEMU probe's sensors (earth rate, biases,
+/// On the QEMU probe's sensors (earth rate, biases,
 /// noise): part 1 (the body-x gyro's part) dead from boot. The probe
 /// levels on part 2's triad, aligns and navigates, flags every frame
 /// SINGLE_PART, keeps roll and pitch within 3 sigma of the truth and never

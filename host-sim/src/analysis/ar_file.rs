@@ -646,7 +646,7 @@ mod tests {
         assert!(err(&f, true).contains("needs an angular rate"));
     }
 
-    /// The audit's bad files (issue 11 item 10).
+    /// The audit's bad files.
     #[test]
     fn models_outside_the_physical_ranges_are_refused() {
         let refused = |edit: &dyn Fn(&mut ArModelEntry), needle: &str| {

@@ -292,7 +292,7 @@ mod tests {
         }
     }
 
-    /// The audit's bad files (issue 11 item 10): each refused with the
+    /// The audit's bad files: each refused with the
     /// field and its range named.
     #[test]
     fn files_outside_the_physical_ranges_are_refused() {

@@ -76,8 +76,7 @@ pub fn run(args: Args) -> Result<()> {
         ..AlignmentConfig::probe(args.site.position().lat)
     }
     .with_heading_prior(args.prior_heading.map(|h| h * DEG));
-    let spans = coarse::find_segments(&records);
-    let report = coarse::align(&records, &spans, &config)?;
+    let report = coarse::align_run(&records, &config)?;
     out!("{}", report.render());
     Ok(())
 }

@@ -24,11 +24,13 @@ pub struct Args {
     /// CSV with a header: a `position` column (1 = +x up, 2 = x down,
     /// 3 = +y up, 4 = y down, 5 = +z up, 6 = z down) and the sensor columns.
     pub file: PathBuf,
-    /// An accelerometer triad: its x,y,z column names (repeat for more triads).
-    #[arg(long, default_values = ["ax,ay,az"])]
+    /// An accelerometer triad: its x,y,z column names (repeat for more
+    /// triads); default: the simulator's.
+    #[arg(long, default_values = ["accel_x_m_s2,accel_y_m_s2,accel_z_m_s2"])]
     pub accel: Vec<String>,
-    /// A gyro: column:axis, e.g. gx:x (repeat for more gyros).
-    #[arg(long, default_values = ["gx:x", "gz:z"])]
+    /// A gyro: column:axis, e.g. gx:x (repeat for more gyros); default: the
+    /// simulator's.
+    #[arg(long, default_values = ["gyro_x_rad_s:x", "gyro_z_rad_s:z"])]
     pub gyro: Vec<String>,
     /// Unit of the accelerometer columns (m/s2, g, mg).
     #[arg(long, default_value = "m/s2")]

@@ -1,4 +1,4 @@
-//! `host-sim demo`: the main job on built-in defaults. Simulates the paper's
+//! `host-sim demo`: the coarse alignment on built-in defaults. Simulates the paper's
 //! 60 s static test (section 4) with the SCC1300 error model, coarse-aligns
 //! on the first 5 s as the paper did and on the whole minute, then shows
 //! what toolface indexing buys; each result next to the truth.
@@ -30,8 +30,7 @@ fn run_case(title: &str, records: &[Record], config: &AlignmentConfig) -> Result
         .iter()
         .map(|r| coarse::calibrated(r, &cal))
         .collect();
-    let spans = coarse::find_segments(&records);
-    let report = coarse::align(&records, &spans, config)?;
+    let report = coarse::align_run(&records, config)?;
     outln!("== {title}");
     out!("{}", report.render());
     outln!();
@@ -77,7 +76,7 @@ fn print_setup(traj: &Trajectory) {
         traj.position.height,
         traj.start.roll / DEG,
         traj.start.pitch / DEG,
-        traj.start.heading / DEG
+        host_sim::display::deg_0_360(traj.start.heading)
     );
     outln!("Prior heading for the north/south ambiguity: truth + 30 deg.\n");
 }

@@ -37,8 +37,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// The main job on built-in defaults: simulate the paper's 60 s static
-    /// test and print the coarse alignment next to the truth.
+    /// Simulate the paper's 60 s static test (and 2 x 10 min of toolface
+    /// indexing) and print the coarse alignment next to the truth.
     Demo(demo::Args),
     /// Simulate a trajectory and the probe's sensors; write the samples.
     Simulate(simulate::Args),

@@ -6,6 +6,7 @@
 use anyhow::{Context, Result};
 use host_sim::analysis::ar_file::{ArModelFile, AxisSource};
 use host_sim::analysis::plot::{line_svg, Curve, Labels};
+use host_sim::display::{azimuth_text, deg_0_360};
 use host_sim::paper_mgwd::{
     consistency, ranks, static_test, truth, Consistency, History, Ranks, Settings, StaticTest,
     PUBLISHED,
@@ -24,9 +25,10 @@ pub struct MgwdArgs {
     /// Seeded runs behind the 3-sigma consistency check.
     #[arg(long, default_value_t = 100)]
     pub runs: usize,
-    /// Directory for the SVG plots of Figures 13-15.
-    #[arg(long, default_value = "mgwd-plots")]
-    pub plots: PathBuf,
+    /// Write the SVG plots of Figures 13-15 into this directory (none
+    /// unless asked).
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
     /// AR(4) noise models fitted at 20 Hz by `host-sim arfit` (its
     /// `.ar.json`): they replace the paper's Tables 4-5 in every filter
     /// setting and in the consistency runs. Sensors map by name onto the
@@ -58,11 +60,13 @@ pub fn run(args: MgwdArgs) -> Result<()> {
     let lines = consistency(args.runs, &model)?;
     print_consistency(args.runs, &lines, loaded.is_some());
     outln!("{WHY}");
-    write_figures(&args.plots, &test.runs)?;
-    outln!(
-        "Plots of Figures 13-15 for each setting in {}",
-        args.plots.display()
-    );
+    if let Some(dir) = &args.plots {
+        write_figures(dir, &test.runs)?;
+        outln!(
+            "Plots of Figures 13-15 for each setting in {}",
+            dir.display()
+        );
+    }
     Ok(())
 }
 
@@ -109,16 +113,17 @@ fn print_static_test(
         "Truth roll {:.4} pitch {:.4} azimuth {:.4} deg (the paper's coarse result, used as our truth).",
         t.roll / DEG,
         t.pitch / DEG,
-        t.heading / DEG
+        deg_0_360(t.heading)
     );
+    // An undetermined azimuth (5 s: gyro bias ~ earth rate) reads as such,
+    // never as a number.
     outln!(
-        "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4}, azimuth {:.3} +- {:.3} deg (1 sigma)\n",
+        "Coarse alignment, first 5 s: roll {:.4} +- {:.4}, pitch {:.4} +- {:.4} deg (1 sigma), azimuth {}\n",
         coarse.roll / DEG,
         sigma[0] / DEG,
         coarse.pitch / DEG,
         sigma[1] / DEG,
-        coarse.heading / DEG,
-        sigma[2] / DEG
+        azimuth_text(coarse.heading, sigma[2], 3)
     );
     outln!("{}", model_source(model, loaded));
     print_final_table(&test.runs);

@@ -284,7 +284,7 @@ mod tests {
         assert!(file.to_model(1).is_err());
     }
 
-    /// The audit's bad files (issue 11 item 10): refused, field and range named.
+    /// The audit's bad files: refused, field and range named.
     #[test]
     fn figures_outside_the_physical_ranges_are_refused() {
         let refused = |edit: &dyn Fn(&mut SensorModelFile), needle: &str| {

@@ -167,6 +167,33 @@ fn east_west_flag_comes_from_the_geometry_not_the_prior() {
     assert!(est.ill_conditioned, "prior east did not flag: {est:?}");
 }
 
+/// A level tool heading 89 deg (noise-free) has its
+/// mirror candidate at 91 deg, closer than the 5 deg search grid: both
+/// minima must be found, the heading reported ambiguous, and the prior
+/// must choose (before, the two were merged and 91.000 came back as the
+/// only answer). Also 1 deg from west, and at 0.5 deg from east.
+#[test]
+fn mirror_candidates_closer_than_the_grid_step_are_both_found() {
+    for (heading, mirror) in [(89.0, 91.0), (-88.0, -92.0), (90.5, 89.5)] {
+        let seg = ideal_segment(&Euler::new(0.0, 0.0, heading * DEG), Vector3::zeros());
+        for (prior, expected, other) in [(heading, heading, mirror), (mirror, mirror, heading)] {
+            let est = gyrocompass(&[seg], &config(ImuNoise::NONE, Some(prior * DEG))).unwrap();
+            assert!(est.ambiguous, "heading {heading}, prior {prior}: {est:?}");
+            assert!(
+                wrap_pi(est.heading.value - expected * DEG).abs() < 1e-3 * DEG,
+                "heading {heading}, prior {prior}: {} deg",
+                est.heading.value / DEG
+            );
+            let alt = est.alternative.expect("the mirror candidate");
+            assert!(
+                wrap_pi(alt - other * DEG).abs() < 1e-3 * DEG,
+                "heading {heading}: alternative {} deg",
+                alt / DEG
+            );
+        }
+    }
+}
+
 #[test]
 fn level_tool_heading_north_is_ambiguous_until_a_prior_chooses() {
     let truth = Euler::new(0.0, 0.0, 10.0 * DEG);

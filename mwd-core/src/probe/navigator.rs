@@ -560,7 +560,7 @@ mod tests {
         navigator
     }
 
-    /// Issue 11, item 2: a probe turning at 3 deg/s with 1 s of invalid
+    /// A probe turning at 3 deg/s with 1 s of invalid
     /// samples ended with a permanent 3 deg heading offset and unchanged
     /// sigmas (the gap was not propagated).
     #[test]
@@ -629,7 +629,7 @@ mod tests {
         assert_eq!(s.flags, nav_flags::ZUPT_APPLIED, "{s:?}");
     }
 
-    /// Issue 11, item 3: with part 1 dead from boot the probe stayed in
+    /// With part 1 dead from boot the probe stayed in
     /// its coarse alignment for ever. Now part 2's triad levels the probe
     /// and its gyro carries what it can; the azimuth is not determined.
     #[test]
