@@ -42,3 +42,7 @@ cargo test --release -p system-tests --test navigator_long_run -- --ignored
 # Coarse alignment: determined headings covered by their bound in every
 # attitude class (19,200 seeded runs; release).
 cargo test --release -p system-tests --test alignment_classes -- --ignored
+# The bad-input matrix: host-sim over 138 bad files and arguments (and good
+# controls); fails on any panic, silent acceptance or flood of stderr.
+cargo build -p host-sim
+bash scripts/bad-input-matrix.sh target/debug/host-sim
