@@ -118,7 +118,9 @@ fn cli_writes_a_loadable_calibration() {
     let dir = std::env::temp_dir().join(format!("calib-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("tumble.csv");
-    let mut text = String::from("position,ax,ay,az,gx,gz\n");
+    // The simulator's column names: calibrate's defaults.
+    let mut text =
+        String::from("position,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_z_rad_s\n");
     for r in simulate(5, 400) {
         text += &format!("{},{},{},{},{},{}\n", r[0], r[1], r[2], r[3], r[4], r[5]);
     }
@@ -142,7 +144,8 @@ fn cli_writes_a_loadable_calibration() {
     assert!((probe.accel[0].bias[1] - BIAS[1]).abs() < 0.01);
     assert!((probe.gyro[1].bias - GYRO_BIAS[1]).abs() < 1e-4);
     // A bad number is reported with its line, not a panic.
-    std::fs::write(&csv, "position,ax,ay,az,gx,gz\n1,0,0,oops,0,0\n").unwrap();
+    let header = "position,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,gyro_x_rad_s,gyro_z_rad_s";
+    std::fs::write(&csv, format!("{header}\n1,0,0,oops,0,0\n")).unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
         .args(["calibrate", csv.to_str().unwrap()])
         .output()
