@@ -170,6 +170,25 @@ pub struct Capture {
     pub stats: DecoderStats,
 }
 
+/// A capture's bytes with frame `index` (counting every frame in the
+/// order sent, the boot event first) left out: a loss on the line, for
+/// tests and studies of the host's loss handling.
+pub fn without_frame(bytes: &[u8], index: usize) -> Vec<u8> {
+    let mut out = Vec::new();
+    for (i, chunk) in bytes
+        .split(|b| *b == 0)
+        .filter(|c| !c.is_empty())
+        .enumerate()
+    {
+        if i != index {
+            out.push(0);
+            out.extend_from_slice(chunk);
+            out.push(0);
+        }
+    }
+    out
+}
+
 /// Decodes a whole capture held in memory.
 pub fn decode_bytes(bytes: &[u8]) -> Capture {
     let mut decoder = Decoder::new();

@@ -79,23 +79,6 @@ fn files_that_are_not_probe_captures_are_refused() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The capture's bytes with frame `index` (the boot event is 0) left out.
-fn without_frame(bytes: &[u8], index: usize) -> Vec<u8> {
-    let mut out = Vec::new();
-    for (i, chunk) in bytes
-        .split(|b| *b == 0)
-        .filter(|c| !c.is_empty())
-        .enumerate()
-    {
-        if i != index {
-            out.push(0);
-            out.extend_from_slice(chunk);
-            out.push(0);
-        }
-    }
-    out
-}
-
 #[test]
 fn replay_exit_statuses_tell_parity_restart_loss_and_post_processing_apart() {
     let dir = temp_dir("replay-status");
@@ -123,7 +106,7 @@ fn replay_exit_statuses_tell_parity_restart_loss_and_post_processing_apart() {
     );
     // The raw frame of sample 69 lost: compared up to sample 68, the rest
     // said, status 4.
-    let lost = path("lost.bin", &without_frame(&bytes, 139));
+    let lost = path("lost.bin", &capture::without_frame(&bytes, 139));
     let csv = dir.join("lost.csv");
     let out = host_sim(&["replay", &lost, "--csv", csv.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(4), "{}", text(&out));

@@ -58,30 +58,12 @@ fn the_committed_capture_replays_to_the_probes_solutions_bit_for_bit() {
     }
 }
 
-/// The committed capture's bytes with frame `index` (counting every frame,
-/// the boot event first) left out.
-fn without_frame(bytes: &[u8], index: usize) -> Vec<u8> {
-    let mut out = Vec::new();
-    for (i, chunk) in bytes
-        .split(|b| *b == 0)
-        .filter(|c| !c.is_empty())
-        .enumerate()
-    {
-        if i != index {
-            out.push(0);
-            out.extend_from_slice(chunk);
-            out.push(0);
-        }
-    }
-    out
-}
-
 #[test]
 fn a_lost_raw_frame_stops_the_comparison_and_a_restart_resumes_it() {
     let bytes = std::fs::read(workspace_root().join("tests/data/qemu-static-6s.bin")).unwrap();
     // Frame 139 is the raw frame of sample 69 (boot event, then raw and
     // navigation frame per sample); then the probe reboots and runs again.
-    let mut damaged = without_frame(&bytes, 139);
+    let mut damaged = capture::without_frame(&bytes, 139);
     damaged.extend_from_slice(&bytes);
     let cap = capture::decode_bytes(&damaged);
     assert_eq!(
