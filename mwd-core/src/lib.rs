@@ -11,6 +11,8 @@
 //!   [`error_model`] (the 33/39-state model), [`aid_sources`] (one file per
 //!   measurement), [`fine_alignment`] (the closed loop).
 //! * The probe's navigation, raw sample to solution: [`probe`].
+//! * Wellbore surveys (stations, north references, minimum curvature
+//!   positions from a tie-on): [`survey`].
 //! * The wire protocol: [`protocol`].
 #![no_std]
 #![forbid(unsafe_code)]
@@ -31,4 +33,5 @@ pub mod probe_sample;
 pub mod protocol;
 pub mod sensor_noise;
 pub mod sensor_units;
+pub mod survey;
 pub mod timing;
