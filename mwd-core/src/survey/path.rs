@@ -144,6 +144,42 @@ pub fn positions<'a, N: NorthReference>(
     }
 }
 
+/// The station and position at measured depth `md` on the minimum
+/// curvature path of `stations` from `tie_on` (see [`Segment::at`]); the
+/// stations' own depths give the stations. An error from the stations up to
+/// `md`, or [`SurveyError::InterpolationDepth`] when `md` is outside them.
+pub fn interpolate<N: NorthReference>(
+    tie_on: &TieOn<N>,
+    stations: &[Station<N>],
+    md: f64,
+) -> Result<SurveyPoint<N>, SurveyError> {
+    let mut previous: Option<SurveyPoint<N>> = None;
+    for point in positions(tie_on, stations) {
+        let point = point?;
+        if point.station.md() >= md {
+            let Some(before) = previous else {
+                return if point.station.md() == md {
+                    Ok(point)
+                } else {
+                    Err(SurveyError::InterpolationDepth)
+                };
+            };
+            if point.station.md() == md {
+                return Ok(point);
+            }
+            let segment = Segment::new(before.station, point.station)?;
+            let (station, chord) = segment.at(md)?;
+            return Ok(SurveyPoint {
+                station,
+                nev: before.nev + chord,
+                dls_deg_per_30m: point.dls_deg_per_30m,
+            });
+        }
+        previous = Some(point);
+    }
+    Err(SurveyError::InterpolationDepth)
+}
+
 /// The iterator of [`positions`].
 #[derive(Clone, Debug)]
 pub struct Positions<'a, N: NorthReference> {

@@ -225,3 +225,34 @@ fn grid_and_true_north_agree() {
         assert!((g.to_true(c).azimuth() - s.azimuth()).abs() < 1e-12);
     }
 }
+
+#[test]
+fn interpolation_along_a_survey() {
+    let tie = TieOn::new(100.0, 99.0, 1.0, 2.0, Matrix3::zeros()).unwrap();
+    let stations = [
+        st(100.0, 5.0, 10.0),
+        st(130.0, 9.0, 20.0),
+        st(160.0, 14.0, 25.0),
+    ];
+    let points: std::vec::Vec<_> = positions(&tie, &stations).map(Result::unwrap).collect();
+    for p in &points {
+        assert_eq!(interpolate(&tie, &stations, p.station.md()).unwrap(), *p);
+    }
+    let mid = interpolate(&tie, &stations, 145.0).unwrap();
+    let segment = Segment::new(stations[1], stations[2]).unwrap();
+    let (station, chord) = segment.at(145.0).unwrap();
+    assert_eq!(mid.station, station);
+    assert_eq!(mid.nev, points[1].nev + chord);
+    assert_eq!(
+        interpolate(&tie, &stations, 99.9),
+        Err(SurveyError::InterpolationDepth)
+    );
+    assert_eq!(
+        interpolate(&tie, &stations, 160.1),
+        Err(SurveyError::InterpolationDepth)
+    );
+    assert_eq!(
+        interpolate(&tie, &stations, f64::NAN),
+        Err(SurveyError::InterpolationDepth)
+    );
+}
