@@ -31,15 +31,26 @@ pub fn tangent(inclination: f64, azimuth: f64) -> Vector3<f64> {
 }
 
 /// The dogleg (rad) between two directions, by the haversine form
-/// beta = 2 asin(sqrt(sin^2(dI/2) + sin I1 sin I2 sin^2(dA/2))), which keeps
-/// full relative precision at small angles where the usual cosine form
-/// acos(cos dI - sin I1 sin I2 (1 - cos dA)) loses half the digits.
+/// beta = 2 asin(sqrt(h)), h = sin^2(dI/2) + sin I1 sin I2 sin^2(dA/2),
+/// which keeps full relative precision at small angles where the usual
+/// cosine form acos(cos dI - sin I1 sin I2 (1 - cos dA)) loses half the
+/// digits. Near 180 deg asin loses them instead, so the angle is taken as
+/// beta = 2 atan2(sqrt(h), sqrt(1 - h)) with 1 - h from its own sum of
+/// non-negative terms, cos^2((I1 + I2)/2) + sin I1 sin I2 cos^2(dA/2): no
+/// cancellation at either end.
 pub fn dogleg(inc1: f64, azi1: f64, inc2: f64, azi2: f64) -> f64 {
-    let h_inc = libm::sin(0.5 * (inc2 - inc1));
-    let h_azi = libm::sin(0.5 * (azi2 - azi1));
-    let h = h_inc * h_inc + libm::sin(inc1) * libm::sin(inc2) * h_azi * h_azi;
-    // Rounding can push h a hair past 1 at a dogleg of 180 deg.
-    2.0 * libm::asin(libm::sqrt(h.clamp(0.0, 1.0)))
+    let sines = libm::sin(inc1) * libm::sin(inc2);
+    let (s_inc, c_mean) = (
+        libm::sin(0.5 * (inc2 - inc1)),
+        libm::cos(0.5 * (inc1 + inc2)),
+    );
+    let (s_azi, c_azi) = (
+        libm::sin(0.5 * (azi2 - azi1)),
+        libm::cos(0.5 * (azi2 - azi1)),
+    );
+    let h = s_inc * s_inc + sines * s_azi * s_azi;
+    let complement = c_mean * c_mean + sines * c_azi * c_azi;
+    2.0 * libm::atan2(libm::sqrt(h.max(0.0)), libm::sqrt(complement.max(0.0)))
 }
 
 /// The ratio factor RF = 2/beta * tan(beta/2) of a dogleg beta (rad) in

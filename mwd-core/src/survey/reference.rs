@@ -5,9 +5,17 @@ use super::SurveyError;
 use crate::conventions::wrap_two_pi;
 use core::f64::consts::FRAC_PI_2;
 
-/// Marker of an azimuth reference (implemented by [`TrueNorth`] and
-/// [`GridNorth`] only in this crate's use).
-pub trait NorthReference: Clone + Copy + core::fmt::Debug + PartialEq + Default {}
+/// Marker of an azimuth reference: [`TrueNorth`] or [`GridNorth`] (sealed).
+pub trait NorthReference:
+    sealed::Sealed + Clone + Copy + core::fmt::Debug + PartialEq + Default
+{
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::TrueNorth {}
+    impl Sealed for super::GridNorth {}
+}
 
 /// Azimuths from true (geographic) north.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

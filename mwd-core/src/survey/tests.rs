@@ -256,3 +256,15 @@ fn interpolation_along_a_survey() {
         Err(SurveyError::InterpolationDepth)
     );
 }
+
+#[test]
+fn dogleg_near_180_deg_keeps_its_digits() {
+    for eps in [1e-3, 1e-5, 1e-7] {
+        // Horizontal north, then back down-south eps short of opposite.
+        let (i1, a1, i2, a2) = (FRAC_PI_2, 0.0, FRAC_PI_2 + eps, PI);
+        let (t1, t2) = (tangent(i1, a1), tangent(i2, a2));
+        let reference = t1.cross(&t2).norm().atan2(t1.dot(&t2));
+        let beta = dogleg(i1, a1, i2, a2);
+        assert!(((PI - beta) - (PI - reference)).abs() < 1e-9 * eps, "{eps}");
+    }
+}
