@@ -59,12 +59,13 @@ pub const TILT_SIGMA_LIMIT_RAD: f64 = 3.0 * DEG;
 
 /// The covariance health check's bound on every variance, in the states'
 /// own units squared (rad^2, (m/s)^2, m^2, and the sensor-error states'):
-/// 1e10 is a position sigma of 100 km, a velocity sigma of 100 km/s.
-/// The f32 covariance holds variances down to ~1e-11 (the gyro-bias
-/// states); beyond a 1e21 spread its Phi P Phi^T loses the small entries
-/// to the rounding of the large ones (f32: 24-bit mantissa, docs/filter-
-/// derivation.md section "Covariance health"), so the check stops it
-/// there rather than report what the roundings made.
+/// 1e16 is a position sigma of 1e8 m (100,000 km), far past any meaning.
+/// The f32 covariance also holds variances down to ~1e-11 (the gyro-bias
+/// states); with a spread of much more than 1e21 its Phi P Phi^T would
+/// lose the small entries to the rounding of the large ones (f32: 24-bit
+/// mantissa; docs/filter-derivation.md section 5b), so
+/// the check stops it before that rather than report what the roundings
+/// made.
 pub const VARIANCE_LIMIT: f32 = 1e16;
 
 /// The rate (rad/s) a sample the probe did not measure may be off by: a
