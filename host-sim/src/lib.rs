@@ -11,3 +11,4 @@ pub mod paper_mgwd;
 pub mod replay;
 pub mod samples_csv;
 pub mod sim;
+pub mod survey_error;

@@ -1,0 +1,457 @@
+//! ISCWSA wellbore position-uncertainty model (SPE 67616, Williamson 2000)
+//! on the host: error sources as data (a term table read from CSV), the
+//! weighting functions of the ISCWSA MWD Rev 5 model, and the propagation
+//! of each source's error vectors to the NEV covariance at every station.
+//!
+//! Conventions (as in the ISCWSA example workbooks and SPE 67616):
+//! * stations are (MD, inclination, true azimuth, TVD), MD/TVD in metres,
+//!   angles in radians; the first station is the tie-on;
+//! * the position change over the leg k-1 -> k is taken, for the
+//!   derivatives, as the balanced-tangential
+//!   `dr_k = (D_k - D_{k-1})/2 * (t_{k-1} + t_k)` with `t` the unit tangent;
+//! * a source's error at station k is `e_k = sigma * (d dr_k/dp_k +
+//!   d dr_{k+1}/dp_k) * w_k` with `w = (dD, dI, dA)/d eps` the weighting
+//!   function; at the station of interest K only the leg before it counts;
+//! * the tie-on's own inclination/azimuth error is carried by station 1
+//!   (its leg-before weight covers the whole first course length), its depth
+//!   error is not counted — this is what the published diagnostics show
+//!   (e.g. the random XYM3E of well #1 at 1200 m);
+//! * random sources: sum over stations of `e e^T`; systematic, per-well and
+//!   global sources: the outer product of the summed vector (the same
+//!   thing on a single well);
+//! * at a station closer to vertical than the model's limit, a source
+//!   whose azimuth weighting is singular uses its tabulated NEV
+//!   "singularity" vector in place of `dr/dp * w`.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::Path;
+
+/// Propagation mode of an error source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Propagation {
+    Random,
+    Systematic,
+    PerWell,
+    Global,
+}
+
+impl Propagation {
+    fn parse(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "R" => Ok(Self::Random),
+            "S" => Ok(Self::Systematic),
+            "W" => Ok(Self::PerWell),
+            "G" => Ok(Self::Global),
+            other => Err(format!("unknown propagation mode {other:?}")),
+        }
+    }
+}
+
+/// One error source (a row of the term table).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ErrorTerm {
+    pub code: String,
+    /// Weighting-function name (`Wt.Fn.` column), e.g. `DSF`, `ABXY-TI1`.
+    pub weighting: String,
+    /// Magnitude as published, in `unit`.
+    pub magnitude: f64,
+    pub unit: String,
+    /// Magnitude in the units the weighting functions use (degree terms in
+    /// radians): the table's "converted" column.
+    pub magnitude_si: f64,
+    pub propagation: Propagation,
+}
+
+/// Error loading a term table or a data file.
+#[derive(Debug)]
+pub struct DataError(pub String);
+
+impl fmt::Display for DataError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DataError {}
+
+fn col(headers: &csv::StringRecord, name: &str) -> Result<usize, DataError> {
+    headers
+        .iter()
+        .position(|h| h.trim() == name)
+        .ok_or_else(|| DataError(format!("term table: no column {name:?}")))
+}
+
+fn num(field: Option<&str>, what: &str, line: u64) -> Result<f64, DataError> {
+    let s = field.ok_or_else(|| DataError(format!("line {line}: missing {what}")))?;
+    s.trim()
+        .parse::<f64>()
+        .map_err(|e| DataError(format!("line {line}: {what} {s:?}: {e}")))
+}
+
+/// Reads an ISCWSA term table (`Model` sheet as CSV, as in
+/// `tests/data/iscwsa/mwd_rev5_04_model_terms.csv`).
+pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
+    let mut rdr =
+        csv::Reader::from_path(path).map_err(|e| DataError(format!("{}: {e}", path.display())))?;
+    let headers = rdr
+        .headers()
+        .map_err(|e| DataError(format!("{}: {e}", path.display())))?
+        .clone();
+    let c_code = col(&headers, "Code")?;
+    let c_wt = col(&headers, "Wt.Fn.")?;
+    let c_mag = col(&headers, "Magnitude")?;
+    let c_unit = col(&headers, "Units")?;
+    let c_prop = col(&headers, "Prop.")?;
+    let c_si = col(&headers, "Convert Magnitudes Degrees to Radians")?;
+    let mut terms = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| DataError(format!("{}: {e}", path.display())))?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let text = |c: usize, what: &str| {
+            rec.get(c)
+                .map(|s| s.trim().to_string())
+                .ok_or_else(|| DataError(format!("line {line}: missing {what}")))
+        };
+        let code = text(c_code, "Code")?;
+        if code.is_empty() {
+            return Err(DataError(format!("line {line}: empty Code")));
+        }
+        terms.push(ErrorTerm {
+            code,
+            weighting: text(c_wt, "Wt.Fn.")?,
+            magnitude: num(rec.get(c_mag), "Magnitude", line)?,
+            unit: text(c_unit, "Units")?,
+            magnitude_si: num(rec.get(c_si), "converted magnitude", line)?,
+            propagation: Propagation::parse(&text(c_prop, "Prop.")?)
+                .map_err(|e| DataError(format!("line {line}: {e}")))?,
+        });
+    }
+    if terms.is_empty() {
+        return Err(DataError(format!("{}: no terms", path.display())));
+    }
+    Ok(terms)
+}
+
+/// Site and model parameters the weighting functions need.
+#[derive(Clone, Copy, Debug)]
+pub struct Site {
+    /// Gravity, m/s^2.
+    pub gravity: f64,
+    /// Total field, nT.
+    pub b_total: f64,
+    /// Dip, rad.
+    pub dip: f64,
+    /// Declination, rad (magnetic azimuth = true azimuth - declination -
+    /// ... grid convergence is zero for the test wells and not modelled).
+    pub declination: f64,
+    /// Inclination below which a station counts as vertical, rad.
+    pub vertical_limit: f64,
+}
+
+/// A survey station: MD and TVD in metres, angles in radians.
+#[derive(Clone, Copy, Debug)]
+pub struct Station {
+    pub md: f64,
+    pub inc: f64,
+    pub azi: f64,
+    pub tvd: f64,
+}
+
+/// NEV covariance, m^2: `[nn, ee, vv, ne, nv, ev]`.
+pub type Cov6 = [f64; 6];
+
+fn outer(v: [f64; 3]) -> Cov6 {
+    [
+        v[0] * v[0],
+        v[1] * v[1],
+        v[2] * v[2],
+        v[0] * v[1],
+        v[0] * v[2],
+        v[1] * v[2],
+    ]
+}
+
+/// The weighting function of a source at a station: `(dD, dI, dA)` per unit
+/// of the source, and the NEV singularity vector where the azimuth weighting
+/// is singular at vertical.
+struct Weight {
+    w: [f64; 3],
+    singular: Option<[f64; 3]>,
+}
+
+/// `None`: weighting function not implemented.
+fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight> {
+    let (si, ci) = s.inc.sin_cos();
+    let am = s.azi - site.declination;
+    let (sam, cam) = am.sin_cos();
+    let (sat, cat) = s.azi.sin_cos();
+    let g = site.gravity;
+    let td = site.dip.tan();
+    let bh = site.b_total * site.dip.cos();
+    let r2 = std::f64::consts::SQRT_2;
+    let w = |d: f64, i: f64, a: f64| Weight {
+        w: [d, i, a],
+        singular: None,
+    };
+    let vertical = s.inc < site.vertical_limit;
+    Some(match name {
+        "DREF" => w(1.0, 0.0, 0.0),
+        "DSF" => w(s.md, 0.0, 0.0),
+        "DST" => w(s.md * s.tvd, 0.0, 0.0),
+        "ABXY-TI1" => w(0.0, -ci / g, td * ci * sam / g),
+        "ABXY-TI2" => Weight {
+            w: [
+                0.0,
+                0.0,
+                if vertical {
+                    0.0
+                } else {
+                    ((std::f64::consts::FRAC_PI_2 - s.inc).tan() - td * cam) / g
+                },
+            ],
+            singular: Some([-sat / g, cat / g, 0.0]),
+        },
+        "ABZ" => w(0.0, -si / g, td * si * sam / g),
+        "ASXY-TI1" => w(0.0, si * ci / r2, -td * si * ci * sam / r2),
+        "ASXY-TI2" => w(0.0, si * ci / 2.0, -td * si * ci * sam / 2.0),
+        "ASXY-TI3" => w(0.0, 0.0, (td * si * cam - ci) / 2.0),
+        "ASZ" => w(0.0, -si * ci, td * si * ci * sam),
+        "MBXY-TI1" => w(0.0, 0.0, -ci * sam / bh),
+        "MBXY-TI2" => w(0.0, 0.0, cam / bh),
+        "MBZ" => w(0.0, 0.0, -si * sam / bh),
+        "MSXY-TI1" => w(0.0, 0.0, si * sam * (td * ci + si * cam) / r2),
+        "MSXY-TI2" => w(0.0, 0.0, sam * (td * si * ci - ci * ci * cam - cam) / 2.0),
+        "MSXY-TI3" => w(
+            0.0,
+            0.0,
+            (ci * cam * cam - ci * sam * sam - td * si * cam) / 2.0,
+        ),
+        "MSZ" => w(0.0, 0.0, -(si * cam + td * ci) * si * sam),
+        "AZ" => w(0.0, 0.0, 1.0),
+        "DBH" => w(0.0, 0.0, 1.0 / bh),
+        "AMIL" => w(0.0, 0.0, si * sam / bh),
+        "SAGE" => w(0.0, si.powf(0.25), 0.0),
+        "XYM1" => w(0.0, si.abs(), 0.0),
+        "XYM2" => w(0.0, 0.0, -1.0),
+        "XYM3L" | "XYM3E" => {
+            let f = enhanced(name, course);
+            Weight {
+                w: [
+                    0.0,
+                    f * ci.abs() * cat,
+                    if vertical {
+                        0.0
+                    } else {
+                        -f * ci.abs() * sat / si
+                    },
+                ],
+                singular: Some([f, 0.0, 0.0]),
+            }
+        }
+        "XYM4L" | "XYM4E" => {
+            let f = enhanced(name, course);
+            Weight {
+                w: [
+                    0.0,
+                    f * ci.abs() * sat,
+                    if vertical {
+                        0.0
+                    } else {
+                        f * ci.abs() * cat / si
+                    },
+                ],
+                singular: Some([0.0, f, 0.0]),
+            }
+        }
+        _ => return None,
+    })
+}
+
+/// Minimum course length of the "enhanced" misalignment terms (XYM3E,
+/// XYM4E of Rev 5.10), m: below it the weight grows as sqrt(10 m / course).
+const MISALIGNMENT_MIN_COURSE: f64 = 10.0;
+
+fn enhanced(name: &str, course: f64) -> f64 {
+    if name.ends_with('E') && course > 0.0 {
+        (MISALIGNMENT_MIN_COURSE / course).sqrt().max(1.0)
+    } else {
+        1.0
+    }
+}
+
+/// Default tortuosity of the XCL terms (1 deg / 100 ft), rad/m.
+pub const XCL_TORTUOSITY: f64 = 0.000_572_615;
+
+/// Error vector of the long-course-length terms (SPE 187249), which use the
+/// tangential form: the station's angle error acts over the leg before it
+/// only, `e_k = sigma * (D_k - D_{k-1}) * dt_k/dp * w`.
+fn xcl_vector(name: &str, s: &Station, prev: &Station, sig: f64, site: &Site) -> Option<[f64; 3]> {
+    let len = s.md - prev.md;
+    let (si, ci) = s.inc.sin_cos();
+    let (sa, ca) = s.azi.sin_cos();
+    match name {
+        "XCLH" => {
+            let w = (s.inc - prev.inc).abs().max(XCL_TORTUOSITY * len);
+            Some([
+                sig * len * w * ci * ca,
+                sig * len * w * ci * sa,
+                -sig * len * w * si,
+            ])
+        }
+        "XCLA" => {
+            let mut da = (s.azi - prev.azi).rem_euclid(std::f64::consts::TAU);
+            if da > std::f64::consts::PI {
+                da = std::f64::consts::TAU - da;
+            }
+            // the azimuth of a vertical station is no measurement: no
+            // azimuth change out of it
+            if prev.inc < site.vertical_limit {
+                da = 0.0;
+            }
+            // sin(I) * max(|dA|, tau * L / sin(I)) = max(sin(I) |dA|, tau * L):
+            // finite at vertical
+            let ws = (si * da).max(XCL_TORTUOSITY * len);
+            Some([-sig * len * ws * sa, sig * len * ws * ca, 0.0])
+        }
+        _ => None,
+    }
+}
+
+fn tangent(s: &Station) -> [f64; 3] {
+    let (si, ci) = s.inc.sin_cos();
+    let (sa, ca) = s.azi.sin_cos();
+    [si * ca, si * sa, ci]
+}
+
+/// d(dr)/dI and d(dr)/dA of a leg of length `len` at the station's end
+/// (the same at either end of the leg in the balanced-tangential form).
+fn d_inc_azi(s: &Station, len: f64) -> ([f64; 3], [f64; 3]) {
+    let (si, ci) = s.inc.sin_cos();
+    let (sa, ca) = s.azi.sin_cos();
+    let h = len / 2.0;
+    (
+        [h * ci * ca, h * ci * sa, -h * si],
+        [-h * si * sa, h * si * ca, 0.0],
+    )
+}
+
+/// Per-source and total covariances at every station.
+#[derive(Clone, Debug)]
+pub struct ModelResult {
+    /// Per implemented source code: covariance at each station.
+    pub per_source: BTreeMap<String, Vec<Cov6>>,
+    /// Sum of the implemented sources at each station.
+    pub total: Vec<Cov6>,
+    /// Codes of sources whose weighting function is not implemented (not
+    /// included in `total`).
+    pub missing: Vec<String>,
+}
+
+/// Error vector of one source at every station: (vector as an interior
+/// station, vector as the last station).
+fn error_vectors(
+    term: &ErrorTerm,
+    stations: &[Station],
+    site: &Site,
+) -> Option<Vec<([f64; 3], [f64; 3])>> {
+    let n = stations.len();
+    let mut out = vec![([0.0; 3], [0.0; 3]); n];
+    let sig = term.magnitude_si;
+    if term.weighting.starts_with("XCL") {
+        for k in 1..n {
+            let v = xcl_vector(&term.weighting, &stations[k], &stations[k - 1], sig, site)?;
+            out[k] = (v, v);
+        }
+        return Some(out);
+    }
+    for k in 1..n {
+        let s = &stations[k];
+        let wt = weighting(&term.weighting, s, s.md - stations[k - 1].md, site)?;
+        let len_b = if k == 1 {
+            // the tie-on's inclination/azimuth error is carried here
+            2.0 * (s.md - stations[0].md)
+        } else {
+            s.md - stations[k - 1].md
+        };
+        let len_a = if k + 1 < n {
+            stations[k + 1].md - s.md
+        } else {
+            0.0
+        };
+        let t = tangent(s);
+        let tp = tangent(&stations[k - 1]);
+        let tn = if k + 1 < n {
+            tangent(&stations[k + 1])
+        } else {
+            t
+        };
+        // depth: dr_k/dD_k = (t_{k-1}+t_k)/2 ; dr_{k+1}/dD_k = -(t_k+t_{k+1})/2
+        let dd_b: [f64; 3] = std::array::from_fn(|j| 0.5 * (tp[j] + t[j]));
+        let dd_a: [f64; 3] = std::array::from_fn(|j| -0.5 * (t[j] + tn[j]));
+        let vec_for = |len_after: f64, dd_after: [f64; 3]| -> [f64; 3] {
+            if let (Some(sv), true) = (wt.singular, s.inc < site.vertical_limit) {
+                let h = (len_b + len_after) / 2.0;
+                let dd: [f64; 3] = std::array::from_fn(|j| dd_b[j] + dd_after[j]);
+                return std::array::from_fn(|j| sig * (dd[j] * wt.w[0] + h * sv[j]));
+            }
+            let (di_b, da_b) = d_inc_azi(s, len_b);
+            let (di_a, da_a) = d_inc_azi(s, len_after);
+            std::array::from_fn(|j| {
+                sig * ((dd_b[j] + dd_after[j]) * wt.w[0]
+                    + (di_b[j] + di_a[j]) * wt.w[1]
+                    + (da_b[j] + da_a[j]) * wt.w[2])
+            })
+        };
+        out[k] = (vec_for(len_a, dd_a), vec_for(0.0, [0.0; 3]));
+    }
+    Some(out)
+}
+
+/// Runs the model over a survey (first station = tie-on).
+pub fn run(terms: &[ErrorTerm], stations: &[Station], site: &Site) -> ModelResult {
+    let n = stations.len();
+    let mut per_source = BTreeMap::new();
+    let mut missing = Vec::new();
+    let mut total = vec![[0.0; 6]; n];
+    for term in terms {
+        let Some(ev) = error_vectors(term, stations, site) else {
+            missing.push(term.code.clone());
+            continue;
+        };
+        let mut covs = vec![[0.0; 6]; n];
+        let mut rand_sum = [0.0; 6];
+        let mut sys_sum = [0.0; 3];
+        for k in 1..n {
+            let (interior, last) = ev[k];
+            match term.propagation {
+                Propagation::Random => {
+                    let c = outer(last);
+                    covs[k] = std::array::from_fn(|j| rand_sum[j] + c[j]);
+                    let ci = outer(interior);
+                    for j in 0..6 {
+                        rand_sum[j] += ci[j];
+                    }
+                }
+                _ => {
+                    let v: [f64; 3] = std::array::from_fn(|j| sys_sum[j] + last[j]);
+                    covs[k] = outer(v);
+                    for j in 0..3 {
+                        sys_sum[j] += interior[j];
+                    }
+                }
+            }
+        }
+        for k in 0..n {
+            for j in 0..6 {
+                total[k][j] += covs[k][j];
+            }
+        }
+        per_source.insert(term.code.clone(), covs);
+    }
+    ModelResult {
+        per_source,
+        total,
+        missing,
+    }
+}
