@@ -21,7 +21,26 @@
 //!   thing on a single well);
 //! * at a station closer to vertical than the model's limit, a source
 //!   whose azimuth weighting is singular uses its tabulated NEV
-//!   "singularity" vector in place of `dr/dp * w`.
+//!   "singularity" vector in place of `dr/dp * w`;
+//! * the long-course-length terms XCLA/XCLH (SPE 187249) use the
+//!   tangential form instead (see `xcl_vector`).
+//!
+//! Where the workbook's documentation formulas and its published numbers
+//! disagree, the numbers win (each case checked against the diagnostic
+//! block of the three test wells, `host-sim/tests/iscwsa_error_model.rs`):
+//! XYM3E's azimuth weight is `-|cos I| sin A / sin I` (the 5.10 Model sheet
+//! prints it without the minus sign), and an azimuth change out of a
+//! vertical station does not count in XCLA.
+//!
+//! Weighting functions are looked up by the table's `Wt.Fn.` name; a name
+//! not implemented here is reported in [`ModelResult::missing`], never
+//! treated as zero. Implemented: DREF, DSF, DST, ABXY-TI1/2, ABZ,
+//! ASXY-TI1/2/3, ASZ, MBXY-TI1/2, MBZ, MSXY-TI1/2/3, MSZ, AZ, DBH, AMIL,
+//! SAGE, XYM1, XYM2, XYM3L/XYM3E, XYM4L/XYM4E, XCLA, XCLH (the Rev 5.10
+//! MWD set). Not implemented: the Rev 5.04 single `XCL` function, the
+//! 5.10 XCLA "sine term" variant of the HPT diagnostics, the Rev 4
+//! functions with other names, and the gyro (GXY-*, AXYZ-*) functions of
+//! the OWSG gyro models.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -62,6 +81,9 @@ pub struct ErrorTerm {
     pub magnitude_si: f64,
     pub propagation: Propagation,
 }
+
+#[cfg(test)]
+mod tests;
 
 /// Error loading a term table or a data file.
 #[derive(Debug)]
@@ -142,8 +164,8 @@ pub struct Site {
     pub b_total: f64,
     /// Dip, rad.
     pub dip: f64,
-    /// Declination, rad (magnetic azimuth = true azimuth - declination -
-    /// ... grid convergence is zero for the test wells and not modelled).
+    /// Declination, rad: magnetic azimuth = true azimuth - declination
+    /// (grid convergence is not modelled; it is zero for the test wells).
     pub declination: f64,
     /// Inclination below which a station counts as vertical, rad.
     pub vertical_limit: f64,
