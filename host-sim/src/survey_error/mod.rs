@@ -14,8 +14,9 @@
 //!   function; at the station of interest K only the leg before it counts;
 //! * the tie-on's own inclination/azimuth error is carried by station 1
 //!   (its leg-before weight covers the whole first course length), its depth
-//!   error is not counted — this is what the published diagnostics show
-//!   (e.g. the random XYM3E of well #1 at 1200 m);
+//!   error is not counted — this is what the published Rev 5 diagnostics
+//!   show (e.g. the random XYM3E of well #1 at 1200 m); the Rev 4
+//!   diagnostics take the tie-on as exact instead ([`TieOn`]);
 //! * random sources: sum over stations of `e e^T`; systematic, per-well and
 //!   global sources: the outer product of the summed vector (the same
 //!   thing on a single well);
@@ -37,10 +38,10 @@
 //! treated as zero. Implemented: DREF, DSF, DST, ABXY-TI1/2, ABZ,
 //! ASXY-TI1/2/3, ASZ, MBXY-TI1/2, MBZ, MSXY-TI1/2/3, MSZ, AZ, DBH, AMIL,
 //! SAGE, XYM1, XYM2, XYM3L/XYM3E, XYM4L/XYM4E, XCLA, XCLH (the Rev 5.10
-//! MWD set). Not implemented: the Rev 5.04 single `XCL` function, the
-//! 5.10 XCLA "sine term" variant of the HPT diagnostics, the Rev 4
-//! functions with other names, and the gyro (GXY-*, AXYZ-*) functions of
-//! the OWSG gyro models.
+//! MWD set), and SAG, XYM3, XYM4 (Rev 4). Not implemented: the Rev 5.04
+//! single `XCL` function, the 5.10 XCLA "sine term" variant of the HPT
+//! diagnostics, and the gyro (GXY-*, AXYZ-*) functions of the OWSG gyro
+//! models.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -254,9 +255,10 @@ fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight
         "DBH" => w(0.0, 0.0, 1.0 / bh),
         "AMIL" => w(0.0, 0.0, si * sam / bh),
         "SAGE" => w(0.0, si.powf(0.25), 0.0),
+        "SAG" => w(0.0, si, 0.0),
         "XYM1" => w(0.0, si.abs(), 0.0),
         "XYM2" => w(0.0, 0.0, -1.0),
-        "XYM3L" | "XYM3E" => {
+        "XYM3" | "XYM3L" | "XYM3E" => {
             let f = enhanced(name, course);
             Weight {
                 w: [
@@ -271,7 +273,7 @@ fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight
                 singular: Some([f, 0.0, 0.0]),
             }
         }
-        "XYM4L" | "XYM4E" => {
+        "XYM4" | "XYM4L" | "XYM4E" => {
             let f = enhanced(name, course);
             Weight {
                 w: [
@@ -370,12 +372,24 @@ pub struct ModelResult {
     pub missing: Vec<String>,
 }
 
+/// How the tie-on's own inclination/azimuth error is counted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TieOn {
+    /// Rev 5 workbooks: station 1 carries it (its leg-before weight covers
+    /// the whole first course length).
+    CarriedByFirstStation,
+    /// Rev 4 workbook: the tie-on is exact; station 1's leg-before weight
+    /// is half the first course length, as at every other station.
+    Exact,
+}
+
 /// Error vector of one source at every station: (vector as an interior
 /// station, vector as the last station).
 fn error_vectors(
     term: &ErrorTerm,
     stations: &[Station],
     site: &Site,
+    tie_on: TieOn,
 ) -> Option<Vec<([f64; 3], [f64; 3])>> {
     let n = stations.len();
     let mut out = vec![([0.0; 3], [0.0; 3]); n];
@@ -390,7 +404,7 @@ fn error_vectors(
     for k in 1..n {
         let s = &stations[k];
         let wt = weighting(&term.weighting, s, s.md - stations[k - 1].md, site)?;
-        let len_b = if k == 1 {
+        let len_b = if k == 1 && tie_on == TieOn::CarriedByFirstStation {
             // the tie-on's inclination/azimuth error is carried here
             2.0 * (s.md - stations[0].md)
         } else {
@@ -430,14 +444,25 @@ fn error_vectors(
     Some(out)
 }
 
-/// Runs the model over a survey (first station = tie-on).
+/// Runs the model over a survey (first station = tie-on), with the Rev 5
+/// tie-on convention.
 pub fn run(terms: &[ErrorTerm], stations: &[Station], site: &Site) -> ModelResult {
+    run_with(terms, stations, site, TieOn::CarriedByFirstStation)
+}
+
+/// Runs the model with an explicit tie-on convention.
+pub fn run_with(
+    terms: &[ErrorTerm],
+    stations: &[Station],
+    site: &Site,
+    tie_on: TieOn,
+) -> ModelResult {
     let n = stations.len();
     let mut per_source = BTreeMap::new();
     let mut missing = Vec::new();
     let mut total = vec![[0.0; 6]; n];
     for term in terms {
-        let Some(ev) = error_vectors(term, stations, site) else {
+        let Some(ev) = error_vectors(term, stations, site, tie_on) else {
             missing.push(term.code.clone());
             continue;
         };
