@@ -12,7 +12,7 @@
 //! passes if it is within `abs_tol` or within REL_TOL of the reference.
 
 use host_sim::survey_error::{
-    load_term_table, run, run_with, Cov6, ErrorTerm, ModelResult, Site, Station, TieOn,
+    load_term_table, run, run_with, Cov6, ErrorTerm, ModelResult, Options, Site, Station,
 };
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -133,7 +133,12 @@ fn terms_diagnostic() -> Result<Vec<ErrorTerm>, String> {
 }
 
 fn model(well: &Well) -> Result<ModelResult, String> {
-    Ok(run(&terms_diagnostic()?, &well.stations, &well.site))
+    Ok(run_with(
+        &terms_diagnostic()?,
+        &well.stations,
+        &well.site,
+        Options::REV5_DIAGNOSTIC,
+    ))
 }
 
 fn station_index(well: &Well, md_text: &str) -> Result<usize, String> {
@@ -282,10 +287,8 @@ fn load_hpt() -> Result<BTreeMap<(String, String, String), Cov6>, String> {
 }
 
 /// The HPT Rev 5.1 diagnostics were produced with the 5.10 table as
-/// published (DEC-OH 0.21 deg): DEC-OH and TOTAL rows. Their XCLA rows are
-/// not compared: the engine's XCLA reproduces the workbook diagnostic block
-/// (before the 5.10 "sine term"), which differs from the HPT XCLA at well
-/// #3, 4030 m by 0.0245 m^2 NN (0.7 %); the 5.10 variant is not implemented.
+/// published (DEC-OH 0.21 deg) and the 5.10 XCLA sine term: DEC-OH, XCLA
+/// and TOTAL rows.
 #[test]
 fn rev5_10_table_matches_the_hpt_5_1_diagnostics() {
     let hpt = load_hpt().unwrap_or_else(|e| panic!("{e}"));
@@ -315,7 +318,7 @@ fn rev5_10_table_matches_the_hpt_5_1_diagnostics() {
                 .unwrap_or_else(|| panic!("{w}: no station at {md_m} m"));
             reference.insert((format!("{}", st.md / well.unit), src.clone()), *c);
         }
-        for s in ["DEC-OH", "TOTAL"] {
+        for s in ["DEC-OH", "XCLA", "TOTAL"] {
             let (f, worst) =
                 compare(w, &well, &res, s, &reference).unwrap_or_else(|e| panic!("{e}"));
             println!(
@@ -334,6 +337,18 @@ fn rev5_10_table_matches_the_hpt_5_1_diagnostics() {
         failures.len(),
         failures.join("\n")
     );
+}
+
+/// The XCLA variants differ where the azimuth turns hard: well #3, 4030 m,
+/// NN 3.3030 (diagnostic block, |dA|) vs 3.2785 m^2 (HPT, sin |dA|).
+#[test]
+fn xcla_sine_term_separates_the_two_reference_generations() {
+    let well = load_well("iscwsa_3").unwrap_or_else(|e| panic!("{e}"));
+    let terms = terms_5_10().unwrap_or_else(|e| panic!("{e}"));
+    let k = station_index(&well, "4030").unwrap_or_else(|e| panic!("{e}"));
+    let nn = |o: Options| run_with(&terms, &well.stations, &well.site, o).per_source["XCLA"][k][0];
+    assert!((nn(Options::REV5_DIAGNOSTIC) - 3.3030).abs() < 5e-5);
+    assert!((nn(Options::REV5_10) - 3.2785).abs() < 5e-5);
 }
 
 /// The check can fail: the 5.10 table's DEC-OH (0.21 deg) is 10.25 % off
@@ -379,7 +394,7 @@ fn rev4_table_matches_the_rev4_diagnostic_block_of_well_1() {
     let terms = load_term_table(&data_dir().join("mwd_rev4_model_terms.csv"))
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(terms.len(), 27);
-    let res = run_with(&terms, &well.stations, &well.site, TieOn::Exact);
+    let res = run_with(&terms, &well.stations, &well.site, Options::REV4);
     assert!(res.missing.is_empty(), "not implemented: {:?}", res.missing);
     let mut srcs: Vec<String> = well.reference.keys().map(|k| k.1.clone()).collect();
     srcs.sort();
@@ -412,10 +427,10 @@ fn tie_on_convention_matters_for_rev4() {
         .unwrap_or_else(|e| panic!("{e}"));
     let k = station_index(&well, "1200").unwrap_or_else(|e| panic!("{e}"));
     let nn =
-        |t: TieOn| run_with(&terms, &well.stations, &well.site, t).per_source["ABXY-TI1S"][k][0];
+        |t: Options| run_with(&terms, &well.stations, &well.site, t).per_source["ABXY-TI1S"][k][0];
     // published Rev 4: 0.2336 m^2
-    assert!((nn(TieOn::Exact) - 0.2336).abs() < 5e-5);
-    assert!((nn(TieOn::CarriedByFirstStation) - 0.2336).abs() > 5e-3);
+    assert!((nn(Options::REV4) - 0.2336).abs() < 5e-5);
+    assert!((nn(Options::REV5_DIAGNOSTIC) - 0.2336).abs() > 5e-3);
 }
 
 /// Dense regression: the WB5.10-#1 workbook's own calculated TOTALS (5.10

@@ -38,9 +38,9 @@
 //! treated as zero. Implemented: DREF, DSF, DST, ABXY-TI1/2, ABZ,
 //! ASXY-TI1/2/3, ASZ, MBXY-TI1/2, MBZ, MSXY-TI1/2/3, MSZ, AZ, DBH, AMIL,
 //! SAGE, XYM1, XYM2, XYM3L/XYM3E, XYM4L/XYM4E, XCLA, XCLH (the Rev 5.10
-//! MWD set), and SAG, XYM3, XYM4 (Rev 4). Not implemented: the Rev 5.04
-//! single `XCL` function, the 5.10 XCLA "sine term" variant of the HPT
-//! diagnostics, and the gyro (GXY-*, AXYZ-*) functions of the OWSG gyro
+//! MWD set; XCLA in both its pre-5.10 and 5.10 forms, [`XclAzimuth`]), and
+//! SAG, XYM3, XYM4 (Rev 4). Not implemented: the Rev 5.04 single `XCL`
+//! function, and the gyro (GXY-*, AXYZ-*) functions of the OWSG gyro
 //! models.
 
 use std::collections::BTreeMap;
@@ -310,7 +310,14 @@ pub const XCL_TORTUOSITY: f64 = 0.000_572_615;
 /// Error vector of the long-course-length terms (SPE 187249), which use the
 /// tangential form: the station's angle error acts over the leg before it
 /// only, `e_k = sigma * (D_k - D_{k-1}) * dt_k/dp * w`.
-fn xcl_vector(name: &str, s: &Station, prev: &Station, sig: f64, site: &Site) -> Option<[f64; 3]> {
+fn xcl_vector(
+    name: &str,
+    s: &Station,
+    prev: &Station,
+    sig: f64,
+    site: &Site,
+    xcl: XclAzimuth,
+) -> Option<[f64; 3]> {
     let len = s.md - prev.md;
     let (si, ci) = s.inc.sin_cos();
     let (sa, ca) = s.azi.sin_cos();
@@ -335,7 +342,11 @@ fn xcl_vector(name: &str, s: &Station, prev: &Station, sig: f64, site: &Site) ->
             }
             // sin(I) * max(|dA|, tau * L / sin(I)) = max(sin(I) |dA|, tau * L):
             // finite at vertical
-            let ws = (si * da).max(XCL_TORTUOSITY * len);
+            let change = match xcl {
+                XclAzimuth::Angle => da,
+                XclAzimuth::Sine => da.sin(),
+            };
+            let ws = (si * change).max(XCL_TORTUOSITY * len);
             Some([-sig * len * ws * sa, sig * len * ws * ca, 0.0])
         }
         _ => None,
@@ -383,20 +394,61 @@ pub enum TieOn {
     Exact,
 }
 
+/// The azimuth change XCLA weighs: `|dA|` in the workbook diagnostic
+/// block (before Rev 5.10), `sin |dA|` from Rev 5.10 on (the "sine term";
+/// HPT Rev 5.1 diagnostics, OWSG tool models).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum XclAzimuth {
+    Angle,
+    Sine,
+}
+
+/// Conventions that differ between model revisions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    pub tie_on: TieOn,
+    pub xcl_azimuth: XclAzimuth,
+}
+
+impl Options {
+    /// Rev 5.10 (HPT Rev 5.1 diagnostics, WB5.10 calculation sheets).
+    pub const REV5_10: Self = Self {
+        tie_on: TieOn::CarriedByFirstStation,
+        xcl_azimuth: XclAzimuth::Sine,
+    };
+    /// The workbook diagnostic block (Rev 5 before the 5.10 XCLA change).
+    pub const REV5_DIAGNOSTIC: Self = Self {
+        tie_on: TieOn::CarriedByFirstStation,
+        xcl_azimuth: XclAzimuth::Angle,
+    };
+    /// Rev 4 (no XCL terms).
+    pub const REV4: Self = Self {
+        tie_on: TieOn::Exact,
+        xcl_azimuth: XclAzimuth::Angle,
+    };
+}
+
 /// Error vector of one source at every station: (vector as an interior
 /// station, vector as the last station).
 fn error_vectors(
     term: &ErrorTerm,
     stations: &[Station],
     site: &Site,
-    tie_on: TieOn,
+    opts: Options,
 ) -> Option<Vec<([f64; 3], [f64; 3])>> {
     let n = stations.len();
     let mut out = vec![([0.0; 3], [0.0; 3]); n];
     let sig = term.magnitude_si;
     if term.weighting.starts_with("XCL") {
         for k in 1..n {
-            let v = xcl_vector(&term.weighting, &stations[k], &stations[k - 1], sig, site)?;
+            let v = xcl_vector(
+                &term.weighting,
+                &stations[k],
+                &stations[k - 1],
+                sig,
+                site,
+                opts.xcl_azimuth,
+            )?;
             out[k] = (v, v);
         }
         return Some(out);
@@ -404,7 +456,7 @@ fn error_vectors(
     for k in 1..n {
         let s = &stations[k];
         let wt = weighting(&term.weighting, s, s.md - stations[k - 1].md, site)?;
-        let len_b = if k == 1 && tie_on == TieOn::CarriedByFirstStation {
+        let len_b = if k == 1 && opts.tie_on == TieOn::CarriedByFirstStation {
             // the tie-on's inclination/azimuth error is carried here
             2.0 * (s.md - stations[0].md)
         } else {
@@ -444,25 +496,25 @@ fn error_vectors(
     Some(out)
 }
 
-/// Runs the model over a survey (first station = tie-on), with the Rev 5
-/// tie-on convention.
+/// Runs the model over a survey (first station = tie-on), with the Rev
+/// 5.10 conventions.
 pub fn run(terms: &[ErrorTerm], stations: &[Station], site: &Site) -> ModelResult {
-    run_with(terms, stations, site, TieOn::CarriedByFirstStation)
+    run_with(terms, stations, site, Options::REV5_10)
 }
 
-/// Runs the model with an explicit tie-on convention.
+/// Runs the model with explicit conventions.
 pub fn run_with(
     terms: &[ErrorTerm],
     stations: &[Station],
     site: &Site,
-    tie_on: TieOn,
+    opts: Options,
 ) -> ModelResult {
     let n = stations.len();
     let mut per_source = BTreeMap::new();
     let mut missing = Vec::new();
     let mut total = vec![[0.0; 6]; n];
     for term in terms {
-        let Some(ev) = error_vectors(term, stations, site, tie_on) else {
+        let Some(ev) = error_vectors(term, stations, site, opts) else {
             missing.push(term.code.clone());
             continue;
         };
