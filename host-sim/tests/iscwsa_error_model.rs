@@ -62,6 +62,8 @@ fn load_well(key: &str) -> Result<Well, String> {
         dip: f("dip_deg")?.to_radians(),
         declination: f("declination_deg")?.to_radians(),
         vertical_limit: f("vertical_inc_limit_deg")?.to_radians(),
+        latitude: f("latitude_deg")?.to_radians(),
+        gyro_noise_reduction: 1.0,
     };
     let mut stations = Vec::new();
     let survey = dir.join(s("survey_file")?);
@@ -478,5 +480,54 @@ fn rev5_10_totals_of_well_1_at_every_station() {
     assert!(
         worst_rel < 1e-6 && worst_abs < 1e-4,
         "worst rel {worst_rel}, abs {worst_abs}"
+    );
+}
+
+/// The OWSG gyro models (GYRO-MWD, GYRO-NS) load and run with every term
+/// implemented. No published covariances exist for them on the test wells,
+/// so this checks only what must hold: the tables read, the deg/hr
+/// magnitudes converted, every covariance finite with non-negative
+/// variances, and GYRO-NS (same terms, gyro magnitudes no larger) never
+/// less accurate than GYRO-MWD. Well #1 is used up to the last station
+/// within the models' 89 deg inclination range.
+#[test]
+fn owsg_gyro_models_run_on_well_1() {
+    let mut well = load_well("iscwsa_1").unwrap_or_else(|e| panic!("{e}"));
+    let last = well
+        .stations
+        .iter()
+        .position(|s| s.inc > 89_f64.to_radians())
+        .unwrap_or(well.stations.len());
+    well.stations.truncate(last);
+    assert!(well.stations.len() > 100);
+    let load = |f: &str| load_term_table(&data_dir().join(f)).unwrap_or_else(|e| panic!("{e}"));
+    let mwd = load("owsg_gyro_mwd_terms.csv");
+    let ns = load("owsg_gyro_ns_terms.csv");
+    assert_eq!((mwd.len(), ns.len()), (18, 18));
+    let rn = mwd
+        .iter()
+        .find(|t| t.code == "GXY-RN")
+        .unwrap_or_else(|| panic!("no GXY-RN"));
+    assert!((rn.magnitude_si - 0.6_f64.to_radians() / 3600.0).abs() < 1e-15);
+    let a = run(&mwd, &well.stations, &well.site);
+    let b = run(&ns, &well.stations, &well.site);
+    assert!(
+        a.missing.is_empty() && b.missing.is_empty(),
+        "{:?} {:?}",
+        a.missing,
+        b.missing
+    );
+    for (k, (ca, cb)) in a.total.iter().zip(&b.total).enumerate() {
+        assert!(ca.iter().chain(cb).all(|x| x.is_finite()), "station {k}");
+        assert!(
+            ca[..3].iter().chain(&cb[..3]).all(|&x| x >= 0.0),
+            "station {k}"
+        );
+        assert!(cb[0] + cb[1] <= ca[0] + ca[1] + 1e-12, "station {k}");
+    }
+    let k = well.stations.len() - 1;
+    println!(
+        "OWSG on well #1 to MD {} m: GYRO-MWD NN {:.3} EE {:.3} VV {:.3} m2; GYRO-NS NN {:.3} EE {:.3} VV {:.3} m2",
+        well.stations[k].md, a.total[k][0], a.total[k][1], a.total[k][2], b.total[k][0], b.total[k][1], b.total[k][2]
     );
 }

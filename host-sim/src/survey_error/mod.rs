@@ -39,9 +39,12 @@
 //! ASXY-TI1/2/3, ASZ, MBXY-TI1/2, MBZ, MSXY-TI1/2/3, MSZ, AZ, DBH, AMIL,
 //! SAGE, XYM1, XYM2, XYM3L/XYM3E, XYM4L/XYM4E, XCLA, XCLH (the Rev 5.10
 //! MWD set; XCLA in both its pre-5.10 and 5.10 forms, [`XclAzimuth`]), and
-//! SAG, XYM3, XYM4 (Rev 4). Not implemented: the Rev 5.04 single `XCL`
-//! function, and the gyro (GXY-*, AXYZ-*) functions of the OWSG gyro
-//! models.
+//! SAG, XYM3, XYM4 (Rev 4), and the OWSG GYRO-MWD / GYRO-NS gyro and
+//! accelerometer functions AXYZ-MIS/SF/ZB, GXY-B1/B2/G1/G4/RN (no
+//! published covariances to check them against: tested only by closed
+//! forms; the OWSG models are stated for inclinations up to 89 deg, and
+//! GXY-B1/G4/RN grow without bound towards 90 deg). Not implemented: the
+//! Rev 5.04 single `XCL` function.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -126,7 +129,8 @@ pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
     let c_mag = col(&headers, "Magnitude")?;
     let c_unit = col(&headers, "Units")?;
     let c_prop = col(&headers, "Prop.")?;
-    let c_si = col(&headers, "Convert Magnitudes Degrees to Radians")?;
+    // the MWD tables carry the converted magnitude; the OWSG sheets do not
+    let c_si = col(&headers, "Convert Magnitudes Degrees to Radians").ok();
     let mut terms = Vec::new();
     for rec in rdr.records() {
         let rec = rec.map_err(|e| DataError(format!("{}: {e}", path.display())))?;
@@ -137,15 +141,23 @@ pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
                 .ok_or_else(|| DataError(format!("line {line}: missing {what}")))
         };
         let code = text(c_code, "Code")?;
+        let magnitude = num(rec.get(c_mag), "Magnitude", line)?;
+        let unit = text(c_unit, "Units")?;
+        let magnitude_si = match c_si {
+            Some(c) => num(rec.get(c), "converted magnitude", line)?,
+            None => to_model_units(magnitude, &unit).ok_or_else(|| {
+                DataError(format!("line {line}: unknown unit {unit:?} of {code}"))
+            })?,
+        };
         if code.is_empty() {
             return Err(DataError(format!("line {line}: empty Code")));
         }
         terms.push(ErrorTerm {
             code,
             weighting: text(c_wt, "Wt.Fn.")?,
-            magnitude: num(rec.get(c_mag), "Magnitude", line)?,
-            unit: text(c_unit, "Units")?,
-            magnitude_si: num(rec.get(c_si), "converted magnitude", line)?,
+            magnitude,
+            unit,
+            magnitude_si,
             propagation: Propagation::parse(&text(c_prop, "Prop.")?)
                 .map_err(|e| DataError(format!("line {line}: {e}")))?,
         });
@@ -155,6 +167,22 @@ pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
     }
     Ok(terms)
 }
+
+/// A magnitude in the units the weighting functions use: angles in
+/// radians, angular rates in rad/s, the rest as tabulated.
+fn to_model_units(magnitude: f64, unit: &str) -> Option<f64> {
+    let deg = std::f64::consts::PI / 180.0;
+    Some(match unit {
+        "deg" => magnitude * deg,
+        "deg/hr" => magnitude * deg / 3600.0,
+        "deg.nT" => magnitude * deg,
+        "m" | "-" | "1/m" | "m/s2" | "nT" => magnitude,
+        _ => return None,
+    })
+}
+
+/// Earth rate, rad/s (the gyro weighting functions' `EarthRate`).
+pub const EARTH_RATE: f64 = 7.292_115e-5;
 
 /// Site and model parameters the weighting functions need.
 #[derive(Clone, Copy, Debug)]
@@ -170,6 +198,11 @@ pub struct Site {
     pub declination: f64,
     /// Inclination below which a station counts as vertical, rad.
     pub vertical_limit: f64,
+    /// Latitude, rad (gyro terms).
+    pub latitude: f64,
+    /// `NoiseReductionFactor` of the gyro random-noise term GXY-RN (1: one
+    /// measurement per station).
+    pub gyro_noise_reduction: f64,
 }
 
 /// A survey station: MD and TVD in metres, angles in radians.
@@ -256,6 +289,21 @@ fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight
         "AMIL" => w(0.0, 0.0, si * sam / bh),
         "SAGE" => w(0.0, si.powf(0.25), 0.0),
         "SAG" => w(0.0, si, 0.0),
+        // OWSG gyro models (SPE 90408 Tables 1 and 4): 3-axis
+        // accelerometer, 2-axis (XY) stationary gyro
+        "AXYZ-MIS" => w(0.0, 1.0, 0.0),
+        "AXYZ-SF" => w(0.0, 1.3 * si * ci, 0.0),
+        "AXYZ-ZB" => w(0.0, si / g, 0.0),
+        "GXY-B1" => w(0.0, 0.0, sat / (horizontal_earth_rate(site) * ci)),
+        "GXY-B2" => w(0.0, 0.0, cat / horizontal_earth_rate(site)),
+        "GXY-G1" => w(0.0, 0.0, cat * si / horizontal_earth_rate(site)),
+        "GXY-G4" => w(0.0, 0.0, sat * si / ci / horizontal_earth_rate(site)),
+        "GXY-RN" => w(
+            0.0,
+            0.0,
+            site.gyro_noise_reduction * (1.0 - (cat * si).powi(2)).sqrt()
+                / (horizontal_earth_rate(site) * ci),
+        ),
         "XYM1" => w(0.0, si.abs(), 0.0),
         "XYM2" => w(0.0, 0.0, -1.0),
         "XYM3" | "XYM3L" | "XYM3E" => {
@@ -351,6 +399,10 @@ fn xcl_vector(
         }
         _ => None,
     }
+}
+
+fn horizontal_earth_rate(site: &Site) -> f64 {
+    EARTH_RATE * site.latitude.cos()
 }
 
 fn tangent(s: &Station) -> [f64; 3] {

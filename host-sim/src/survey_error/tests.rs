@@ -7,6 +7,8 @@ fn site() -> Site {
         dip: 72_f64.to_radians(),
         declination: -4_f64.to_radians(),
         vertical_limit: 1e-4_f64.to_radians(),
+        latitude: 60_f64.to_radians(),
+        gyro_noise_reduction: 1.0,
     }
 }
 
@@ -97,14 +99,14 @@ fn unknown_weighting_is_reported_missing_not_zero() {
     let st = vertical(5, 30.0);
     let r = run(
         &[
-            term("GXY-B1R", "GXY-B1", 0.1, Propagation::Random),
+            term("XCLL", "XCL", 0.167, Propagation::Random),
             term("DRFR", "DREF", 0.35, Propagation::Random),
         ],
         &st,
         &site(),
     );
-    assert_eq!(r.missing, vec!["GXY-B1R".to_string()]);
-    assert!(!r.per_source.contains_key("GXY-B1R"));
+    assert_eq!(r.missing, vec!["XCLL".to_string()]);
+    assert!(!r.per_source.contains_key("XCLL"));
     // the total holds only what was computed
     assert!((r.total[4][2] - 0.1225).abs() < 1e-12);
 }
@@ -155,4 +157,44 @@ fn term_table_errors_are_clear() {
             std::env::temp_dir().join(format!("iscwsa-{}-{n}.csv", std::process::id())),
         );
     }
+}
+
+/// A systematic gyro bias on the east axis (GXY-B2, azimuth error
+/// b cos A / (Omega cos lat)) on a straight hold due north: the whole hold
+/// is swung sideways, EE = (dA sin I L)^2 with L the hold's length.
+#[test]
+fn gyro_bias_swings_a_straight_hold() {
+    let inc = 60_f64.to_radians();
+    let st: Vec<Station> = (0..101)
+        .map(|i| Station {
+            md: i as f64 * 30.0,
+            inc,
+            azi: 0.0,
+            tvd: i as f64 * 15.0,
+        })
+        .collect();
+    let b = 0.15 * std::f64::consts::PI / 180.0 / 3600.0; // 0.15 deg/h
+    let r = run(
+        &[term("GXY-B2S", "GXY-B2", b, Propagation::Systematic)],
+        &st,
+        &site(),
+    );
+    let da = b / (EARTH_RATE * 60_f64.to_radians().cos());
+    let expect = (da * inc.sin() * 3000.0).powi(2);
+    let got = r.per_source["GXY-B2S"][100];
+    assert!(
+        (got[1] - expect).abs() < 1e-9 * expect,
+        "{} vs {expect}",
+        got[1]
+    );
+    assert!(got[0].abs() < 1e-12 && got[2].abs() < 1e-12);
+}
+
+#[test]
+fn magnitudes_without_a_converted_column_follow_their_unit() {
+    assert_eq!(to_model_units(0.35, "m"), Some(0.35));
+    let dph = to_model_units(15.0, "deg/hr").expect("deg/hr");
+    assert!((dph - 15_f64.to_radians() / 3600.0).abs() < 1e-18);
+    assert!((to_model_units(0.2, "deg").expect("deg") - 0.2_f64.to_radians()).abs() < 1e-18);
+    assert_eq!(to_model_units(1.0, "furlong"), None);
 }
