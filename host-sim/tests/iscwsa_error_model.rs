@@ -12,7 +12,8 @@
 //! passes if it is within `abs_tol` or within REL_TOL of the reference.
 
 use host_sim::survey_error::{
-    load_term_table, run, run_with, Cov6, ErrorTerm, ModelResult, Options, Site, Station,
+    check_stations, load_term_table, run, run_with, Cov6, ErrorTerm, ModelResult, Options, Site,
+    Station,
 };
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -100,6 +101,7 @@ fn load_well(key: &str) -> Result<Well, String> {
         }
         reference.insert((get(0)?.trim().to_string(), get(1)?.trim().to_string()), c);
     }
+    check_stations(&stations).map_err(|e| format!("{}: {e}", survey.display()))?;
     Ok(Well {
         site,
         stations,

@@ -214,6 +214,35 @@ pub struct Station {
     pub tvd: f64,
 }
 
+/// Checks a survey before [`run`]: at least a tie-on, every value finite,
+/// MD strictly increasing, inclination within 0..=180 deg. `run` itself
+/// assumes this (a repeated MD would make a zero-length leg; a non-finite
+/// value would spread NaN through every later station).
+pub fn check_stations(stations: &[Station]) -> Result<(), DataError> {
+    if stations.is_empty() {
+        return Err(DataError("survey: no stations".into()));
+    }
+    for (k, s) in stations.iter().enumerate() {
+        if ![s.md, s.inc, s.azi, s.tvd].iter().all(|x| x.is_finite()) {
+            return Err(DataError(format!("survey station {k}: non-finite value")));
+        }
+        if !(0.0..=std::f64::consts::PI).contains(&s.inc) {
+            return Err(DataError(format!(
+                "survey station {k}: inclination {} deg outside 0..180",
+                s.inc.to_degrees()
+            )));
+        }
+        if k > 0 && s.md <= stations[k - 1].md {
+            return Err(DataError(format!(
+                "survey station {k}: MD {} m not beyond the previous {} m",
+                s.md,
+                stations[k - 1].md
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// NEV covariance, m^2: `[nn, ee, vv, ne, nv, ev]`.
 pub type Cov6 = [f64; 6];
 

@@ -198,3 +198,25 @@ fn magnitudes_without_a_converted_column_follow_their_unit() {
     assert!((to_model_units(0.2, "deg").expect("deg") - 0.2_f64.to_radians()).abs() < 1e-18);
     assert_eq!(to_model_units(1.0, "furlong"), None);
 }
+
+#[test]
+fn bad_surveys_are_rejected_with_the_station_named() {
+    assert!(check_stations(&[]).is_err());
+    let mut st = vertical(5, 30.0);
+    assert!(check_stations(&st).is_ok());
+    st[3].md = st[2].md;
+    let e = check_stations(&st).expect_err("repeated MD");
+    assert!(e.0.contains("station 3"), "{e}");
+    let mut st = vertical(5, 30.0);
+    st[2].azi = f64::NAN;
+    assert!(check_stations(&st)
+        .expect_err("NaN")
+        .0
+        .contains("station 2"));
+    let mut st = vertical(5, 30.0);
+    st[4].inc = -0.1;
+    assert!(check_stations(&st)
+        .expect_err("negative inc")
+        .0
+        .contains("inclination"));
+}
