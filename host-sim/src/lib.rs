@@ -12,3 +12,4 @@ pub mod replay;
 pub mod samples_csv;
 pub mod sim;
 pub mod survey_error;
+pub mod survey_listing;

@@ -22,6 +22,11 @@ fn data_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa")
 }
 
+/// The term tables the `survey` command embeds (moved from tests/data/iscwsa).
+fn tool_data_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data")
+}
+
 struct Well {
     site: Site,
     stations: Vec<Station>,
@@ -112,7 +117,7 @@ fn load_well(key: &str) -> Result<Well, String> {
 
 /// The Rev 5.10 term table (`mwd_rev5_model_terms.csv`) as published.
 fn terms_5_10() -> Result<Vec<ErrorTerm>, String> {
-    load_term_table(&data_dir().join("mwd_rev5_model_terms.csv")).map_err(|e| e.to_string())
+    load_term_table(&tool_data_dir().join("mwd_rev5_model_terms.csv")).map_err(|e| e.to_string())
 }
 
 /// The term set the workbook diagnostic block was produced with: Rev 5.10
@@ -502,7 +507,8 @@ fn owsg_gyro_models_run_on_well_1() {
         .unwrap_or(well.stations.len());
     well.stations.truncate(last);
     assert!(well.stations.len() > 100);
-    let load = |f: &str| load_term_table(&data_dir().join(f)).unwrap_or_else(|e| panic!("{e}"));
+    let load =
+        |f: &str| load_term_table(&tool_data_dir().join(f)).unwrap_or_else(|e| panic!("{e}"));
     let mwd = load("owsg_gyro_mwd_terms.csv");
     let ns = load("owsg_gyro_ns_terms.csv");
     assert_eq!((mwd.len(), ns.len()), (18, 18));

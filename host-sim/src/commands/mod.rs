@@ -27,6 +27,7 @@ mod paper_mgwd;
 mod replay;
 mod simulate;
 mod site;
+mod survey;
 
 #[derive(Parser, Debug)]
 #[command(name = "host-sim", version, about = "Host tool of the gyro MWD probe")]
@@ -57,6 +58,9 @@ pub enum Command {
     /// What ZUPT and zero-position updates can determine at rest, per state
     /// (one toolface or toolface indexing).
     Observability(observability::Args),
+    /// Survey stations (CSV): positions by minimum curvature, ISCWSA
+    /// uncertainty and error ellipses; listing, CSV, JSON, WITSML exports.
+    Survey(survey::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
@@ -105,6 +109,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Arfit(args) => done(arfit::run(args)),
         Command::Calibrate(args) => done(calibrate::run(args)),
         Command::Observability(args) => done(observability::run(args)),
+        Command::Survey(args) => done(survey::run(args)),
         Command::Paper(cmd) => done(paper::run(cmd)),
     }
 }

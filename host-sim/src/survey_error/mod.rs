@@ -118,11 +118,23 @@ fn num(field: Option<&str>, what: &str, line: u64) -> Result<f64, DataError> {
 /// Reads an ISCWSA term table (`Model` sheet as CSV, as in
 /// `tests/data/iscwsa/mwd_rev5_04_model_terms.csv`).
 pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
-    let mut rdr =
+    let rdr =
         csv::Reader::from_path(path).map_err(|e| DataError(format!("{}: {e}", path.display())))?;
+    read_term_table(rdr, &path.display().to_string())
+}
+
+/// Reads a term table from text (an embedded table); `name` labels errors.
+pub fn parse_term_table(text: &str, name: &str) -> Result<Vec<ErrorTerm>, DataError> {
+    read_term_table(csv::Reader::from_reader(text.as_bytes()), name)
+}
+
+fn read_term_table<R: std::io::Read>(
+    mut rdr: csv::Reader<R>,
+    name: &str,
+) -> Result<Vec<ErrorTerm>, DataError> {
     let headers = rdr
         .headers()
-        .map_err(|e| DataError(format!("{}: {e}", path.display())))?
+        .map_err(|e| DataError(format!("{}: {e}", name)))?
         .clone();
     let c_code = col(&headers, "Code")?;
     let c_wt = col(&headers, "Wt.Fn.")?;
@@ -133,7 +145,7 @@ pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
     let c_si = col(&headers, "Convert Magnitudes Degrees to Radians").ok();
     let mut terms = Vec::new();
     for rec in rdr.records() {
-        let rec = rec.map_err(|e| DataError(format!("{}: {e}", path.display())))?;
+        let rec = rec.map_err(|e| DataError(format!("{}: {e}", name)))?;
         let line = rec.position().map_or(0, |p| p.line());
         let text = |c: usize, what: &str| {
             rec.get(c)
@@ -163,7 +175,7 @@ pub fn load_term_table(path: &Path) -> Result<Vec<ErrorTerm>, DataError> {
         });
     }
     if terms.is_empty() {
-        return Err(DataError(format!("{}: no terms", path.display())));
+        return Err(DataError(format!("{}: no terms", name)));
     }
     Ok(terms)
 }

@@ -1,0 +1,384 @@
+//! `host-sim survey`: positions of a survey's stations by minimum curvature
+//! and, with `--error-model`, their ISCWSA position uncertainty and error
+//! ellipse; a listing on the terminal and CSV, JSON, WITSML exports.
+use super::limits::number_in;
+use super::site::SiteArgs;
+use anyhow::{bail, Context, Result};
+use host_sim::survey_error::Site;
+use host_sim::survey_listing::{
+    self as listing, ellipse::scale_2d, AzimuthReference, KnownModel, Row, StationFile, TieOnInput,
+};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// North reference of the file's azimuths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Reference {
+    True,
+    Grid,
+}
+
+fn finite(text: &str) -> Result<f64, String> {
+    number_in(text, "the value", (-1e6, 1e6), "")
+}
+fn convergence_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the grid convergence", (-90.0, 90.0), "deg")
+}
+fn b_total_nt(text: &str) -> Result<f64, String> {
+    number_in(text, "the total field", (1.0, 100_000.0), "nT")
+}
+fn dip_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the dip", (-90.0, 90.0), "deg")
+}
+fn declination_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the declination", (-180.0, 180.0), "deg")
+}
+fn azimuth_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the vertical-section azimuth", (0.0, 360.0), "deg")
+}
+fn confidence(text: &str) -> Result<f64, String> {
+    let p = number_in(text, "the confidence", (0.0, 1.0), "")?;
+    if p == 0.0 || p == 1.0 {
+        return Err("the confidence must be between 0 and 1, exclusive".into());
+    }
+    Ok(p)
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Station CSV: header with md_m (or md_ft), inc_deg, azi_deg; optional
+    /// toolface_deg, time_s.
+    pub stations: PathBuf,
+    #[command(flatten)]
+    pub site: SiteArgs,
+    /// North reference of the azimuths (grid: give --convergence-deg).
+    #[arg(long, value_enum, default_value_t = Reference::True)]
+    pub azimuth_reference: Reference,
+    /// Grid convergence, deg: true azimuth = grid azimuth + convergence.
+    #[arg(long, allow_hyphen_values = true, value_parser = convergence_deg)]
+    pub convergence_deg: Option<f64>,
+    /// MD of the tie-on (file's unit): must be the first station's MD.
+    #[arg(long, allow_hyphen_values = true, value_parser = finite)]
+    pub tie_on_md: Option<f64>,
+    /// TVD of the tie-on (file's unit).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
+    pub tie_on_tvd: f64,
+    /// North of the tie-on (file's unit, true north).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
+    pub tie_on_north: f64,
+    /// East of the tie-on (file's unit, true north).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
+    pub tie_on_east: f64,
+    /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS".
+    #[arg(long)]
+    pub error_model: Option<String>,
+    /// Total magnetic field, nT (magnetic models).
+    #[arg(long, value_parser = b_total_nt)]
+    pub b_total_nt: Option<f64>,
+    /// Magnetic dip, deg (magnetic models).
+    #[arg(long, allow_hyphen_values = true, value_parser = dip_deg)]
+    pub dip_deg: Option<f64>,
+    /// Magnetic declination, deg (magnetic models).
+    #[arg(long, allow_hyphen_values = true, value_parser = declination_deg)]
+    pub declination_deg: Option<f64>,
+    /// Probability held by the scaled horizontal ellipse (2-D normal).
+    #[arg(long, default_value_t = 0.95, value_parser = confidence)]
+    pub confidence: f64,
+    /// Vertical-section azimuth, deg (default: closure of the last station).
+    #[arg(long, value_parser = azimuth_deg)]
+    pub vsec_azimuth_deg: Option<f64>,
+    /// Write one row per station here (CSV).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write the survey here (JSON).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write a WITSML 1.4.1.1 trajectory here (XML).
+    #[arg(long)]
+    pub witsml: Option<PathBuf>,
+}
+
+/// What the outputs need besides the rows.
+struct Survey {
+    rows: Vec<Row>,
+    vsec_azimuth_deg: f64,
+    model: Option<&'static KnownModel>,
+    /// First station the model is not valid at.
+    invalid_from: Option<usize>,
+    confidence: f64,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let file = read(&args.stations)?;
+    let survey = compute(&args, &file)?;
+    report(&survey);
+    write_outputs(&args, &survey)
+}
+
+fn read(path: &Path) -> Result<StationFile> {
+    let input = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    listing::read_stations(input).with_context(|| format!("{}", path.display()))
+}
+
+fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
+    let reference = match (args.azimuth_reference, args.convergence_deg) {
+        (Reference::True, None) => AzimuthReference::True,
+        (Reference::True, Some(_)) => {
+            bail!("--convergence-deg needs --azimuth-reference grid")
+        }
+        (Reference::Grid, Some(c)) => AzimuthReference::Grid(c.to_radians()),
+        (Reference::Grid, None) => bail!("--azimuth-reference grid needs --convergence-deg"),
+    };
+    let tie = TieOnInput {
+        md: args.tie_on_md,
+        tvd: args.tie_on_tvd,
+        north: args.tie_on_north,
+        east: args.tie_on_east,
+    };
+    let vsec = args.vsec_azimuth_deg.map(f64::to_radians);
+    let (mut rows, direction) = listing::compute(file, reference, tie, vsec)?;
+    let model = args
+        .error_model
+        .as_deref()
+        .map(listing::model)
+        .transpose()?;
+    let mut invalid_from = None;
+    if let Some(m) = model {
+        let terms = listing::terms(m)?;
+        invalid_from = listing::apply_model(&mut rows, m, &terms, &model_site(args, m)?)?;
+    }
+    Ok(Survey {
+        rows,
+        vsec_azimuth_deg: direction.to_degrees(),
+        model,
+        invalid_from,
+        confidence: args.confidence,
+    })
+}
+
+fn model_site(args: &Args, model: &KnownModel) -> Result<Site> {
+    let magnetic = |v: Option<f64>, flag: &str| match v {
+        Some(v) => Ok(v),
+        None if model.magnetic => bail!("--error-model {} needs {flag}", model.name),
+        None => Ok(0.0),
+    };
+    Ok(Site {
+        gravity: 9.806_65,
+        b_total: magnetic(args.b_total_nt, "--b-total-nt")?,
+        dip: magnetic(args.dip_deg, "--dip-deg")?.to_radians(),
+        declination: magnetic(args.declination_deg, "--declination-deg")?.to_radians(),
+        vertical_limit: 0.0001_f64.to_radians(),
+        latitude: args.site.lat.to_radians(),
+        gyro_noise_reduction: 1.0,
+    })
+}
+
+fn validity_note(s: &Survey) -> Option<String> {
+    let (m, k) = (s.model?, s.invalid_from?);
+    Some(format!(
+        "{} is stated for inclinations up to {} deg: no uncertainty from MD {:.2} m (station {}) on, not extrapolated",
+        m.name, m.max_inc_deg, s.rows[k].md_m, k
+    ))
+}
+
+fn report(s: &Survey) {
+    outln!(
+        "{} stations; N/E along true north, m; vertical section along {:.2} deg",
+        s.rows.len(),
+        s.vsec_azimuth_deg
+    );
+    if let Some(m) = s.model {
+        outln!(
+            "error model {}; ellipse at {:.1} % (2-D normal, k = {:.4} x 1-sigma)",
+            m.name,
+            100.0 * s.confidence,
+            scale_2d(s.confidence)
+        );
+    }
+    let mut head = format!(
+        "{:>9} {:>7} {:>7} {:>9} {:>9} {:>9} {:>6} {:>9}",
+        "MD m", "inc", "azi", "TVD m", "N m", "E m", "DLS", "VS m"
+    );
+    if s.model.is_some() {
+        head += &format!(
+            " {:>7} {:>7} {:>7} {:>8} {:>8} {:>6}",
+            "sN m", "sE m", "sV m", "major m", "minor m", "az"
+        );
+    }
+    outln!("{head}");
+    for r in &s.rows {
+        let mut line = format!(
+            "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
+            r.md_m, r.inc_deg, r.azi_deg, r.tvd_m, r.north_m, r.east_m, r.dls_deg_per_30m, r.vsec_m
+        );
+        if s.model.is_some() {
+            match (r.cov, r.ellipse()) {
+                (Some(c), Some(e)) => {
+                    let (a, b) = e.scaled(s.confidence);
+                    let _ = write!(
+                        line,
+                        " {:>7.2} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>6.1}",
+                        c[0].max(0.0).sqrt(),
+                        c[1].max(0.0).sqrt(),
+                        e.sigma_vert,
+                        a,
+                        b,
+                        e.azimuth_deg
+                    );
+                }
+                _ => line += "  (outside the model's validity)",
+            }
+        }
+        outln!("{line}");
+    }
+    if let Some(note) = validity_note(s) {
+        outln!("note: {note}");
+    }
+}
+
+fn write_outputs(args: &Args, s: &Survey) -> Result<()> {
+    let write = |path: &Path, text: String| {
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    };
+    if let Some(p) = &args.csv {
+        write(p, csv_text(s))?;
+    }
+    if let Some(p) = &args.json {
+        write(p, json_text(s)?)?;
+    }
+    if let Some(p) = &args.witsml {
+        write(p, witsml_text(s))?;
+    }
+    Ok(())
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |v| v.to_string())
+}
+
+fn csv_text(s: &Survey) -> String {
+    let mut out = String::from(
+        "md_m,inc_deg,azi_deg,tvd_m,north_m,east_m,dls_deg_per_30m,vsec_m,toolface_deg,time_s",
+    );
+    if s.model.is_some() {
+        out += ",sigma_north_m,sigma_east_m,sigma_vert_m,ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg,confidence,error_model_valid";
+    }
+    out += "\n";
+    for r in &s.rows {
+        let _ = write!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{}",
+            r.md_m,
+            r.inc_deg,
+            r.azi_deg,
+            r.tvd_m,
+            r.north_m,
+            r.east_m,
+            r.dls_deg_per_30m,
+            r.vsec_m,
+            opt(r.input.toolface_deg),
+            opt(r.input.time_s)
+        );
+        if s.model.is_some() {
+            match (r.cov, r.ellipse()) {
+                (Some(c), Some(e)) => {
+                    let (a, b) = e.scaled(s.confidence);
+                    let _ = write!(
+                        out,
+                        ",{},{},{},{a},{b},{},{},true",
+                        c[0].max(0.0).sqrt(),
+                        c[1].max(0.0).sqrt(),
+                        e.sigma_vert,
+                        e.azimuth_deg,
+                        s.confidence
+                    );
+                }
+                _ => {
+                    let _ = write!(out, ",,,,,,,{},false", s.confidence);
+                }
+            }
+        }
+        out += "\n";
+    }
+    out
+}
+
+fn json_text(s: &Survey) -> Result<String> {
+    let stations: Vec<serde_json::Value> = s
+        .rows
+        .iter()
+        .map(|r| {
+            let mut v = serde_json::json!({
+                "md_m": r.md_m, "inc_deg": r.inc_deg, "azi_deg": r.azi_deg,
+                "tvd_m": r.tvd_m, "north_m": r.north_m, "east_m": r.east_m,
+                "dls_deg_per_30m": r.dls_deg_per_30m, "vsec_m": r.vsec_m,
+                "toolface_deg": r.input.toolface_deg, "time_s": r.input.time_s,
+            });
+            if s.model.is_some() {
+                let e = r.ellipse();
+                let scaled = e.map(|e| e.scaled(s.confidence));
+                v["nev_covariance_m2"] = serde_json::json!(r.cov);
+                v["sigma_north_m"] = serde_json::json!(r.cov.map(|c| c[0].max(0.0).sqrt()));
+                v["sigma_east_m"] = serde_json::json!(r.cov.map(|c| c[1].max(0.0).sqrt()));
+                v["sigma_vert_m"] = serde_json::json!(e.map(|e| e.sigma_vert));
+                v["ellipse_semi_major_m"] = serde_json::json!(scaled.map(|x| x.0));
+                v["ellipse_semi_minor_m"] = serde_json::json!(scaled.map(|x| x.1));
+                v["ellipse_azimuth_deg"] = serde_json::json!(e.map(|e| e.azimuth_deg));
+                v["error_model_valid"] = serde_json::json!(r.cov.is_some());
+            }
+            v
+        })
+        .collect();
+    let doc = serde_json::json!({
+        "north_reference": "true",
+        "length_unit": "m",
+        "vsec_azimuth_deg": s.vsec_azimuth_deg,
+        "error_model": s.model.map(|m| m.name),
+        "confidence": s.model.map(|_| s.confidence),
+        "ellipse_convention": s.model.map(|_| "semi-axes: 1-sigma of the NE covariance times sqrt(-2 ln(1 - confidence)); azimuth of the major axis in [0, 180) deg; covariance [nn, ee, vv, ne, nv, ev] m^2"),
+        "note": validity_note(s),
+        "stations": stations,
+    });
+    Ok(serde_json::to_string_pretty(&doc)? + "\n")
+}
+
+fn witsml_text(s: &Survey) -> String {
+    let mut x = String::from(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n\
+         <trajectorys xmlns=\"http://www.witsml.org/schemas/1series\" version=\"1.4.1.1\">\n\
+         \x20 <trajectory uidWell=\"well\" uidWellbore=\"wellbore\" uid=\"survey\">\n\
+         \x20   <nameWell>well</nameWell>\n\
+         \x20   <nameWellbore>wellbore</nameWellbore>\n\
+         \x20   <name>host-sim survey</name>\n",
+    );
+    if let (Some(first), Some(last)) = (s.rows.first(), s.rows.last()) {
+        let _ = writeln!(x, "    <mdMn uom=\"m\">{}</mdMn>", first.md_m);
+        let _ = writeln!(x, "    <mdMx uom=\"m\">{}</mdMx>", last.md_m);
+    }
+    let _ = writeln!(
+        x,
+        "    <aziVertSect uom=\"dega\">{}</aziVertSect>",
+        s.vsec_azimuth_deg
+    );
+    x += "    <aziRef>true north</aziRef>\n";
+    for (k, r) in s.rows.iter().enumerate() {
+        let kind = if k == 0 { "tie in point" } else { "unknown" };
+        let _ = write!(
+            x,
+            "    <trajectoryStation uid=\"st{k}\">\n\
+             \x20     <typeTrajStation>{kind}</typeTrajStation>\n\
+             \x20     <md uom=\"m\">{}</md>\n\
+             \x20     <tvd uom=\"m\">{}</tvd>\n\
+             \x20     <incl uom=\"dega\">{}</incl>\n\
+             \x20     <azi uom=\"dega\">{}</azi>\n\
+             \x20     <dispNs uom=\"m\">{}</dispNs>\n\
+             \x20     <dispEw uom=\"m\">{}</dispEw>\n\
+             \x20     <vertSect uom=\"m\">{}</vertSect>\n\
+             \x20     <dls uom=\"dega/30m\">{}</dls>\n\
+             \x20   </trajectoryStation>\n",
+            r.md_m, r.tvd_m, r.inc_deg, r.azi_deg, r.north_m, r.east_m, r.vsec_m, r.dls_deg_per_30m
+        );
+    }
+    x += "  </trajectory>\n</trajectorys>\n";
+    x
+}

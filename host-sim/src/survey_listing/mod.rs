@@ -1,0 +1,399 @@
+//! `host-sim survey`: a station file (CSV) read, positioned by minimum
+//! curvature (`mwd_core::survey`) and, with an error model, given its NEV
+//! covariance and error ellipse at every station ([`crate::survey_error`]).
+//!
+//! Input: a header line, then one station a line. Columns (any order):
+//! `md_m` or `md_ft` (one of them: feet and metres are never mixed, and
+//! every length column of the file must be in the same unit), `inc_deg`,
+//! `azi_deg` required; `toolface_deg`, `time_s` optional (carried to the
+//! outputs). Outputs are in metres whatever the input unit.
+
+pub mod ellipse;
+
+use crate::analysis::text_records::{excerpt, for_each_record};
+use crate::survey_error::{self, Cov6, ErrorTerm, Site};
+use anyhow::{anyhow, bail, Context, Result};
+use ellipse::Ellipse;
+use mwd_core::survey::{positions, GridConvergence, Station, TieOn, TrueNorth};
+use nalgebra::Matrix3;
+use std::io::Read;
+
+/// Metres per international foot.
+pub const FOOT_M: f64 = 0.3048;
+
+/// Length unit of a station file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LengthUnit {
+    Metre,
+    Foot,
+}
+
+impl LengthUnit {
+    pub fn to_m(self) -> f64 {
+        match self {
+            Self::Metre => 1.0,
+            Self::Foot => FOOT_M,
+        }
+    }
+}
+
+/// One row of a station file, as read (lengths in the file's unit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InputStation {
+    pub md: f64,
+    pub inc_deg: f64,
+    pub azi_deg: f64,
+    pub toolface_deg: Option<f64>,
+    pub time_s: Option<f64>,
+}
+
+/// A station file: its unit and rows, checked (finite, MD increasing,
+/// inclination in 0..=180 deg, at least one station).
+#[derive(Clone, Debug)]
+pub struct StationFile {
+    pub unit: LengthUnit,
+    pub stations: Vec<InputStation>,
+}
+
+struct Columns {
+    md: usize,
+    inc: usize,
+    azi: usize,
+    toolface: Option<usize>,
+    time: Option<usize>,
+    unit: LengthUnit,
+}
+
+fn columns(header: &[&str]) -> Result<Columns> {
+    let find = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
+    let metres: Vec<&str> = header
+        .iter()
+        .copied()
+        .filter(|h| h.ends_with("_m"))
+        .collect();
+    let feet: Vec<&str> = header
+        .iter()
+        .copied()
+        .filter(|h| h.ends_with("_ft"))
+        .collect();
+    if !metres.is_empty() && !feet.is_empty() {
+        bail!(
+            "the header mixes feet and metres ({} and {}): give every length in one unit",
+            metres.join(", "),
+            feet.join(", ")
+        );
+    }
+    let (md, unit) = match (find("md_m"), find("md_ft")) {
+        (Some(c), None) => (c, LengthUnit::Metre),
+        (None, Some(c)) => (c, LengthUnit::Foot),
+        _ => bail!(
+            "no column md_m or md_ft in the header `{}` (required: md_m or md_ft, inc_deg, azi_deg)",
+            excerpt(&header.join(","))
+        ),
+    };
+    let need = |name: &str| {
+        find(name).ok_or_else(|| {
+            anyhow!(
+                "no column {name} in the header `{}` (required: md_m or md_ft, inc_deg, azi_deg)",
+                excerpt(&header.join(","))
+            )
+        })
+    };
+    Ok(Columns {
+        md,
+        inc: need("inc_deg")?,
+        azi: need("azi_deg")?,
+        toolface: find("toolface_deg"),
+        time: find("time_s"),
+        unit,
+    })
+}
+
+fn number(fields: &[&str], col: usize, name: &str, line: u64) -> Result<f64> {
+    let text = fields
+        .get(col)
+        .ok_or_else(|| anyhow!("line {line}: no {name} (too few fields)"))?;
+    let value: f64 = text
+        .parse()
+        .map_err(|_| anyhow!("line {line}: {name} `{}` is not a number", excerpt(text)))?;
+    if !value.is_finite() {
+        bail!("line {line}: {name} is {value}, not a finite number");
+    }
+    Ok(value)
+}
+
+fn optional(fields: &[&str], col: Option<usize>, name: &str, line: u64) -> Result<Option<f64>> {
+    match col {
+        Some(c) if fields.get(c).is_some_and(|f| !f.is_empty()) => {
+            number(fields, c, name, line).map(Some)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// Reads and checks a station file.
+pub fn read_stations<R: Read>(input: R) -> Result<StationFile> {
+    let mut cols: Option<Columns> = None;
+    let mut stations: Vec<InputStation> = Vec::new();
+    for_each_record(input, |line, fields| {
+        let Some(c) = &cols else {
+            cols = Some(columns(fields)?);
+            return Ok(());
+        };
+        let unit = if c.unit == LengthUnit::Metre {
+            "md_m"
+        } else {
+            "md_ft"
+        };
+        let s = InputStation {
+            md: number(fields, c.md, unit, line)?,
+            inc_deg: number(fields, c.inc, "inc_deg", line)?,
+            azi_deg: number(fields, c.azi, "azi_deg", line)?,
+            toolface_deg: optional(fields, c.toolface, "toolface_deg", line)?,
+            time_s: optional(fields, c.time, "time_s", line)?,
+        };
+        if !(0.0..=180.0).contains(&s.inc_deg) {
+            bail!("line {line}: inclination {} deg outside 0..180", s.inc_deg);
+        }
+        if let Some(prev) = stations.last() {
+            if s.md <= prev.md {
+                bail!(
+                    "line {line}: MD {} is not beyond the previous station's {} (MD must increase)",
+                    s.md,
+                    prev.md
+                );
+            }
+        }
+        stations.push(s);
+        Ok(())
+    })?;
+    let Some(c) = cols else {
+        bail!(
+            "the file is empty: expected a header (md_m or md_ft, inc_deg, azi_deg) and stations"
+        );
+    };
+    if stations.is_empty() {
+        bail!("no stations after the header");
+    }
+    Ok(StationFile {
+        unit: c.unit,
+        stations,
+    })
+}
+
+/// North reference of the file's azimuths.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AzimuthReference {
+    True,
+    /// Grid azimuths with this convergence (rad): true = grid + convergence.
+    Grid(f64),
+}
+
+/// The tie-on, in the file's unit (north and east along true north).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TieOnInput {
+    pub md: Option<f64>,
+    pub tvd: f64,
+    pub north: f64,
+    pub east: f64,
+}
+
+/// A station with its position (metres, true north) and, with a model, its
+/// covariance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    pub input: InputStation,
+    pub md_m: f64,
+    pub inc_deg: f64,
+    /// True azimuth, deg.
+    pub azi_deg: f64,
+    pub tvd_m: f64,
+    pub north_m: f64,
+    pub east_m: f64,
+    pub dls_deg_per_30m: f64,
+    pub vsec_m: f64,
+    /// NEV covariance (m^2) when an error model was run and is valid here.
+    pub cov: Option<Cov6>,
+}
+
+impl Row {
+    pub fn ellipse(&self) -> Option<Ellipse> {
+        self.cov.as_ref().map(Ellipse::from_cov)
+    }
+}
+
+/// Positions by minimum curvature from the tie-on (true north), with the
+/// vertical section along `vsec_azimuth` (rad; `None`: the closure azimuth
+/// of the last station).
+pub fn compute(
+    file: &StationFile,
+    reference: AzimuthReference,
+    tie: TieOnInput,
+    vsec_azimuth: Option<f64>,
+) -> Result<(Vec<Row>, f64)> {
+    let k = file.unit.to_m();
+    let first = file.stations[0].md;
+    if let Some(md) = tie.md {
+        if md != first {
+            bail!(
+                "the tie-on MD {md} is not the first station's MD {first}: the first station is the tie-on"
+            );
+        }
+    }
+    let tie_on = TieOn::<TrueNorth>::new(
+        first * k,
+        tie.tvd * k,
+        tie.north * k,
+        tie.east * k,
+        Matrix3::zeros(),
+    )
+    .map_err(|e| anyhow!("tie-on: {e:?}"))?;
+    let stations = file
+        .stations
+        .iter()
+        .map(|s| {
+            let azi = s.azi_deg.to_radians();
+            let azi = match reference {
+                AzimuthReference::True => azi,
+                AzimuthReference::Grid(c) => GridConvergence::new(c)
+                    .map_err(|e| anyhow!("convergence: {e:?}"))?
+                    .true_azimuth(azi),
+            };
+            Station::<TrueNorth>::new(s.md * k, s.inc_deg.to_radians(), azi)
+                .map_err(|e| anyhow!("station at MD {}: {e:?}", s.md))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let points = positions(&tie_on, &stations)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| anyhow!("minimum curvature: {e:?}"))?;
+    let last = points.last().context("no stations")?;
+    let direction = vsec_azimuth.unwrap_or_else(|| {
+        let (n, e) = (last.north() - tie_on.nev().x, last.east() - tie_on.nev().y);
+        if n == 0.0 && e == 0.0 {
+            0.0
+        } else {
+            e.atan2(n).rem_euclid(std::f64::consts::TAU)
+        }
+    });
+    let rows = points
+        .iter()
+        .zip(&file.stations)
+        .map(|(p, input)| Row {
+            input: *input,
+            md_m: p.station.md(),
+            inc_deg: p.station.inclination().to_degrees(),
+            azi_deg: p.station.azimuth().to_degrees(),
+            tvd_m: p.tvd(),
+            north_m: p.north(),
+            east_m: p.east(),
+            dls_deg_per_30m: p.dls_deg_per_30m,
+            vsec_m: p.vertical_section(direction),
+            cov: None,
+        })
+        .collect();
+    Ok((rows, direction))
+}
+
+/// An error model the tool knows: its term table (embedded) and the
+/// inclination range it is stated for.
+#[derive(Clone, Copy, Debug)]
+pub struct KnownModel {
+    pub name: &'static str,
+    pub table: &'static str,
+    pub file: &'static str,
+    /// Largest inclination the model is stated for, deg.
+    pub max_inc_deg: f64,
+    /// Needs the magnetic field (B total, dip, declination).
+    pub magnetic: bool,
+}
+
+/// The embedded models (`host-sim/data/README.md`).
+pub const MODELS: [KnownModel; 3] = [
+    KnownModel {
+        name: "ISCWSA MWD Rev5",
+        table: include_str!("../../data/mwd_rev5_model_terms.csv"),
+        file: "mwd_rev5_model_terms.csv",
+        max_inc_deg: 180.0,
+        magnetic: true,
+    },
+    KnownModel {
+        name: "GYRO-MWD",
+        table: include_str!("../../data/owsg_gyro_mwd_terms.csv"),
+        file: "owsg_gyro_mwd_terms.csv",
+        max_inc_deg: 89.0,
+        magnetic: false,
+    },
+    KnownModel {
+        name: "GYRO-NS",
+        table: include_str!("../../data/owsg_gyro_ns_terms.csv"),
+        file: "owsg_gyro_ns_terms.csv",
+        max_inc_deg: 89.0,
+        magnetic: false,
+    },
+];
+
+/// The model of that name (case and spacing of the name ignored).
+pub fn model(name: &str) -> Result<&'static KnownModel> {
+    let key = |s: &str| {
+        s.split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+            .to_ascii_uppercase()
+    };
+    MODELS
+        .iter()
+        .find(|m| key(m.name) == key(name))
+        .ok_or_else(|| {
+            let names: Vec<&str> = MODELS.iter().map(|m| m.name).collect();
+            anyhow!(
+                "unknown error model `{}` (known: {})",
+                excerpt(name),
+                names.join(", ")
+            )
+        })
+}
+
+/// The model's terms, parsed from the embedded table.
+pub fn terms(model: &KnownModel) -> Result<Vec<ErrorTerm>> {
+    survey_error::parse_term_table(model.table, model.file).map_err(|e| anyhow!("{e}"))
+}
+
+/// Runs the model over the rows (first = tie-on, taken as exact). Stations
+/// from the first beyond the model's inclination limit on get no
+/// covariance (the model is not extrapolated); returns the index of that
+/// first station, if any.
+pub fn apply_model(
+    rows: &mut [Row],
+    model: &KnownModel,
+    terms: &[ErrorTerm],
+    site: &Site,
+) -> Result<Option<usize>> {
+    let valid_to = rows
+        .iter()
+        .position(|r| r.inc_deg > model.max_inc_deg)
+        .unwrap_or(rows.len());
+    let stations: Vec<survey_error::Station> = rows[..valid_to]
+        .iter()
+        .map(|r| survey_error::Station {
+            md: r.md_m,
+            inc: r.inc_deg.to_radians(),
+            azi: r.azi_deg.to_radians(),
+            tvd: r.tvd_m,
+        })
+        .collect();
+    if !stations.is_empty() {
+        survey_error::check_stations(&stations).map_err(|e| anyhow!("{e}"))?;
+        let result = survey_error::run(terms, &stations, site);
+        if !result.missing.is_empty() {
+            bail!(
+                "error model {}: weighting functions not implemented for {}",
+                model.name,
+                result.missing.join(", ")
+            );
+        }
+        for (row, cov) in rows.iter_mut().zip(result.total) {
+            row.cov = Some(cov);
+        }
+    }
+    Ok((valid_to < rows.len()).then_some(valid_to))
+}
