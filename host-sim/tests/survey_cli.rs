@@ -1,0 +1,352 @@
+//! `host-sim survey` through the binary: bad input refused with a sentence
+//! and a non-zero exit (never a panic), and ISCWSA test well #1 against
+//! the published numbers.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+struct Run {
+    code: Option<i32>,
+    stdout: String,
+    stderr: String,
+}
+
+fn host_sim(args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("survey")
+        .args(args)
+        .output()
+        .expect("host-sim runs");
+    Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into(),
+        stderr: String::from_utf8_lossy(&out.stderr).into(),
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("survey-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn well1() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa/well1_stations.csv")
+}
+
+/// Well #1's site (tests/data/iscwsa/wells.json).
+const WELL1_SITE: [&str; 8] = [
+    "--lat",
+    "60",
+    "--b-total-nt",
+    "50000",
+    "--dip-deg",
+    "72",
+    "--declination-deg",
+    "-4",
+];
+
+fn refused(run: &Run, needle: &str) {
+    assert!(
+        matches!(run.code, Some(1 | 2)),
+        "exit {:?}, stderr {}",
+        run.code,
+        run.stderr
+    );
+    assert!(
+        run.stderr.contains(needle),
+        "`{needle}` not in stderr: {}",
+        run.stderr
+    );
+    assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
+}
+
+fn refused_file(name: &str, text: &str, extra: &[&str], needle: &str) {
+    let path = scratch(name).join("stations.csv");
+    std::fs::write(&path, text).unwrap();
+    let mut args = vec![s(&path)];
+    args.extend_from_slice(extra);
+    refused(&host_sim(&args), needle);
+}
+
+#[test]
+fn md_not_increasing() {
+    refused_file(
+        "md",
+        "md_m,inc_deg,azi_deg\n0,0,0\n30,1,10\n30,2,10\n",
+        &[],
+        "MD must increase",
+    );
+}
+
+#[test]
+fn inclination_out_of_range() {
+    refused_file(
+        "inc",
+        "md_m,inc_deg,azi_deg\n0,0,0\n30,181,10\n",
+        &[],
+        "outside 0..180",
+    );
+    refused_file(
+        "inc-neg",
+        "md_m,inc_deg,azi_deg\n0,0,0\n30,-1,10\n",
+        &[],
+        "outside 0..180",
+    );
+}
+
+#[test]
+fn nan_value() {
+    refused_file(
+        "nan",
+        "md_m,inc_deg,azi_deg\n0,0,0\n30,NaN,10\n",
+        &[],
+        "not a finite number",
+    );
+}
+
+#[test]
+fn empty_file_and_header_only() {
+    refused_file("empty", "", &[], "empty");
+    refused_file("header", "md_m,inc_deg,azi_deg\n", &[], "no stations");
+}
+
+#[test]
+fn missing_column() {
+    refused_file("col", "md_m,inc_deg\n0,0\n30,1\n", &[], "no column azi_deg");
+    refused_file(
+        "md",
+        "inc_deg,azi_deg\n0,0\n",
+        &[],
+        "no column md_m or md_ft",
+    );
+}
+
+#[test]
+fn feet_and_metres_mixed() {
+    refused_file(
+        "mixed",
+        "md_ft,inc_deg,azi_deg,tvd_m\n0,0,0,0\n100,1,10,30\n",
+        &[],
+        "mixes feet and metres",
+    );
+    refused_file(
+        "both-md",
+        "md_m,md_ft,inc_deg,azi_deg\n0,0,0,0\n",
+        &[],
+        "mixes feet and metres",
+    );
+}
+
+#[test]
+fn unknown_model() {
+    refused(
+        &host_sim(&[s(&well1()), "--error-model", "NO SUCH MODEL"]),
+        "unknown error model",
+    );
+}
+
+#[test]
+fn magnetic_model_needs_the_field() {
+    refused(
+        &host_sim(&[s(&well1()), "--error-model", "ISCWSA MWD Rev5"]),
+        "--b-total-nt",
+    );
+}
+
+#[test]
+fn bad_flags() {
+    refused(&host_sim(&[s(&well1()), "--confidence", "1"]), "confidence");
+    refused(
+        &host_sim(&[s(&well1()), "--azimuth-reference", "grid"]),
+        "--convergence-deg",
+    );
+    refused(&host_sim(&[s(&well1()), "--tie-on-md", "5"]), "tie-on MD");
+}
+
+/// OWSG gyro models are stated up to 89 deg: well #1 reaches 90 deg, so
+/// the stations beyond get no uncertainty, flagged in every output.
+#[test]
+fn gyro_model_outside_its_inclination_range_is_flagged() {
+    let dir = scratch("gyro");
+    let csv = dir.join("out.csv");
+    let run = host_sim(&[
+        s(&well1()),
+        "--lat",
+        "60",
+        "--error-model",
+        "GYRO-MWD",
+        "--csv",
+        s(&csv),
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains("stated for inclinations up to 89 deg"));
+    assert!(run.stdout.contains("outside the model's validity"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let valid = header
+        .iter()
+        .position(|h| *h == "error_model_valid")
+        .unwrap();
+    let sigma = header.iter().position(|h| *h == "sigma_north_m").unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let flagged: Vec<&Vec<&str>> = rows.iter().filter(|r| r[valid] == "false").collect();
+    assert!(!flagged.is_empty());
+    assert!(flagged.iter().all(|r| r[sigma].is_empty()));
+    let first_bad = rows.iter().position(|r| r[valid] == "false").unwrap();
+    let inc: f64 = rows[first_bad][1].parse().unwrap();
+    assert!(inc > 89.0);
+    assert!(rows[..first_bad]
+        .iter()
+        .all(|r| r[1].parse::<f64>().unwrap() <= 89.0));
+}
+
+fn column(header: &[&str], row: &[&str], name: &str) -> f64 {
+    let c = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    row[c].parse().unwrap()
+}
+
+/// Well #1 with the Rev 5.10 table: positions against the workbook's
+/// typed-in TVD (`well1_survey.csv`) and sigmas against the WB5.10-#1
+/// TOTALS (`mwd_rev5_well1_workbook_totals_nev.csv`) at 2100 and 8000 m.
+#[test]
+fn iscwsa_well_1() {
+    let dir = scratch("well1");
+    let (csv, json, xml) = (dir.join("o.csv"), dir.join("o.json"), dir.join("o.xml"));
+    let well = well1();
+    let mut args = vec![s(&well), "--error-model", "ISCWSA MWD Rev5"];
+    args.extend_from_slice(&WELL1_SITE);
+    args.extend_from_slice(&["--csv", s(&csv), "--json", s(&json), "--witsml", s(&xml)]);
+    let run = host_sim(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for name in [
+        "md_m",
+        "inc_deg",
+        "azi_deg",
+        "tvd_m",
+        "north_m",
+        "east_m",
+        "dls_deg_per_30m",
+        "vsec_m",
+        "sigma_north_m",
+        "sigma_east_m",
+        "sigma_vert_m",
+        "ellipse_semi_major_m",
+        "ellipse_semi_minor_m",
+        "ellipse_azimuth_deg",
+        "confidence",
+    ] {
+        assert!(header.contains(&name), "no {name}");
+    }
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 268);
+    let at = |md: f64| {
+        rows.iter()
+            .find(|r| r[0].parse::<f64>().unwrap() == md)
+            .unwrap()
+    };
+    // (md, published TVD (2 decimals), NN, EE, VV of the WB5.10-#1 TOTALS)
+    let published: [(f64, f64, f64, f64, f64); 2] = [
+        (
+            2100.0,
+            1944.29,
+            34.057_543_625_468_35,
+            9.072_824_958_552_928,
+            4.393_471_335_216_398,
+        ),
+        (
+            8000.0,
+            3521.06,
+            8_518.672_125_607_51,
+            711.200_490_342_599_1,
+            513.294_279_080_466_5,
+        ),
+    ];
+    for (md, tvd, nn, ee, vv) in published {
+        let r = at(md);
+        assert!((column(&header, r, "tvd_m") - tvd).abs() < 0.006);
+        let sn = column(&header, r, "sigma_north_m");
+        let se = column(&header, r, "sigma_east_m");
+        let sv = column(&header, r, "sigma_vert_m");
+        for (got, want) in [(sn, nn.sqrt()), (se, ee.sqrt()), (sv, vv.sqrt())] {
+            assert!((got - want).abs() < 1e-3 * want, "MD {md}: {got} vs {want}");
+        }
+        let major = column(&header, r, "ellipse_semi_major_m");
+        let minor = column(&header, r, "ellipse_semi_minor_m");
+        let k = (-2.0 * (0.05f64).ln()).sqrt();
+        // the 1-sigma semi-axes bracket the N and E sigmas
+        assert!(major / k >= sn.max(se) - 1e-9 && minor / k <= sn.min(se) + 1e-9);
+        let az = column(&header, r, "ellipse_azimuth_deg");
+        assert!((0.0..180.0).contains(&az));
+    }
+    // 8000 m: horizontal at 75 deg azimuth, N/E from the closure
+    let r = at(8000.0);
+    let (n, e) = (column(&header, r, "north_m"), column(&header, r, "east_m"));
+    assert!((e.atan2(n).to_degrees() - 75.0).abs() < 1e-6);
+    // JSON and WITSML
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(doc["stations"].as_array().unwrap().len(), 268);
+    let xml = std::fs::read_to_string(&xml).unwrap();
+    assert!(xml.contains("xmlns=\"http://www.witsml.org/schemas/1series\""));
+    assert!(xml.contains("version=\"1.4.1.1\""));
+    assert_eq!(xml.matches("<trajectoryStation ").count(), 268);
+    assert_eq!(xml.matches("</trajectoryStation>").count(), 268);
+    for tag in [
+        "md", "tvd", "incl", "azi", "dispNs", "dispEw", "vertSect", "dls",
+    ] {
+        assert_eq!(xml.matches(&format!("<{tag} uom=")).count(), 268, "{tag}");
+    }
+    assert!(well_formed(&xml));
+}
+
+/// A light well-formedness check: every open tag closed in order.
+fn well_formed(xml: &str) -> bool {
+    let mut stack: Vec<&str> = Vec::new();
+    let mut rest = xml;
+    while let Some(start) = rest.find('<') {
+        let Some(len) = rest[start..].find('>') else {
+            return false;
+        };
+        let tag = &rest[start + 1..start + len];
+        rest = &rest[start + len + 1..];
+        if tag.starts_with('?') {
+            continue;
+        }
+        if let Some(name) = tag.strip_prefix('/') {
+            if stack.pop() != Some(name.trim()) {
+                return false;
+            }
+        } else if !tag.ends_with('/') {
+            stack.push(tag.split_whitespace().next().unwrap_or(""));
+        }
+    }
+    stack.is_empty()
+}
+
+#[test]
+fn feet_input_is_converted() {
+    let path = scratch("feet").join("stations.csv");
+    std::fs::write(&path, "md_ft,inc_deg,azi_deg\n0,0,0\n1000,0,0\n").unwrap();
+    let csv = path.with_extension("out.csv");
+    let run = host_sim(&[s(&path), "--csv", s(&csv)]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let last: Vec<&str> = text.lines().last().unwrap().split(',').collect();
+    assert!((last[0].parse::<f64>().unwrap() - 304.8).abs() < 1e-9);
+    assert!((last[3].parse::<f64>().unwrap() - 304.8).abs() < 1e-9);
+}
