@@ -218,8 +218,9 @@ fn column(header: &[&str], row: &[&str], name: &str) -> f64 {
 }
 
 /// Well #1 with the Rev 5.10 table: positions against the workbook's
-/// typed-in TVD (`well1_survey.csv`) and sigmas against the WB5.10-#1
-/// TOTALS (`mwd_rev5_well1_workbook_totals_nev.csv`) at 2100 and 8000 m.
+/// typed-in TVD (`well1_survey.csv`) and sigmas against the published
+/// ISCWSA Rev 5.1 diagnostic TOTALs at the four tabulated depths (equal to
+/// the WB5.10-#1 TOTALS sheet).
 #[test]
 fn iscwsa_well_1() {
     let dir = scratch("well1");
@@ -260,21 +261,13 @@ fn iscwsa_well_1() {
             .unwrap()
     };
     // (md, published TVD (2 decimals), NN, EE, VV of the WB5.10-#1 TOTALS)
-    let published: [(f64, f64, f64, f64, f64); 2] = [
-        (
-            2100.0,
-            1944.29,
-            34.057_543_625_468_35,
-            9.072_824_958_552_928,
-            4.393_471_335_216_398,
-        ),
-        (
-            8000.0,
-            3521.06,
-            8_518.672_125_607_51,
-            711.200_490_342_599_1,
-            513.294_279_080_466_5,
-        ),
+    // ISCWSA Rev 5.1 diagnostics (HPT .dat), TOTAL rows of well #1
+    // (tests/data/iscwsa/mwd_rev5_1_hpt_diagnostics_selected_rows.csv), m^2
+    let published: [(f64, f64, f64, f64, f64); 4] = [
+        (1200.0, 1200.0, 1.5352, 1.5352, 0.7037),
+        (2100.0, 1944.29, 34.0575, 9.0728, 4.3935),
+        (5100.0, 3444.29, 2073.1747, 215.9499, 134.5116),
+        (8000.0, 3521.06, 8518.6721, 711.2004, 513.2943),
     ];
     for (md, tvd, nn, ee, vv) in published {
         let r = at(md);
