@@ -223,8 +223,9 @@ impl Row {
 }
 
 /// Positions by minimum curvature from the tie-on (true north), with the
-/// vertical section along `vsec_azimuth` (rad; `None`: the closure azimuth
-/// of the last station).
+/// vertical section (from the origin of north and east) along
+/// `vsec_azimuth` (rad; `None`: the closure azimuth of the last station
+/// from that origin).
 pub fn compute(
     file: &StationFile,
     reference: AzimuthReference,
@@ -268,7 +269,7 @@ pub fn compute(
         .map_err(|e| anyhow!("minimum curvature: {e:?}"))?;
     let last = points.last().context("no stations")?;
     let direction = vsec_azimuth.unwrap_or_else(|| {
-        let (n, e) = (last.north() - tie_on.nev().x, last.east() - tie_on.nev().y);
+        let (n, e) = (last.north(), last.east());
         if n == 0.0 && e == 0.0 {
             0.0
         } else {
@@ -396,4 +397,59 @@ pub fn apply_model(
         }
     }
     Ok((valid_to < rows.len()).then_some(valid_to))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(text: &str) -> StationFile {
+        read_stations(text.as_bytes()).unwrap()
+    }
+
+    #[test]
+    fn embedded_tables_parse() {
+        for m in &MODELS {
+            let terms = terms(m).unwrap();
+            assert!(terms.len() >= 18, "{}", m.name);
+        }
+        assert_eq!(model("iscwsa  mwd rev5").unwrap().name, "ISCWSA MWD Rev5");
+        assert!(model("ISCWSA MWD Rev4").is_err());
+    }
+
+    #[test]
+    fn grid_azimuths_and_tie_on() {
+        let f = file("md_m,inc_deg,azi_deg,toolface_deg,time_s\n100,90,0,10,1\n200,90,0,,2\n");
+        assert_eq!(f.stations[0].toolface_deg, Some(10.0));
+        assert_eq!(f.stations[1].toolface_deg, None);
+        let tie = TieOnInput {
+            md: Some(100.0),
+            tvd: 50.0,
+            north: 10.0,
+            east: -5.0,
+        };
+        let grid = AzimuthReference::Grid(2f64.to_radians());
+        let (rows, vsec) = compute(&f, grid, tie, None).unwrap();
+        assert!((rows[0].north_m - 10.0).abs() < 1e-12);
+        assert!((rows[0].tvd_m - 50.0).abs() < 1e-12);
+        // grid north + 2 deg convergence = true azimuth 2 deg
+        assert!((rows[1].azi_deg - 2.0).abs() < 1e-9);
+        let c = 2f64.to_radians();
+        assert!((rows[1].north_m - (10.0 + 100.0 * c.cos())).abs() < 1e-9);
+        assert!((rows[1].east_m - (-5.0 + 100.0 * c.sin())).abs() < 1e-9);
+        assert!((rows[1].tvd_m - 50.0).abs() < 1e-9);
+        // default vertical section: closure of the last station
+        let closure = rows[1]
+            .east_m
+            .atan2(rows[1].north_m)
+            .rem_euclid(std::f64::consts::TAU);
+        assert!((vsec - closure).abs() < 1e-12);
+        assert!((rows[1].vsec_m - rows[1].north_m.hypot(rows[1].east_m)).abs() < 1e-9);
+        // the tie-on MD must be the first station's
+        let bad = TieOnInput {
+            md: Some(0.0),
+            ..tie
+        };
+        assert!(compute(&f, AzimuthReference::True, bad, None).is_err());
+    }
 }
