@@ -18,8 +18,9 @@ pub enum Reference {
     Grid,
 }
 
-fn finite(text: &str) -> Result<f64, String> {
-    number_in(text, "the value", (-1e6, 1e6), "")
+/// Tie-on numbers, in the file's length unit.
+fn tie_on(text: &str) -> Result<f64, String> {
+    number_in(text, "a tie-on value", (-1e6, 1e6), "(file's length unit)")
 }
 fn convergence_deg(text: &str) -> Result<f64, String> {
     number_in(text, "the grid convergence", (-90.0, 90.0), "deg")
@@ -37,7 +38,7 @@ fn azimuth_deg(text: &str) -> Result<f64, String> {
     number_in(text, "the vertical-section azimuth", (0.0, 360.0), "deg")
 }
 fn confidence(text: &str) -> Result<f64, String> {
-    let p = number_in(text, "the confidence", (0.0, 1.0), "")?;
+    let p = number_in(text, "the confidence", (0.0, 1.0), "(probability)")?;
     if p == 0.0 || p == 1.0 {
         return Err("the confidence must be between 0 and 1, exclusive".into());
     }
@@ -58,16 +59,16 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, value_parser = convergence_deg)]
     pub convergence_deg: Option<f64>,
     /// MD of the tie-on (file's unit): must be the first station's MD.
-    #[arg(long, allow_hyphen_values = true, value_parser = finite)]
+    #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_md: Option<f64>,
     /// TVD of the tie-on (file's unit).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_tvd: f64,
     /// North of the tie-on (file's unit, true north).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_north: f64,
     /// East of the tie-on (file's unit, true north).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_east: f64,
     /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS".
     #[arg(long)]
