@@ -86,6 +86,7 @@ pub struct ErrorTerm {
     pub propagation: Propagation,
 }
 
+pub mod probe_model;
 #[cfg(test)]
 mod tests;
 
