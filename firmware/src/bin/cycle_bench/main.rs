@@ -1,7 +1,8 @@
 //! One 20 Hz filter cycle (mechanization, time update, ZUPT and
 //! zero-position updates, feedback) counted in SysTick ticks on QEMU's
 //! mps2-an386 with `-icount shift=0`, fast vs dense, f32 vs f64, 33 states
-//! and (fast f32) 39 states with the sensor biases.
+//! and (fast f32) 39 states with the sensor biases; and one survey
+//! station's minimum-curvature step (f64, docs/survey-benchmarks.md).
 //!
 //! Under `-icount shift=0` every instruction advances virtual time by 1 ns;
 //! SysTick runs from the 25 MHz board clock, so it ticks every 40
@@ -26,6 +27,7 @@ use mwd_core::error_model::{
 use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use mwd_core::kalman::{dense, FilterScalar};
 use mwd_core::mechanization::{ImuSample, NavState, Strapdown};
+use mwd_core::survey::{Segment, TrueStation};
 use nalgebra::{SMatrix, SVector, Vector3};
 
 const RELOAD: u32 = 0x00ff_ffff;
@@ -182,6 +184,31 @@ fn parts<T: FilterScalar, const N: usize>() -> [(&'static str, u32); 5] {
     ]
 }
 
+/// One survey station's minimum-curvature step in f64: the segment from
+/// the previous station (dogleg, checks) and its chord (ratio factor,
+/// north/east/TVD increment) added to the position, with the dogleg
+/// severity, as `mwd_core::survey::positions` does per station. A
+/// 30 m course with a 3 deg/30 m build and a turn; the stations are
+/// validated outside the loop.
+fn min_curvature_step() -> u32 {
+    let (Ok(from), Ok(to)) = (
+        TrueStation::new(1000.0, 0.52, 1.10),
+        TrueStation::new(1030.0, 0.5724, 1.13),
+    ) else {
+        return 0;
+    };
+    let mut nev = Vector3::new(100.0, 200.0, 900.0);
+    let start = SYST::get_current();
+    for _ in 0..CYCLES {
+        if let Ok(seg) = Segment::new(core::hint::black_box(from), core::hint::black_box(to)) {
+            nev += seg.increment();
+            core::hint::black_box(seg.dogleg_severity_deg_per_30m());
+        }
+        core::hint::black_box(&nev);
+    }
+    ticks(start) / CYCLES
+}
+
 /// Ticks of a loop of known length: 1 nop + subs + bne per iteration.
 fn calibration() -> (u32, u32) {
     let n: u32 = 300_000;
@@ -244,6 +271,12 @@ fn main() -> ! {
             t as f32 * per_tick
         );
     }
+    let mc = min_curvature_step();
+    hprintln!(
+        "survey: one station's minimum-curvature step (f64): {} ticks = ~{:.0} instructions",
+        mc,
+        mc as f32 * per_tick
+    );
     debug::exit(debug::EXIT_SUCCESS);
     loop {
         cortex_m::asm::wfi();

@@ -1,0 +1,94 @@
+//! Survey computation on a long well: 10,001 stations 1 m apart (10 km MD:
+//! vertical to 500 m, build at 3 deg/30 m to 60 deg, then a slow turn),
+//! ISCWSA MWD Rev 5 (`host-sim/data/mwd_rev5_model_terms.csv`, 22
+//! sources) at the ISCWSA #1 site. `positions`: minimum curvature
+//! (`mwd_core::survey::positions`); `covariance`: the error model's per-source
+//! and total NEV covariance at every station (`survey_error::run`);
+//! `positions_and_covariance`: both, as a survey command would. Run with
+//! `cargo bench -p host-sim --bench survey` (figures:
+//! docs/survey-benchmarks.md).
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use host_sim::survey_error::{self, Site, Station as ErrStation};
+use mwd_core::survey::{positions, TieOn, TrueNorth, TrueStation};
+use std::hint::black_box;
+use std::path::PathBuf;
+use std::time::Duration;
+
+const STATIONS: usize = 10_001;
+
+fn well() -> Vec<TrueStation> {
+    (0..STATIONS)
+        .map(|k| {
+            let md = k as f64;
+            let inc = ((md - 500.0).max(0.0) * 3.0 / 30.0).min(60.0);
+            let azi = 30.0 + (md - 1100.0).max(0.0) * 0.01;
+            TrueStation::new(md, inc.to_radians(), (azi % 360.0).to_radians())
+                .expect("valid station")
+        })
+        .collect()
+}
+
+fn site() -> Site {
+    Site {
+        gravity: 9.80665,
+        b_total: 50_000.0,
+        dip: 72_f64.to_radians(),
+        declination: -4_f64.to_radians(),
+        vertical_limit: 1e-4_f64.to_radians(),
+        latitude: 60_f64.to_radians(),
+        gyro_noise_reduction: 1.0,
+    }
+}
+
+fn with_tvd(stations: &[TrueStation]) -> Vec<ErrStation> {
+    positions(&TieOn::<TrueNorth>::origin(), stations)
+        .map(|p| {
+            let p = p.expect("valid survey");
+            ErrStation {
+                md: p.station.md(),
+                inc: p.station.inclination(),
+                azi: p.station.azimuth(),
+                tvd: p.tvd(),
+            }
+        })
+        .collect()
+}
+
+fn bench_survey(c: &mut Criterion) {
+    let terms = survey_error::load_term_table(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/mwd_rev5_model_terms.csv"),
+    )
+    .expect("term table");
+    let stations = well();
+    let err_stations = with_tvd(&stations);
+    survey_error::check_stations(&err_stations).expect("valid survey");
+    let site = site();
+    assert!(survey_error::run(&terms, &err_stations, &site)
+        .missing
+        .is_empty());
+    let mut group = c.benchmark_group("survey_10001");
+    group.sample_size(20);
+    group.warm_up_time(Duration::from_millis(500));
+    group.measurement_time(Duration::from_secs(5));
+    group.bench_function("positions", |b| {
+        b.iter(|| {
+            positions(&TieOn::<TrueNorth>::origin(), black_box(&stations))
+                .map(|p| p.expect("valid").tvd())
+                .sum::<f64>()
+        })
+    });
+    group.bench_function("covariance", |b| {
+        b.iter(|| survey_error::run(black_box(&terms), black_box(&err_stations), &site))
+    });
+    group.bench_function("positions_and_covariance", |b| {
+        b.iter(|| {
+            let s = with_tvd(black_box(&stations));
+            survey_error::run(black_box(&terms), &s, &site)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_survey);
+criterion_main!(benches);
