@@ -296,11 +296,13 @@ impl Navigator {
         // Without a usable heading the solution runs on with heading 0 and
         // says so through its (infinite) standard deviation; the filter
         // starts it with its largest prior (30 deg, see `physical`).
-        let (heading, heading_std) = match gyrocompass(core::slice::from_ref(segment), &config) {
-            _ if !gyrocompass_possible => (0.0, f64::INFINITY),
-            Ok(h) if h.determined => (h.heading.value, h.heading.sigma),
-            Ok(h) => (h.heading.value, f64::INFINITY),
-            Err(_) => (0.0, f64::INFINITY),
+        // One part's gyro alone cannot gyrocompass: not even tried.
+        let estimate =
+            gyrocompass_possible.then(|| gyrocompass(core::slice::from_ref(segment), &config));
+        let (heading, heading_std) = match estimate {
+            Some(Ok(h)) if h.determined => (h.heading.value, h.heading.sigma),
+            Some(Ok(h)) => (h.heading.value, f64::INFINITY),
+            Some(Err(_)) | None => (0.0, f64::INFINITY),
         };
         let sigma = [roll_pitch_std[0], roll_pitch_std[1], heading_std];
         self.coarse_std = sigma.map(|s| s as f32);

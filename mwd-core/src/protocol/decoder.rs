@@ -297,6 +297,7 @@ pub fn starts_a_run(seq: u16, payload: &Payload) -> bool {
 
 #[cfg(test)]
 mod tests {
+    use super::super::example::boot_event;
     use super::super::frame::{Event, EventKind, Payload, NO_PART};
     use super::super::wire::{FrameEncoder, MAX_WIRE_LEN};
     use super::*;
@@ -379,16 +380,6 @@ mod tests {
         })
     }
 
-    fn boot() -> Payload {
-        Payload::Event(Event {
-            time_us: 0,
-            kind: EventKind::Boot,
-            part: NO_PART,
-            code: 1,
-            value: 0,
-        })
-    }
-
     /// Decodes frames given as (sequence number, payload).
     fn stats_of(frames: impl IntoIterator<Item = (u16, Payload)>) -> DecoderStats {
         let mut buf = [0u8; MAX_WIRE_LEN];
@@ -403,7 +394,7 @@ mod tests {
     /// A probe run: its boot event, then `samples` raw and navigation
     /// frames (the navigation ones stand in as events here), from `from`.
     fn run(samples: u32) -> impl Iterator<Item = (u16, Payload)> {
-        core::iter::once((0, boot())).chain((0..samples).flat_map(|n| {
+        core::iter::once((0, boot_event())).chain((0..samples).flat_map(|n| {
             let seq = (1 + 2 * n) as u16;
             [(seq, raw(n)), (seq.wrapping_add(1), event(n))]
         }))
