@@ -3,35 +3,13 @@
 //! with a panic (exit 101) or a silent success, and text tables with a
 //! byte-order mark or a quoted header read as the plain ones do.
 
+mod common;
+
+use common::{run as host_sim, s, Run};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-struct Run {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-fn host_sim(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .args(args)
-        .output()
-        .expect("host-sim runs");
-    Run {
-        code: out.status.code(),
-        stdout: String::from_utf8_lossy(&out.stdout).into(),
-        stderr: String::from_utf8_lossy(&out.stderr).into(),
-    }
-}
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bad-input-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::scratch("bad-input-cli", name)
 }
 
 /// A refusal: exit 1 or 2 (clap), an error containing `needle`, short.

@@ -2,36 +2,17 @@
 //! and a non-zero exit (never a panic), and ISCWSA test well #1 against
 //! the published numbers.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-struct Run {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
+use common::{s, Run};
+use std::path::{Path, PathBuf};
 
 fn host_sim(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .arg("survey")
-        .args(args)
-        .output()
-        .expect("host-sim runs");
-    Run {
-        code: out.status.code(),
-        stdout: String::from_utf8_lossy(&out.stdout).into(),
-        stderr: String::from_utf8_lossy(&out.stderr).into(),
-    }
+    common::run(&[&["survey"], args].concat())
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("survey-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::scratch("survey-cli", name)
 }
 
 fn well1() -> PathBuf {
