@@ -278,12 +278,42 @@ struct Weight {
     singular: Option<[f64; 3]>,
 }
 
+/// Sines and cosines of a station's inclination and azimuth, computed once
+/// per station: every error source's weighting, the leg tangents and their
+/// derivatives all read them.
+#[derive(Clone, Copy, Debug)]
+struct StationTrig {
+    sin_inc: f64,
+    cos_inc: f64,
+    sin_azi: f64,
+    cos_azi: f64,
+}
+
+impl StationTrig {
+    fn of(s: &Station) -> Self {
+        let (sin_inc, cos_inc) = s.inc.sin_cos();
+        let (sin_azi, cos_azi) = s.azi.sin_cos();
+        Self {
+            sin_inc,
+            cos_inc,
+            sin_azi,
+            cos_azi,
+        }
+    }
+}
+
 /// `None`: weighting function not implemented.
-fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight> {
-    let (si, ci) = s.inc.sin_cos();
+fn weighting(
+    name: &str,
+    s: &Station,
+    trig: &StationTrig,
+    course: f64,
+    site: &Site,
+) -> Option<Weight> {
+    let (si, ci) = (trig.sin_inc, trig.cos_inc);
     let am = s.azi - site.declination;
     let (sam, cam) = am.sin_cos();
-    let (sat, cat) = s.azi.sin_cos();
+    let (sat, cat) = (trig.sin_azi, trig.cos_azi);
     let g = site.gravity;
     let td = site.dip.tan();
     let bh = site.b_total * site.dip.cos();
@@ -447,17 +477,15 @@ fn horizontal_earth_rate(site: &Site) -> f64 {
     EARTH_RATE * site.latitude.cos()
 }
 
-fn tangent(s: &Station) -> [f64; 3] {
-    let (si, ci) = s.inc.sin_cos();
-    let (sa, ca) = s.azi.sin_cos();
-    [si * ca, si * sa, ci]
+fn tangent(t: &StationTrig) -> [f64; 3] {
+    [t.sin_inc * t.cos_azi, t.sin_inc * t.sin_azi, t.cos_inc]
 }
 
 /// d(dr)/dI and d(dr)/dA of a leg of length `len` at the station's end
 /// (the same at either end of the leg in the balanced-tangential form).
-fn d_inc_azi(s: &Station, len: f64) -> ([f64; 3], [f64; 3]) {
-    let (si, ci) = s.inc.sin_cos();
-    let (sa, ca) = s.azi.sin_cos();
+fn d_inc_azi(t: &StationTrig, len: f64) -> ([f64; 3], [f64; 3]) {
+    let (si, ci) = (t.sin_inc, t.cos_inc);
+    let (sa, ca) = (t.sin_azi, t.cos_azi);
     let h = len / 2.0;
     (
         [h * ci * ca, h * ci * sa, -h * si],
@@ -527,6 +555,7 @@ impl Options {
 fn error_vectors(
     term: &ErrorTerm,
     stations: &[Station],
+    trig: &[StationTrig],
     site: &Site,
     opts: Options,
 ) -> Option<Vec<([f64; 3], [f64; 3])>> {
@@ -549,7 +578,13 @@ fn error_vectors(
     }
     for k in 1..n {
         let s = &stations[k];
-        let wt = weighting(&term.weighting, s, s.md - stations[k - 1].md, site)?;
+        let wt = weighting(
+            &term.weighting,
+            s,
+            &trig[k],
+            s.md - stations[k - 1].md,
+            site,
+        )?;
         let len_b = if k == 1 && opts.tie_on == TieOn::CarriedByFirstStation {
             // the tie-on's inclination/azimuth error is carried here
             2.0 * (s.md - stations[0].md)
@@ -561,13 +596,9 @@ fn error_vectors(
         } else {
             0.0
         };
-        let t = tangent(s);
-        let tp = tangent(&stations[k - 1]);
-        let tn = if k + 1 < n {
-            tangent(&stations[k + 1])
-        } else {
-            t
-        };
+        let t = tangent(&trig[k]);
+        let tp = tangent(&trig[k - 1]);
+        let tn = if k + 1 < n { tangent(&trig[k + 1]) } else { t };
         // depth: dr_k/dD_k = (t_{k-1}+t_k)/2 ; dr_{k+1}/dD_k = -(t_k+t_{k+1})/2
         let dd_b: [f64; 3] = std::array::from_fn(|j| 0.5 * (tp[j] + t[j]));
         let dd_a: [f64; 3] = std::array::from_fn(|j| -0.5 * (t[j] + tn[j]));
@@ -577,8 +608,8 @@ fn error_vectors(
                 let dd: [f64; 3] = std::array::from_fn(|j| dd_b[j] + dd_after[j]);
                 return std::array::from_fn(|j| sig * (dd[j] * wt.w[0] + h * sv[j]));
             }
-            let (di_b, da_b) = d_inc_azi(s, len_b);
-            let (di_a, da_a) = d_inc_azi(s, len_after);
+            let (di_b, da_b) = d_inc_azi(&trig[k], len_b);
+            let (di_a, da_a) = d_inc_azi(&trig[k], len_after);
             std::array::from_fn(|j| {
                 sig * ((dd_b[j] + dd_after[j]) * wt.w[0]
                     + (di_b[j] + di_a[j]) * wt.w[1]
@@ -607,8 +638,9 @@ pub fn run_with(
     let mut per_source = BTreeMap::new();
     let mut missing = Vec::new();
     let mut total = vec![[0.0; 6]; n];
+    let trig: Vec<StationTrig> = stations.iter().map(StationTrig::of).collect();
     for term in terms {
-        let Some(ev) = error_vectors(term, stations, site, opts) else {
+        let Some(ev) = error_vectors(term, stations, &trig, site, opts) else {
             missing.push(term.code.clone());
             continue;
         };
