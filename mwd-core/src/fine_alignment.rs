@@ -16,7 +16,7 @@ use crate::error_model::{
     is_model_size, AugmentedModel, AugmentedTransition, LinearizationPoint, ProcessNoise,
     ACCEL_BIAS, ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
 };
-use crate::kalman::{std_dev_of, FilterScalar, KalmanFilter, UpdateReport};
+use crate::kalman::{std_dev_of, FilterScalar, KalmanFilter, Measurement, UpdateReport};
 use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -370,6 +370,19 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             None => UpdateReport::default(),
         };
 
+        let correction = self.feed_back();
+        self.steps = self.steps.saturating_add(1);
+        StepReport {
+            sample_used: true,
+            zero_velocity,
+            zero_position,
+            correction,
+        }
+    }
+
+    /// Feeds the estimated navigation errors back into the mechanization
+    /// (closed loop) and zeroes them in the filter; returns them.
+    fn feed_back(&mut self) -> [f64; NAV_STATES] {
         let correction: [f64; NAV_STATES] = core::array::from_fn(|i| self.filter.x[i].as_f64());
         let v3 = |first: usize| {
             Vector3::new(
@@ -383,12 +396,38 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         for i in 0..NAV_STATES {
             self.filter.x[i] = T::zero();
         }
-        self.steps = self.steps.saturating_add(1);
-        StepReport {
-            sample_used: true,
-            zero_velocity,
-            zero_position,
-            correction,
+        correction
+    }
+
+    /// One aiding measurement between steps, at the current solution
+    /// (e.g. the non-holonomic constraint while drilling, built with
+    /// [`state`](Self::state)), fed back as a step's updates are. Never
+    /// inlined: one copy per measurement type.
+    #[inline(never)]
+    pub fn aid<M: Measurement<T>>(&mut self, measurement: &M) -> UpdateReport {
+        let report = self.filter.update(measurement);
+        if report.accepted > 0 {
+            self.feed_back();
+        }
+        report
+    }
+
+    /// Replaces the attitude-error covariance (rad^2, nav frame) and clears
+    /// its cross-covariances with every other state: an attitude from
+    /// outside the probe's own sensors (a tie-in survey) is independent of
+    /// their errors. `p_phi` must be symmetric positive semi-definite.
+    pub fn set_attitude_error_covariance(&mut self, p_phi: &Matrix3<f64>) {
+        let p = &mut self.filter.p;
+        for i in ATT..ATT + 3 {
+            for j in 0..N {
+                p[(i, j)] = T::zero();
+                p[(j, i)] = T::zero();
+            }
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                p[(ATT + i, ATT + j)] = T::of(p_phi[(i, j)]);
+            }
         }
     }
 

@@ -8,9 +8,14 @@
 //! velocity error. Eq. 48 prints "H12, H13" as the unit blocks; the
 //! velocity and position blocks are H12 and H23 (erratum 5,
 //! docs/paper-errata.md).
+//!
+//! The non-holonomic constraint (no velocity across the tool axis while
+//! drilling) is not in the paper: derivation section 4b.
 
+mod non_holonomic;
 mod zero_position;
 mod zero_velocity;
 
+pub use non_holonomic::{BhaCrossMotion, NonHolonomic, CROSS_AXES, DRILLING_VARIANCE};
 pub use zero_position::ZeroPosition;
 pub use zero_velocity::ZeroVelocity;

@@ -4,9 +4,13 @@
 //!
 //! * [`raw`]: a raw sample's counts to calibrated body-frame rates and force.
 //! * [`navigator`]: coarse alignment, fine alignment, navigation.
+//! * [`tie_in`]: a start from a parent well's survey instead of the
+//!   static alignment.
 
 pub mod navigator;
 pub mod raw;
+pub mod tie_in;
 
 pub use navigator::Navigator;
 pub use raw::body_sample;
+pub use tie_in::{TieIn, TieInAngle, TieInError};

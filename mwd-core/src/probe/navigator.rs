@@ -29,13 +29,16 @@
 //! bit for bit.
 
 use super::raw::{reading, Reading};
+use super::tie_in::TieIn;
+use crate::aid_sources::{NonHolonomic, DRILLING_VARIANCE};
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::ToolAxisRate;
 use crate::calibration::ProbeCalibration;
 use crate::conventions::{euler_from_quat, quat_from_euler, Euler, DEG};
 use crate::earth::Position;
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
-use crate::fine_alignment::{FineAlignment, FineAlignmentConfig, StepNoise};
+use crate::fine_alignment::{FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior};
+use crate::kalman::UpdateReport;
 use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
@@ -380,6 +383,44 @@ impl Navigator {
         solution.velocity_std = core::array::from_fn(|i| kalman.std_dev(VEL + i));
         solution.position_std_ned = core::array::from_fn(|i| kalman.std_dev(POS + i));
         solution
+    }
+
+    /// Starts navigation from a tie-in (`super::tie_in`) instead of the
+    /// static alignment, dropping whatever the navigator was doing: the
+    /// tie-in's attitude at rest at the navigator's position, its angles'
+    /// covariance as the attitude-error covariance (independent of the
+    /// sensor states: not levelled with these accelerometers), the other
+    /// states as after a coarse alignment, no zero updates.
+    pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
+        let sigma = tie_in.euler_sigma();
+        let mut config = filter_config(&self.position, &sigma);
+        config.tilt_prior = TiltPrior::Independent;
+        let start = NavState::at_rest(tie_in.attitude(), self.position);
+        self.filter.restart(start, self.position, config);
+        self.filter
+            .set_attitude_error_covariance(&tie_in.attitude_error_covariance());
+        self.filter.start_navigation();
+        self.coarse_std = sigma.map(|s| s as f32);
+        self.input = ProbeInput::new();
+        self.held = None;
+        self.missed = 0;
+        self.coasting = false;
+        self.covariance_invalid = false;
+        self.coarse_single_part = false;
+        self.phase = Phase::Navigating;
+    }
+
+    /// One non-holonomic update at the current solution (no velocity
+    /// across the tool axis, `aid_sources::NonHolonomic`, with the drilling
+    /// BHA's noise [`DRILLING_VARIANCE`]), for the caller that knows the
+    /// tool is drilling; call it between steps (the next frame shows it).
+    /// Only while navigating with a valid covariance; `None` otherwise.
+    pub fn apply_non_holonomic(&mut self) -> Option<UpdateReport> {
+        if !self.is_navigating() || self.covariance_invalid {
+            return None;
+        }
+        let constraint = NonHolonomic::at(self.filter.state(), DRILLING_VARIANCE as f32);
+        Some(self.filter.aid(&constraint))
     }
 
     /// The filter (idle during the coarse alignment): for analysis, e.g.
