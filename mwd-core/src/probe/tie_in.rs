@@ -359,6 +359,46 @@ mod tests {
         assert!(frame.velocity_std.iter().all(|s| s.is_finite() && *s > 0.0));
     }
 
+    /// The navigator's NHC hook: only while navigating; on a still probe
+    /// started from a tie-in both scalars are taken and the cross-axis
+    /// velocity variances drop below the constraint's.
+    #[test]
+    fn the_navigator_applies_the_constraint_only_while_navigating() {
+        use crate::aid_sources::DRILLING_VARIANCE;
+        use crate::error_model::VEL;
+        let t = lateral();
+        let mut navigator = Navigator::new(Position::paper_site());
+        navigator.step(&still_at(&t, 0));
+        assert_eq!(navigator.apply_non_holonomic(), None);
+        navigator.start_from_tie_in(&t);
+        for n in 1..=20 {
+            navigator.step(&still_at(&t, n));
+        }
+        let cross_variance = |nav: &Navigator| -> [f64; 2] {
+            let c = dcm_from_euler(&t.angles().to_euler());
+            let p = nav
+                .filter()
+                .filter()
+                .p
+                .fixed_view::<3, 3>(VEL, VEL)
+                .map(f64::from);
+            [0, 2].map(|a| {
+                let r = c.column(a);
+                (r.transpose() * p * r)[(0, 0)]
+            })
+        };
+        let before = cross_variance(&navigator);
+        let report = navigator.apply_non_holonomic().expect("navigating");
+        assert_eq!(report.accepted, 2, "{report:?}");
+        let after = cross_variance(&navigator);
+        for a in 0..2 {
+            assert!(
+                after[a] < before[a] && after[a] < DRILLING_VARIANCE,
+                "{before:?} {after:?}"
+            );
+        }
+    }
+
     #[test]
     fn bad_tie_ins_are_refused_with_the_reason() {
         let good = angles(89.5, 137.0, 210.0);
