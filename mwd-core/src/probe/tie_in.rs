@@ -347,9 +347,9 @@ mod tests {
         // One 50 ms step: the probe sensed no earth rate (7.3e-5 rad/s):
         // 3.6e-6 rad of turn, plus f32 rounding of the frame.
         let want = [e.roll, e.pitch, e.heading];
-        for i in 0..3 {
-            let error = wrap_pi(f64::from(frame.attitude[i]) - want[i]);
-            assert!(error.abs() < 1e-5, "{i}: {frame:?}");
+        for (got, want) in frame.attitude.iter().zip(want) {
+            let error = wrap_pi(f64::from(*got) - want);
+            assert!(error.abs() < 1e-5, "{want}: {frame:?}");
         }
         // One step of process noise on top of the tie-in's sigmas.
         for (i, s) in t.euler_sigma().iter().enumerate() {
