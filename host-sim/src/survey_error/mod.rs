@@ -87,6 +87,7 @@ pub struct ErrorTerm {
 }
 
 pub mod probe_model;
+pub mod probe_weighting;
 #[cfg(test)]
 mod tests;
 
@@ -225,6 +226,9 @@ pub struct Station {
     pub inc: f64,
     pub azi: f64,
     pub tvd: f64,
+    /// Gravity toolface (rad), when the survey gives it: the probe's
+    /// `PRB-GXB`/`PRB-GZB` weights ([`probe_weighting`]) use it.
+    pub toolface: Option<f64>,
 }
 
 /// Checks a survey before [`run`]: at least a tie-on, every value finite,
@@ -408,6 +412,11 @@ fn weighting(
                 singular: Some([0.0, f, 0.0]),
             }
         }
+        // this probe's gyrocompass, valid through 90 deg (probe_weighting.rs)
+        p if p.starts_with("PRB-") => Weight {
+            w: probe_weighting::weighting(p, s, trig, site)?,
+            singular: None,
+        },
         _ => return None,
     })
 }
