@@ -6,7 +6,7 @@
 mod common;
 
 use common::{s, Run};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 fn host_sim(args: &[&str]) -> Run {
     common::run(&[&["survey"], args].concat())
@@ -41,15 +41,10 @@ fn lateral(
 }
 
 /// Rows of the output CSV as (header, rows).
-fn csv_rows(path: &PathBuf) -> (Vec<String>, Vec<Vec<String>>) {
+fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(String::from)
-        .collect();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
     let rows = lines
         .map(|l| l.split(',').map(String::from).collect())
         .collect();
@@ -64,7 +59,7 @@ fn col(header: &[String], name: &str) -> usize {
 }
 
 /// Runs the probe model on `stations` at latitude 45 deg, CSV out.
-fn probe(stations: &PathBuf, name: &str) -> (Run, Vec<String>, Vec<Vec<String>>) {
+fn probe(stations: &Path, name: &str) -> (Run, Vec<String>, Vec<Vec<String>>) {
     let out = common::scratch("survey-probe-cli", name).join("out.csv");
     let run = host_sim(&[
         s(stations),
@@ -117,7 +112,11 @@ fn lateral_heading_north_gets_covariances() {
 #[test]
 fn lateral_heading_east_is_flagged_undetermined() {
     let (run, h, rows) = probe(&lateral("east", |_| 90.0, None), "east");
-    assert!(run.stdout.contains("azimuth undetermined"), "{}", run.stdout);
+    assert!(
+        run.stdout.contains("azimuth undetermined"),
+        "{}",
+        run.stdout
+    );
     assert!(run.stdout.contains("outside the model's validity"));
     assert!(run.stdout.contains("(station 0)"), "{}", run.stdout);
     let (valid, sn) = (col(&h, "error_model_valid"), col(&h, "sigma_north_m"));
@@ -137,7 +136,11 @@ fn lateral_turning_east_is_flagged_from_the_first_undetermined_station() {
     assert_eq!(rows[first_bad][md].parse::<f64>().unwrap(), 900.0);
     assert!(rows[..first_bad].iter().all(|r| r[valid] == "true"));
     assert!(rows[first_bad..].iter().all(|r| r[valid] == "false"));
-    assert!(run.stdout.contains("no uncertainty from MD 900.00 m"), "{}", run.stdout);
+    assert!(
+        run.stdout.contains("no uncertainty from MD 900.00 m"),
+        "{}",
+        run.stdout
+    );
 }
 
 /// With the toolface column the bias terms are projected per gyro; without

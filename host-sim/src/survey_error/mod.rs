@@ -43,8 +43,9 @@
 //! accelerometer functions AXYZ-MIS/SF/ZB, GXY-B1/B2/G1/G4/RN (no
 //! published covariances to check them against: tested only by closed
 //! forms; the OWSG models are stated for inclinations up to 89 deg, and
-//! GXY-B1/G4/RN grow without bound towards 90 deg). Not implemented: the
-//! Rev 5.04 single `XCL` function.
+//! GXY-B1/G4/RN grow without bound towards 90 deg); and this probe's own
+//! PRB-GXB/GZB/GN ([`probe_weighting`]), valid through 90 deg. Not
+//! implemented: the Rev 5.04 single `XCL` function.
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -179,7 +179,10 @@ mod tests {
         for azi in [90.0, 85.0, 95.0, 270.0, 265.0] {
             let r = run(&probe, &hold(90.0, azi, |_| None), &site());
             assert!(
-                r.total.iter().skip(1).all(|c| c[0].is_nan() && c[1].is_nan()),
+                r.total
+                    .iter()
+                    .skip(1)
+                    .all(|c| c[0].is_nan() && c[1].is_nan()),
                 "azimuth {azi}"
             );
             assert!(!probe_weighting::azimuth_determined(
@@ -190,7 +193,10 @@ mod tests {
         for azi in [84.0, 96.0, 264.0] {
             let r = run(&probe, &hold(90.0, azi, |_| None), &site());
             assert!(
-                r.total.iter().skip(1).all(|c| c.iter().all(|x| x.is_finite())),
+                r.total
+                    .iter()
+                    .skip(1)
+                    .all(|c| c.iter().all(|x| x.is_finite())),
                 "azimuth {azi}"
             );
         }
@@ -201,7 +207,9 @@ mod tests {
             s.azi = 90f64.to_radians();
         }
         let r = run(&probe, &st, &site());
-        assert!(r.total[..20].iter().all(|c| c.iter().all(|x| x.is_finite())));
+        assert!(r.total[..20]
+            .iter()
+            .all(|c| c.iter().all(|x| x.is_finite())));
         assert!(r.total[20..].iter().all(|c| c[0].is_nan()));
     }
 
@@ -279,37 +287,38 @@ mod tests {
     }
 
     /// The table of docs/probe-tool-model.md (not a check): horizontal
-    /// 1-sigma at the end of a 1000 m lateral at 90 deg (tie-on at MD 0),
-    /// all terms, without a toolface (bias bound) and with a constant one.
+    /// 1-sigma at the end of a 1000 m lateral at 90 deg (tie-on at MD 0,
+    /// 34 stations), all terms, without a toolface (bias bound) and with a
+    /// constant one; and the gyro noise (PRB-GN) alone.
     /// `cargo test -p host-sim --lib probe_model -- --ignored --nocapture`
     #[test]
     #[ignore]
     fn print_lateral_table() {
         let probe = load_term_table(&data(PROBE_MODEL_CSV)).unwrap();
-        let ns = load_term_table(&data("host-sim/data/owsg_gyro_ns_terms.csv")).unwrap();
-        println!("| lat (deg) | azi (deg) | S | probe, no toolface (m) | probe, toolface 0 (m) | GYRO-NS (m) |");
+        println!("| lat (deg) | azi (deg) | S | no toolface (m) | toolface 0 (m) | gyro noise alone (m) |");
         println!("| --- | --- | --- | --- | --- | --- |");
+        let horizontal = |c: &Cov6| {
+            let v = (c[0] + c[1]).sqrt();
+            if v.is_finite() {
+                format!("{v:.1}")
+            } else {
+                "undetermined".to_string()
+            }
+        };
         for lat in [0.0f64, 30.0, 60.0] {
             for azi in [0.0f64, 30.0, 60.0, 80.0, 84.0, 85.0, 90.0] {
                 let site = Site {
                     latitude: lat.to_radians(),
                     ..site()
                 };
-                let h = |t: &[ErrorTerm], st: &[Station]| {
-                    let c = *run(t, st, &site).total.last().unwrap();
-                    let v = (c[0] + c[1]).sqrt();
-                    if v.is_finite() {
-                        format!("{v:.1}")
-                    } else {
-                        "undetermined".to_string()
-                    }
-                };
+                let free = run(&probe, &hold(90.0, azi, |_| None), &site);
+                let tf0 = run(&probe, &hold(90.0, azi, |_| Some(0.0)), &site);
                 let s = probe_weighting::azimuth_sensitivity(1.0, azi.to_radians().sin());
                 println!(
                     "| {lat} | {azi} | {s:.3} | {} | {} | {} |",
-                    h(&probe, &hold(90.0, azi, |_| None)),
-                    h(&probe, &hold(90.0, azi, |_| Some(0.0))),
-                    h(&ns, &hold(90.0, azi, |_| None)),
+                    horizontal(free.total.last().unwrap()),
+                    horizontal(tf0.total.last().unwrap()),
+                    horizontal(free.per_source["PRB-GN"].last().unwrap()),
                 );
             }
         }

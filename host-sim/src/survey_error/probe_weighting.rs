@@ -42,7 +42,8 @@
 //!   Without a toolface each is given the bound `|g| = 1 / (Omega_h S)`,
 //!   valid for any toolface (the largest either weight takes over theta);
 //!   with equal biases on both axes it overstates the station's azimuth
-//!   variance by up to a factor 2 (sigma by sqrt 2).
+//!   variance by a factor 2 (sigma by sqrt 2), and along a straight hole
+//!   it bounds the covariance for any sequence of toolfaces.
 //! * `PRB-GN`: white noise of equal sigma on both gyros: its azimuth sigma
 //!   `|g| sigma` does not depend on the toolface (the rotation keeps the
 //!   noise isotropic); times the site's `gyro_noise_reduction`, as GXY-RN.
@@ -259,7 +260,9 @@ mod tests {
 
     /// Empirical azimuth sigma over [`DRAWS`] stations; accelerometer
     /// noise on every draw.
+    #[allow(clippy::too_many_arguments)]
     fn empirical(
+        lat_deg: f64,
         inc: f64,
         azi: f64,
         tf: f64,
@@ -268,7 +271,7 @@ mod tests {
         sigma_acc: f64,
         rng: &mut ChaCha8Rng,
     ) -> f64 {
-        let lat = LAT_DEG.to_radians();
+        let lat = lat_deg.to_radians();
         let unit = Normal::new(0.0, 1.0).unwrap();
         let mut sum2 = 0.0;
         for _ in 0..DRAWS {
@@ -343,7 +346,7 @@ mod tests {
                     (Error::BiasZ, "PRB-GZB", Some(tf)),
                 ] {
                     let predicted = sigma * weight(name, inc, azi, tool, &site).abs();
-                    let got = empirical(inc, azi, tf, error, sigma, sigma_acc, &mut rng);
+                    let got = empirical(LAT_DEG, inc, azi, tf, error, sigma, sigma_acc, &mut rng);
                     let rel = got / predicted - 1.0;
                     println!(
                         "I {inc_deg:>4} A {azi_deg:>4} {error:?}: predicted {predicted:.4e} rad, empirical {got:.4e} rad ({:+.2} %)",
@@ -358,5 +361,56 @@ mod tests {
             }
         }
         println!("largest difference {:.2} %", 100.0 * worst);
+    }
+
+    /// Not a check: the same comparison at the probe's own noise (one 120 s
+    /// station, PRB-GN and AXYZ-ZN magnitudes), where the first-order model
+    /// is stretched (docs/probe-tool-model.md, "Range of the first-order
+    /// model"). `cargo test -p host-sim --lib probe_weighting -- --ignored --nocapture`
+    #[test]
+    #[ignore]
+    fn print_first_order_at_the_probe_noise() {
+        let mags: std::collections::BTreeMap<_, _> = sensor_term_magnitudes().into_iter().collect();
+        let sigma = mags["PRB-GN"].to_radians() / 3600.0;
+        let sigma_acc = mags["AXYZ-ZN"];
+        let mut rng = ChaCha8Rng::seed_from_u64(90);
+        println!("| lat (deg) | inc (deg) | azi (deg) | first-order sigma (deg) | Monte Carlo sigma (deg) |");
+        println!("| --- | --- | --- | --- | --- |");
+        for lat_deg in [0.0, 30.0, 60.0] {
+            let site = Site {
+                gravity: G,
+                b_total: 0.0,
+                dip: 0.0,
+                declination: 0.0,
+                vertical_limit: 1e-4_f64.to_radians(),
+                latitude: f64::to_radians(lat_deg),
+                gyro_noise_reduction: 1.0,
+            };
+            for (inc_deg, azi_deg) in [
+                (30.0, 30.0),
+                (90.0, 0.0),
+                (90.0, 30.0),
+                (90.0, 60.0),
+                (90.0, 80.0),
+            ] {
+                let (inc, azi) = (f64::to_radians(inc_deg), f64::to_radians(azi_deg));
+                let predicted = sigma * weight("PRB-GN", inc, azi, None, &site);
+                let got = empirical(
+                    lat_deg,
+                    inc,
+                    azi,
+                    0.0,
+                    Error::Noise,
+                    sigma,
+                    sigma_acc,
+                    &mut rng,
+                );
+                println!(
+                    "| {lat_deg} | {inc_deg} | {azi_deg} | {:.1} | {:.1} |",
+                    predicted.to_degrees(),
+                    got.to_degrees()
+                );
+            }
+        }
     }
 }

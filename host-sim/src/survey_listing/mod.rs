@@ -322,8 +322,9 @@ impl Validity {
     /// Why the model is not valid at this row, or `None`.
     fn check(&self, row: &Row) -> Option<String> {
         match *self {
-            Self::MaxInclination(max) => (row.inc_deg > max)
-                .then(|| format!("is stated for inclinations up to {max} deg")),
+            Self::MaxInclination(max) => {
+                (row.inc_deg > max).then(|| format!("is stated for inclinations up to {max} deg"))
+            }
             Self::AzimuthSensitivity => {
                 use survey_error::probe_weighting as pw;
                 let (inc, azi) = (row.inc_deg.to_radians(), row.azi_deg.to_radians());
@@ -480,10 +481,37 @@ mod tests {
 
     #[test]
     fn embedded_tables_parse() {
+        // every model's every term has its weighting function: a short
+        // survey at 45 deg runs with nothing missing and a finite result
+        let f = file("md_m,inc_deg,azi_deg\n0,0,0\n300,45,30\n600,45,30\n");
+        let tie = TieOnInput {
+            md: None,
+            tvd: 0.0,
+            north: 0.0,
+            east: 0.0,
+        };
+        let site = Site {
+            gravity: 9.80665,
+            b_total: 50_000.0,
+            dip: 72f64.to_radians(),
+            declination: 0.0,
+            vertical_limit: 1e-4f64.to_radians(),
+            latitude: 45f64.to_radians(),
+            gyro_noise_reduction: 1.0,
+        };
         for m in &MODELS {
             let terms = terms(m).unwrap();
-            assert!(terms.len() >= 18, "{}", m.name);
+            assert!(terms.len() >= 17, "{}", m.name);
+            let (mut rows, _) = compute(&f, AzimuthReference::True, tie, None).unwrap();
+            assert_eq!(apply_model(&mut rows, m, &terms, &site).unwrap(), None);
+            let last = rows.last().unwrap().cov.unwrap();
+            assert!(
+                last.iter().all(|x| x.is_finite()) && last[0] > 0.0,
+                "{}",
+                m.name
+            );
         }
+        assert_eq!(model("probe-scc1300").unwrap().name, "PROBE-SCC1300");
         assert_eq!(model("iscwsa  mwd rev5").unwrap().name, "ISCWSA MWD Rev5");
         assert!(model("ISCWSA MWD Rev4").is_err());
     }
