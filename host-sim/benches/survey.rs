@@ -50,6 +50,7 @@ fn with_tvd(stations: &[TrueStation]) -> Vec<ErrStation> {
                 inc: p.station.inclination(),
                 azi: p.station.azimuth(),
                 tvd: p.tvd(),
+                toolface: None,
             }
         })
         .collect()

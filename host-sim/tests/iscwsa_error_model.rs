@@ -89,6 +89,7 @@ fn load_well(key: &str) -> Result<Well, String> {
             inc: v(1)?.to_radians(),
             azi: v(2)?.to_radians(),
             tvd: v(3)? * unit,
+            toolface: None,
         });
     }
     let mut reference = BTreeMap::new();

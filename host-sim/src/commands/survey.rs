@@ -70,7 +70,8 @@ pub struct Args {
     /// East of the tie-on (file's unit, true north).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_east: f64,
-    /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS".
+    /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS",
+    /// "PROBE-SCC1300" (this probe, valid through 90 deg).
     #[arg(long)]
     pub error_model: Option<String>,
     /// Total magnetic field, nT (magnetic models).
@@ -105,7 +106,7 @@ struct Survey {
     vsec_azimuth_deg: f64,
     model: Option<&'static KnownModel>,
     /// First station the model is not valid at.
-    invalid_from: Option<usize>,
+    invalid_from: Option<listing::Invalid>,
     confidence: f64,
 }
 
@@ -175,10 +176,10 @@ fn model_site(args: &Args, model: &KnownModel) -> Result<Site> {
 }
 
 fn validity_note(s: &Survey) -> Option<String> {
-    let (m, k) = (s.model?, s.invalid_from?);
+    let (m, inv) = (s.model?, s.invalid_from.as_ref()?);
     Some(format!(
-        "{} is stated for inclinations up to {} deg: no uncertainty from MD {:.2} m (station {}) on, not extrapolated",
-        m.name, m.max_inc_deg, s.rows[k].md_m, k
+        "{} {}: no uncertainty from MD {:.2} m (station {}) on, not extrapolated",
+        m.name, inv.reason, s.rows[inv.station].md_m, inv.station
     ))
 }
 

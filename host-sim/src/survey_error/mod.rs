@@ -43,8 +43,9 @@
 //! accelerometer functions AXYZ-MIS/SF/ZB, GXY-B1/B2/G1/G4/RN (no
 //! published covariances to check them against: tested only by closed
 //! forms; the OWSG models are stated for inclinations up to 89 deg, and
-//! GXY-B1/G4/RN grow without bound towards 90 deg). Not implemented: the
-//! Rev 5.04 single `XCL` function.
+//! GXY-B1/G4/RN grow without bound towards 90 deg); and this probe's own
+//! PRB-GXB/GZB/GN ([`probe_weighting`]), valid through 90 deg. Not
+//! implemented: the Rev 5.04 single `XCL` function.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -87,6 +88,7 @@ pub struct ErrorTerm {
 }
 
 pub mod probe_model;
+pub mod probe_weighting;
 #[cfg(test)]
 mod tests;
 
@@ -225,6 +227,9 @@ pub struct Station {
     pub inc: f64,
     pub azi: f64,
     pub tvd: f64,
+    /// Gravity toolface (rad), when the survey gives it: the probe's
+    /// `PRB-GXB`/`PRB-GZB` weights ([`probe_weighting`]) use it.
+    pub toolface: Option<f64>,
 }
 
 /// Checks a survey before [`run`]: at least a tie-on, every value finite,
@@ -408,6 +413,11 @@ fn weighting(
                 singular: Some([0.0, f, 0.0]),
             }
         }
+        // this probe's gyrocompass, valid through 90 deg (probe_weighting.rs)
+        p if p.starts_with("PRB-") => Weight {
+            w: probe_weighting::weighting(p, s, trig, site)?,
+            singular: None,
+        },
         _ => return None,
     })
 }

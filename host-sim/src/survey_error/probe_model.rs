@@ -27,19 +27,15 @@ pub fn sensor_term_magnitudes() -> Vec<(&'static str, f64)> {
     let [gx, _, gz] = n.gyro;
     let accel = n.accel[1];
     vec![
-        // residual (run-to-run) gyro bias, constant over the run
-        (
-            "GXY-B1S",
-            gx.residual_bias.max(gz.residual_bias) * RAD_PER_S_TO_DEG_PER_HR,
-        ),
-        (
-            "GXY-B2S",
-            gx.residual_bias.max(gz.residual_bias) * RAD_PER_S_TO_DEG_PER_HR,
-        ),
+        // residual (run-to-run) bias of each cross-axis gyro, constant over
+        // the run: projected through the toolface (probe_weighting.rs)
+        ("PRB-GXB", gx.residual_bias * RAD_PER_S_TO_DEG_PER_HR),
+        ("PRB-GZB", gz.residual_bias * RAD_PER_S_TO_DEG_PER_HR),
         // white + coloured + Gauss-Markov noise of the station mean, the
-        // worse of the two cross-axis gyros (their AR(4) fits differ)
+        // worse of the two cross-axis gyros (their AR(4) fits differ): the
+        // weighting function takes equal noise on both axes
         (
-            "GXY-RN",
+            "PRB-GN",
             gx.mean_sigma(samples, dt).max(gz.mean_sigma(samples, dt)) * RAD_PER_S_TO_DEG_PER_HR,
         ),
         // residual bias of the along-tool accelerometer
@@ -91,33 +87,39 @@ mod tests {
         }
         // the systematic gyro and accelerometer biases, the random noise
         let prop = |c: &str| terms.iter().find(|t| t.code == c).unwrap().propagation;
-        assert_eq!(prop("GXY-B1S"), Propagation::Systematic);
-        assert_eq!(prop("GXY-B2S"), Propagation::Systematic);
+        assert_eq!(prop("PRB-GXB"), Propagation::Systematic);
+        assert_eq!(prop("PRB-GZB"), Propagation::Systematic);
         assert_eq!(prop("AXYZ-ZB"), Propagation::Systematic);
-        assert_eq!(prop("GXY-RN"), Propagation::Random);
+        assert_eq!(prop("PRB-GN"), Propagation::Random);
         assert_eq!(prop("AXYZ-ZN"), Propagation::Random);
     }
 
-    /// A 1000 m lateral at 88 deg inclination, 30 m stations.
-    fn lateral() -> Vec<Station> {
-        let inc = 88_f64.to_radians();
-        let azi = 45_f64.to_radians();
-        let mut md = 0.0;
-        let mut out = Vec::new();
-        while md <= 1000.0 + 1e-9 {
-            out.push(Station {
-                md,
-                inc,
-                azi,
-                tvd: md * inc.cos(),
-            });
-            md += 1000.0 / 33.0;
-        }
-        out
+    /// A straight 1000 m hold from a tie-on at MD 0 (34 stations, about
+    /// 30 m apart), with the toolface of each station from `toolface`.
+    fn hold(inc_deg: f64, azi_deg: f64, toolface: impl Fn(usize) -> Option<f64>) -> Vec<Station> {
+        let (inc, azi) = (inc_deg.to_radians(), azi_deg.to_radians());
+        (0..34)
+            .map(|k| {
+                let md = k as f64 * 1000.0 / 33.0;
+                Station {
+                    md,
+                    inc,
+                    azi,
+                    tvd: md * inc.cos(),
+                    toolface: toolface(k),
+                }
+            })
+            .collect()
     }
 
     fn matrix(c: &Cov6) -> Matrix3<f64> {
         Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2])
+    }
+
+    fn psd(m: &Matrix3<f64>, what: &str) {
+        let e = SymmetricEigen::new(*m).eigenvalues;
+        let scale = m.trace().abs().max(1e-300);
+        assert!(e.iter().all(|&x| x >= -1e-9 * scale), "{what}: {e}");
     }
 
     #[test]
@@ -139,76 +141,185 @@ mod tests {
         }
     }
 
+    /// The case the OWSG functions cannot take (they divide by cos I): a
+    /// horizontal lateral heading north gets a finite, symmetric, positive
+    /// semi-definite covariance at every station, whose horizontal part
+    /// grows along the hole, at the equator and at 60 deg latitude.
     #[test]
-    fn lateral_at_88_deg_is_finite_psd_and_wider_than_gyro_ns() {
-        let stations = lateral();
-        check_stations(&stations).unwrap();
+    fn lateral_at_90_deg_heading_north_has_a_covariance() {
         let probe = load_term_table(&data(PROBE_MODEL_CSV)).unwrap();
-        let ns = load_term_table(&data("host-sim/data/owsg_gyro_ns_terms.csv")).unwrap();
-        let rp = run(&probe, &stations, &site());
-        let rn = run(&ns, &stations, &site());
-        assert!(rp.missing.is_empty(), "missing {:?}", rp.missing);
-        assert!(rn.missing.is_empty());
-        for (k, (cp, cn)) in rp.total.iter().zip(&rn.total).enumerate().skip(1) {
-            assert!(cp.iter().all(|x| x.is_finite()), "station {k}");
-            let p = matrix(cp);
-            assert_eq!(p, p.transpose());
-            let ep = SymmetricEigen::new(p).eigenvalues;
-            let scale = p.trace();
-            assert!(ep.iter().all(|&e| e >= -1e-9 * scale), "station {k}: {ep}");
-            // larger than GYRO-NS: the difference is PSD, the trace larger
-            let d = SymmetricEigen::new(p - matrix(cn)).eigenvalues;
-            assert!(d.iter().all(|&e| e >= -1e-9 * scale), "station {k}: {d}");
-            assert!(p.trace() > matrix(cn).trace());
+        for lat in [0.0f64, 60.0] {
+            let site = Site {
+                latitude: lat.to_radians(),
+                ..site()
+            };
+            let stations = hold(90.0, 0.0, |_| None);
+            check_stations(&stations).unwrap();
+            let r = run(&probe, &stations, &site);
+            assert!(r.missing.is_empty(), "missing {:?}", r.missing);
+            let mut prev = 0.0;
+            for (k, c) in r.total.iter().enumerate().skip(1) {
+                assert!(c.iter().all(|x| x.is_finite()), "lat {lat}, station {k}");
+                let m = matrix(c);
+                assert_eq!(m, m.transpose());
+                psd(&m, &format!("lat {lat}, station {k}"));
+                // the cross-hole (east) variance grows with MD
+                assert!(c[1] > prev, "lat {lat}, station {k}");
+                prev = c[1];
+            }
         }
-        let last = rp.total.last().unwrap();
-        let ns_last = rn.total.last().unwrap();
-        println!(
-            "1000 m at 88 deg: probe horizontal 1-sigma {:.1} m, GYRO-NS {:.1} m",
-            (last[0] + last[1]).sqrt(),
-            (ns_last[0] + ns_last[1]).sqrt()
-        );
+    }
+
+    /// Heading east (or within 5.7 deg of it) at 90 deg the azimuth is
+    /// undetermined: no number from the first such station on, while 84
+    /// deg (S = cos 84 deg = 0.105) still gets a finite covariance.
+    #[test]
+    fn lateral_heading_east_is_undetermined() {
+        let probe = load_term_table(&data(PROBE_MODEL_CSV)).unwrap();
+        for azi in [90.0, 85.0, 95.0, 270.0, 265.0] {
+            let r = run(&probe, &hold(90.0, azi, |_| None), &site());
+            assert!(
+                r.total
+                    .iter()
+                    .skip(1)
+                    .all(|c| c[0].is_nan() && c[1].is_nan()),
+                "azimuth {azi}"
+            );
+            assert!(!probe_weighting::azimuth_determined(
+                90f64.to_radians(),
+                f64::to_radians(azi)
+            ));
+        }
+        for azi in [84.0, 96.0, 264.0] {
+            let r = run(&probe, &hold(90.0, azi, |_| None), &site());
+            assert!(
+                r.total
+                    .iter()
+                    .skip(1)
+                    .all(|c| c.iter().all(|x| x.is_finite())),
+                "azimuth {azi}"
+            );
+        }
+        // turning east part way: finite before, NaN from the first
+        // undetermined station on (never an extrapolated number)
+        let mut st = hold(90.0, 0.0, |_| None);
+        for s in st.iter_mut().skip(20) {
+            s.azi = 90f64.to_radians();
+        }
+        let r = run(&probe, &st, &site());
+        assert!(r.total[..20]
+            .iter()
+            .all(|c| c.iter().all(|x| x.is_finite())));
+        assert!(r.total[20..].iter().all(|c| c[0].is_nan()));
+    }
+
+    /// The weights against closed forms: near vertical they are the OWSG
+    /// GXY functions (SPE 90408 Table 1) up to sign, with the toolface
+    /// turning body x/z into right/high side; the least-squares noise
+    /// weight is never larger than GXY-RN's (the closed-form solution
+    /// divides the high-side channel by cos I; least squares weighs both).
+    #[test]
+    fn weights_against_the_owsg_closed_forms() {
+        let site = site();
+        let wt = |name: &str, inc: f64, azi: f64, tf: Option<f64>| {
+            let s = Station {
+                md: 100.0,
+                inc: inc.to_radians(),
+                azi: azi.to_radians(),
+                tvd: 50.0,
+                toolface: tf.map(f64::to_radians),
+            };
+            weighting(name, &s, &StationTrig::of(&s), 30.0, &site)
+                .unwrap()
+                .w[2]
+        };
+        for azi in [0.0, 30.0, 135.0, 250.0] {
+            let tol = |x: f64| 1e-9 * x.abs().max(1.0 / horizontal_earth_rate(&site));
+            // vertical, toolface 0: body x is the right side, z the high side
+            let (b1, b2) = (wt("GXY-B1", 0.0, azi, None), wt("GXY-B2", 0.0, azi, None));
+            assert!((wt("PRB-GXB", 0.0, azi, Some(0.0)) + b2).abs() < tol(b2));
+            assert!((wt("PRB-GZB", 0.0, azi, Some(0.0)) + b1).abs() < tol(b1));
+            // toolface 90 deg: body z on the right side, x on the low side
+            assert!((wt("PRB-GZB", 0.0, azi, Some(90.0)) + b2).abs() < tol(b2));
+            assert!((wt("PRB-GXB", 0.0, azi, Some(90.0)) - b1).abs() < tol(b1));
+            let rn = wt("GXY-RN", 0.0, azi, None);
+            assert!((wt("PRB-GN", 0.0, azi, None) - rn).abs() < tol(rn));
+            for inc in [10.0, 45.0, 80.0, 88.0, 120.0] {
+                let ls = wt("PRB-GN", inc, azi, None);
+                let rn = wt("GXY-RN", inc, azi, None).abs();
+                assert!(ls <= rn * (1.0 + 1e-12), "inc {inc} azi {azi}: {ls} > {rn}");
+                // the toolface-free bound is the largest weight over toolface
+                let bound = wt("PRB-GXB", inc, azi, None);
+                assert!((bound - ls).abs() < 1e-12 * ls);
+                let max = (0..360)
+                    .map(|tf| wt("PRB-GXB", inc, azi, Some(tf as f64)).abs())
+                    .fold(0.0, f64::max);
+                assert!(max <= bound && max > 0.999 * bound, "inc {inc} azi {azi}");
+            }
+        }
+    }
+
+    /// Along a lateral whose toolface turns from station to station, the
+    /// toolface-free bias terms bound the toolface-aware ones: the
+    /// difference of the two covariances is positive semi-definite.
+    #[test]
+    fn toolface_free_bias_bounds_any_toolface() {
+        let terms: Vec<ErrorTerm> = load_term_table(&data(PROBE_MODEL_CSV))
+            .unwrap()
+            .into_iter()
+            .filter(|t| t.code == "PRB-GXB" || t.code == "PRB-GZB")
+            .collect();
+        assert_eq!(terms.len(), 2);
+        for azi in [0.0, 40.0, 75.0] {
+            for (name, tf) in [
+                ("fixed 0", (|_| 0.0) as fn(usize) -> f64),
+                ("fixed 70", |_| 70f64.to_radians()),
+                ("turning", |k| (k as f64 * 47.0).to_radians()),
+            ] {
+                let with = run(&terms, &hold(90.0, azi, |k| Some(tf(k))), &site());
+                let free = run(&terms, &hold(90.0, azi, |_| None), &site());
+                for k in 1..with.total.len() {
+                    let d = matrix(&free.total[k]) - matrix(&with.total[k]);
+                    psd(&d, &format!("azi {azi}, {name}, station {k}"));
+                }
+            }
+        }
     }
 
     /// The table of docs/probe-tool-model.md (not a check): horizontal
-    /// 1-sigma at the end of a 1000 m straight hold, probe vs OWSG models.
+    /// 1-sigma at the end of a 1000 m lateral at 90 deg (tie-on at MD 0,
+    /// 34 stations), all terms, without a toolface (bias bound) and with a
+    /// constant one; and the gyro noise (PRB-GN) alone.
     /// `cargo test -p host-sim --lib probe_model -- --ignored --nocapture`
     #[test]
     #[ignore]
-    fn print_hold_sweep() {
+    fn print_lateral_table() {
         let probe = load_term_table(&data(PROBE_MODEL_CSV)).unwrap();
-        let ns = load_term_table(&data("host-sim/data/owsg_gyro_ns_terms.csv")).unwrap();
-        let mwd = load_term_table(&data("host-sim/data/owsg_gyro_mwd_terms.csv")).unwrap();
-        for lat in [0.0f64, 60.0] {
-            for inc in [0.0f64, 30.0, 60.0, 80.0, 88.0, 89.9] {
-                for azi in [0.0f64, 45.0, 90.0] {
-                    let (i, a) = (inc.to_radians(), azi.to_radians());
-                    let st: Vec<Station> = (0..34)
-                        .map(|k| {
-                            let md = k as f64 * 1000.0 / 33.0;
-                            Station {
-                                md,
-                                inc: i,
-                                azi: a,
-                                tvd: md * i.cos(),
-                            }
-                        })
-                        .collect();
-                    let site = Site {
-                        latitude: lat.to_radians(),
-                        ..site()
-                    };
-                    let h = |t: &[ErrorTerm]| {
-                        let c = *run(t, &st, &site).total.last().unwrap();
-                        (c[0] + c[1]).sqrt()
-                    };
-                    println!(
-                        "| {lat} | {inc} | {azi} | {:.1} | {:.1} | {:.1} |",
-                        h(&probe),
-                        h(&mwd),
-                        h(&ns)
-                    );
-                }
+        println!("| lat (deg) | azi (deg) | S | no toolface (m) | toolface 0 (m) | gyro noise alone (m) |");
+        println!("| --- | --- | --- | --- | --- | --- |");
+        let horizontal = |c: &Cov6| {
+            let v = (c[0] + c[1]).sqrt();
+            if v.is_finite() {
+                format!("{v:.1}")
+            } else {
+                "undetermined".to_string()
+            }
+        };
+        for lat in [0.0f64, 30.0, 60.0] {
+            for azi in [0.0f64, 30.0, 60.0, 80.0, 84.0, 85.0, 90.0] {
+                let site = Site {
+                    latitude: lat.to_radians(),
+                    ..site()
+                };
+                let free = run(&probe, &hold(90.0, azi, |_| None), &site);
+                let tf0 = run(&probe, &hold(90.0, azi, |_| Some(0.0)), &site);
+                let s = probe_weighting::azimuth_sensitivity(1.0, azi.to_radians().sin());
+                println!(
+                    "| {lat} | {azi} | {s:.3} | {} | {} | {} |",
+                    horizontal(free.total.last().unwrap()),
+                    horizontal(tf0.total.last().unwrap()),
+                    horizontal(free.per_source["PRB-GN"].last().unwrap()),
+                );
             }
         }
     }

@@ -19,6 +19,7 @@ fn vertical(n: usize, step: f64) -> Vec<Station> {
             inc: 0.0,
             azi: 0.0,
             tvd: i as f64 * step,
+            toolface: None,
         })
         .collect()
 }
@@ -71,6 +72,7 @@ fn random_and_systematic_propagation_differ_as_expected() {
             inc: 60_f64.to_radians(),
             azi: 0.0,
             tvd: i as f64 * 15.0,
+            toolface: None,
         })
         .collect();
     let sig = 1e-3;
@@ -171,6 +173,7 @@ fn gyro_bias_swings_a_straight_hold() {
             inc,
             azi: 0.0,
             tvd: i as f64 * 15.0,
+            toolface: None,
         })
         .collect();
     let b = 0.15 * std::f64::consts::PI / 180.0 / 3600.0; // 0.15 deg/h

@@ -295,40 +295,96 @@ pub fn compute(
     Ok((rows, direction))
 }
 
-/// An error model the tool knows: its term table (embedded) and the
-/// inclination range it is stated for.
+/// Where an error model may be applied.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Validity {
+    /// Stated for inclinations up to this, deg (the OWSG gyro models'
+    /// 89 deg: their weighting functions divide by cos I).
+    MaxInclination(f64),
+    /// This probe's gyrocompass: every inclination, but only where the
+    /// azimuth sensitivity `S = sqrt(1 - sin^2 I sin^2 A)` is at least
+    /// [`survey_error::probe_weighting::MIN_AZIMUTH_SENSITIVITY`]; below it
+    /// (a tool near horizontal heading near east or west) the station's
+    /// azimuth is undetermined.
+    AzimuthSensitivity,
+}
+
+/// The first station an error model is not valid at, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    pub station: usize,
+    /// A clause after the model's name, e.g. "is stated for inclinations
+    /// up to 89 deg".
+    pub reason: String,
+}
+
+impl Validity {
+    /// Why the model is not valid at this row, or `None`.
+    fn check(&self, row: &Row) -> Option<String> {
+        match *self {
+            Self::MaxInclination(max) => {
+                (row.inc_deg > max).then(|| format!("is stated for inclinations up to {max} deg"))
+            }
+            Self::AzimuthSensitivity => {
+                use survey_error::probe_weighting as pw;
+                let (inc, azi) = (row.inc_deg.to_radians(), row.azi_deg.to_radians());
+                let s = pw::azimuth_sensitivity(inc.sin(), azi.sin());
+                (!pw::azimuth_determined(inc, azi)).then(|| {
+                    format!(
+                        "cannot gyrocompass the azimuth at inclination {:.2} deg, azimuth {:.2} deg \
+                         (azimuth sensitivity S = sqrt(1 - sin^2 I sin^2 A) = {s:.3} < {}: a tool near \
+                         horizontal heading near east or west; azimuth undetermined)",
+                        row.inc_deg,
+                        row.azi_deg,
+                        pw::MIN_AZIMUTH_SENSITIVITY
+                    )
+                })
+            }
+        }
+    }
+}
+
+/// An error model the tool knows: its term table (embedded) and where it
+/// is valid.
 #[derive(Clone, Copy, Debug)]
 pub struct KnownModel {
     pub name: &'static str,
     pub table: &'static str,
     pub file: &'static str,
-    /// Largest inclination the model is stated for, deg.
-    pub max_inc_deg: f64,
+    pub validity: Validity,
     /// Needs the magnetic field (B total, dip, declination).
     pub magnetic: bool,
 }
 
 /// The embedded models (`host-sim/data/README.md`).
-pub const MODELS: [KnownModel; 3] = [
+pub const MODELS: [KnownModel; 4] = [
     KnownModel {
         name: "ISCWSA MWD Rev5",
         table: include_str!("../../data/mwd_rev5_model_terms.csv"),
         file: "mwd_rev5_model_terms.csv",
-        max_inc_deg: 180.0,
+        validity: Validity::MaxInclination(180.0),
         magnetic: true,
     },
     KnownModel {
         name: "GYRO-MWD",
         table: include_str!("../../data/owsg_gyro_mwd_terms.csv"),
         file: "owsg_gyro_mwd_terms.csv",
-        max_inc_deg: 89.0,
+        validity: Validity::MaxInclination(89.0),
         magnetic: false,
     },
     KnownModel {
         name: "GYRO-NS",
         table: include_str!("../../data/owsg_gyro_ns_terms.csv"),
         file: "owsg_gyro_ns_terms.csv",
-        max_inc_deg: 89.0,
+        validity: Validity::MaxInclination(89.0),
+        magnetic: false,
+    },
+    // this probe (docs/probe-tool-model.md): valid through 90 deg
+    KnownModel {
+        name: "PROBE-SCC1300",
+        table: include_str!("../../data/probe_scc1300_terms.csv"),
+        file: "probe_scc1300_terms.csv",
+        validity: Validity::AzimuthSensitivity,
         magnetic: false,
     },
 ];
@@ -359,20 +415,26 @@ pub fn terms(model: &KnownModel) -> Result<Vec<ErrorTerm>> {
     survey_error::parse_term_table(model.table, model.file).map_err(|e| anyhow!("{e}"))
 }
 
-/// Runs the model over the rows (first = tie-on, taken as exact). Stations
-/// from the first beyond the model's inclination limit on get no
-/// covariance (the model is not extrapolated); returns the index of that
-/// first station, if any.
+/// Runs the model over the rows (first = tie-on, taken as exact). From
+/// the first station where the model is not valid on (an inclination
+/// beyond its limit, or an azimuth the probe cannot gyrocompass) no station
+/// gets a covariance: the model is not extrapolated, and a position error
+/// without a bound at one station carries on to every later one. Returns
+/// that first station and the reason, if any. The station's toolface, when
+/// the file gives it, goes to the weighting functions that use it.
 pub fn apply_model(
     rows: &mut [Row],
     model: &KnownModel,
     terms: &[ErrorTerm],
     site: &Site,
-) -> Result<Option<usize>> {
-    let valid_to = rows
-        .iter()
-        .position(|r| r.inc_deg > model.max_inc_deg)
-        .unwrap_or(rows.len());
+) -> Result<Option<Invalid>> {
+    let invalid = rows.iter().enumerate().find_map(|(k, r)| {
+        model
+            .validity
+            .check(r)
+            .map(|reason| Invalid { station: k, reason })
+    });
+    let valid_to = invalid.as_ref().map_or(rows.len(), |i| i.station);
     let stations: Vec<survey_error::Station> = rows[..valid_to]
         .iter()
         .map(|r| survey_error::Station {
@@ -380,6 +442,7 @@ pub fn apply_model(
             inc: r.inc_deg.to_radians(),
             azi: r.azi_deg.to_radians(),
             tvd: r.tvd_m,
+            toolface: r.input.toolface_deg.map(f64::to_radians),
         })
         .collect();
     if !stations.is_empty() {
@@ -392,11 +455,20 @@ pub fn apply_model(
                 result.missing.join(", ")
             );
         }
-        for (row, cov) in rows.iter_mut().zip(result.total) {
+        for (k, (row, cov)) in rows.iter_mut().zip(result.total).enumerate() {
+            // every station before the first invalid one is valid: a
+            // non-finite covariance here is a fault, not a flag
+            if !cov.iter().all(|x| x.is_finite()) {
+                bail!(
+                    "error model {}: non-finite covariance at station {k} (MD {} m)",
+                    model.name,
+                    row.md_m
+                );
+            }
             row.cov = Some(cov);
         }
     }
-    Ok((valid_to < rows.len()).then_some(valid_to))
+    Ok(invalid)
 }
 
 #[cfg(test)]
@@ -409,10 +481,37 @@ mod tests {
 
     #[test]
     fn embedded_tables_parse() {
+        // every model's every term has its weighting function: a short
+        // survey at 45 deg runs with nothing missing and a finite result
+        let f = file("md_m,inc_deg,azi_deg\n0,0,0\n300,45,30\n600,45,30\n");
+        let tie = TieOnInput {
+            md: None,
+            tvd: 0.0,
+            north: 0.0,
+            east: 0.0,
+        };
+        let site = Site {
+            gravity: 9.80665,
+            b_total: 50_000.0,
+            dip: 72f64.to_radians(),
+            declination: 0.0,
+            vertical_limit: 1e-4f64.to_radians(),
+            latitude: 45f64.to_radians(),
+            gyro_noise_reduction: 1.0,
+        };
         for m in &MODELS {
             let terms = terms(m).unwrap();
-            assert!(terms.len() >= 18, "{}", m.name);
+            assert!(terms.len() >= 17, "{}", m.name);
+            let (mut rows, _) = compute(&f, AzimuthReference::True, tie, None).unwrap();
+            assert_eq!(apply_model(&mut rows, m, &terms, &site).unwrap(), None);
+            let last = rows.last().unwrap().cov.unwrap();
+            assert!(
+                last.iter().all(|x| x.is_finite()) && last[0] > 0.0,
+                "{}",
+                m.name
+            );
         }
+        assert_eq!(model("probe-scc1300").unwrap().name, "PROBE-SCC1300");
         assert_eq!(model("iscwsa  mwd rev5").unwrap().name, "ISCWSA MWD Rev5");
         assert!(model("ISCWSA MWD Rev4").is_err());
     }
