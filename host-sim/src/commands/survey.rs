@@ -6,7 +6,8 @@ use super::site::SiteArgs;
 use anyhow::{bail, Context, Result};
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::{
-    self as listing, ellipse::scale_2d, AzimuthReference, KnownModel, Row, StationFile, TieOnInput,
+    self as listing, ellipse::scale_2d, plot, AzimuthReference, KnownModel, LengthUnit, Row,
+    StationFile, TieOnInput,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -97,6 +98,10 @@ pub struct Args {
     /// Write a WITSML 1.4.1.1 trajectory here (XML).
     #[arg(long)]
     pub witsml: Option<PathBuf>,
+    /// Write plan.svg/.png and section.svg/.png (path and 2-sigma error
+    /// ellipses) into this directory (created if missing).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 /// What the outputs need besides the rows.
@@ -107,9 +112,15 @@ struct Survey {
     /// First station the model is not valid at.
     invalid_from: Option<usize>,
     confidence: f64,
+    /// Length unit of the station file (the figures use it).
+    unit: LengthUnit,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(dir) = &args.plot {
+        // refused before any work: a file in the way is the user's mistake
+        plot::prepare_dir(dir)?;
+    }
     let file = read(&args.stations)?;
     let survey = compute(&args, &file)?;
     report(&survey);
@@ -154,6 +165,7 @@ fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
         model,
         invalid_from,
         confidence: args.confidence,
+        unit: file.unit,
     })
 }
 
@@ -249,6 +261,23 @@ fn write_outputs(args: &Args, s: &Survey) -> Result<()> {
     }
     if let Some(p) = &args.witsml {
         write(p, witsml_text(s))?;
+    }
+    if let Some(dir) = &args.plot {
+        let well = args
+            .stations
+            .file_stem()
+            .map_or_else(|| "survey".into(), |n| n.to_string_lossy());
+        let figures = plot::SurveyPlot {
+            rows: &s.rows,
+            unit: s.unit,
+            vsec_azimuth: s.vsec_azimuth_deg.to_radians(),
+            well: &well,
+            model: s.model.map(|m| m.name),
+        };
+        let files = figures.write(dir)?;
+        for f in files {
+            outln!("wrote {}", f.display());
+        }
     }
     Ok(())
 }
