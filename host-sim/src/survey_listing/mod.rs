@@ -10,6 +10,7 @@
 
 pub mod ellipse;
 pub mod plot;
+pub mod separation;
 
 use crate::analysis::text_records::{excerpt, for_each_record};
 use crate::survey_error::{self, Cov6, ErrorTerm, Site};
