@@ -174,3 +174,40 @@ fn plot_onto_a_file_is_refused() {
     // the file is left alone
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
+
+#[test]
+fn offset_well_is_drawn_without_ellipses() {
+    let dir = scratch("offset");
+    let plots = dir.join("figures");
+    let json = dir.join("survey.json");
+    let well = well1();
+    let mut args = vec![s(&well)];
+    args.extend_from_slice(&WELL1_SITE);
+    args.extend_from_slice(&[
+        "--error-model",
+        "ISCWSA MWD Rev5",
+        "--offset",
+        s(&well),
+        "--offset-tie-on-north",
+        "30",
+        "--hole-radius-m",
+        "0.1",
+        "--offset-hole-radius-m",
+        "0.1",
+        "--json",
+        s(&json),
+        "--plot",
+        s(&plots),
+    ]);
+    let run = host_sim(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let n = doc["stations"].as_array().unwrap().len();
+    for stem in ["plan", "section"] {
+        let svg = plots.join(format!("{stem}.svg"));
+        // the reference well's ellipses only
+        assert_eq!(ellipses_in(&svg), n);
+        assert!(svg_text(&svg).contains("offset well well1_stations.csv"));
+    }
+}

@@ -157,6 +157,9 @@ struct Offset {
     model: Option<&'static KnownModel>,
     rule: sep::Rule,
     seps: Vec<sep::Separation>,
+    /// The offset's file name (figures' legend) and its rows.
+    short_name: String,
+    rows: Vec<Row>,
 }
 
 /// What the outputs need besides the rows.
@@ -280,6 +283,10 @@ fn offset(args: &Args, path: &Path, reference: &StationFile, s: &Survey) -> Resu
         model,
         rule,
         seps,
+        short_name: path
+            .file_name()
+            .map_or_else(|| "offset".into(), |n| n.to_string_lossy().into_owned()),
+        rows,
     })
 }
 
@@ -457,6 +464,10 @@ fn write_outputs(args: &Args, s: &Survey) -> Result<()> {
             vsec_azimuth: s.vsec_azimuth_deg.to_radians(),
             well: &well,
             model: s.model.map(|m| m.name),
+            offset: s
+                .offset
+                .as_ref()
+                .map(|o| (o.short_name.as_str(), o.rows.as_slice())),
         };
         let files = figures.write(dir)?;
         for f in files {

@@ -35,6 +35,7 @@ pub const FONT: &str = "sans-serif";
 /// line), so a reader (or a test) can tell them apart in the SVG.
 pub const ELLIPSE_COLOUR: RGBColor = RGBColor(214, 39, 40);
 const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
+const OTHER_COLOUR: RGBColor = RGBColor(44, 160, 44);
 /// Points per ellipse outline.
 const ELLIPSE_POINTS: usize = 73;
 
@@ -147,6 +148,8 @@ pub struct Panel {
     /// The y axis grows downwards (TVD): y is drawn negated and labelled
     /// with its true value.
     pub y_down: bool,
+    /// Other wells' paths (legend label, points), drawn without ellipses.
+    pub others: Vec<(String, Vec<(f64, f64)>)>,
 }
 
 const MARGIN: u32 = 15;
@@ -195,6 +198,7 @@ impl Figure for Panel {
             .iter()
             .chain(self.ellipses.iter().flatten())
             .chain(&self.no_cov)
+            .chain(self.others.iter().flat_map(|o| &o.1))
             .map(flip);
         let ((x0, x1), (y0, y1)) = equal_ranges(all, px);
         let mut chart = ChartBuilder::on(&area)
@@ -248,6 +252,18 @@ impl Figure for Panel {
             .legend(|(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], PATH_COLOUR.stroke_width(2))
             });
+        for (label, points) in &self.others {
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().map(flip),
+                    OTHER_COLOUR.stroke_width(2),
+                ))
+                .map_err(plot_error)?
+                .label(label.as_str())
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], OTHER_COLOUR.stroke_width(2))
+                });
+        }
         if !self.no_cov.is_empty() {
             chart
                 .draw_series(
@@ -282,6 +298,8 @@ pub struct SurveyPlot<'a> {
     pub well: &'a str,
     /// Error model name, if one was run.
     pub model: Option<&'a str>,
+    /// An offset well (name, rows) drawn as a path without ellipses.
+    pub offset: Option<(&'a str, &'a [Row])>,
 }
 
 impl SurveyPlot<'_> {
@@ -309,6 +327,7 @@ impl SurveyPlot<'_> {
             no_cov: Vec::new(),
             no_cov_note: String::new(),
             y_down: false,
+            others: Vec::new(),
         };
         let mut section = Panel {
             title: format!("{}: vertical section, {what}", self.well),
@@ -320,6 +339,7 @@ impl SurveyPlot<'_> {
             no_cov: Vec::new(),
             no_cov_note: String::new(),
             y_down: true,
+            others: Vec::new(),
         };
         for r in self.rows {
             let p = (k * r.east_m, k * r.north_m);
@@ -355,6 +375,21 @@ impl SurveyPlot<'_> {
         };
         plan.no_cov_note = note.clone();
         section.no_cov_note = note;
+        if let Some((name, rows)) = self.offset {
+            let label = format!("offset well {name} (no ellipses drawn)");
+            let (sa, ca) = a.sin_cos();
+            plan.others.push((
+                label.clone(),
+                rows.iter().map(|r| (k * r.east_m, k * r.north_m)).collect(),
+            ));
+            // projected on the reference well's section plane
+            section.others.push((
+                label,
+                rows.iter()
+                    .map(|r| (k * (r.north_m * ca + r.east_m * sa), k * r.tvd_m))
+                    .collect(),
+            ));
+        }
         (plan, section)
     }
 
