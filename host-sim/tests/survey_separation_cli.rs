@@ -197,4 +197,9 @@ fn bad_offset_input_is_refused() {
     let mut args = vec![s(&a), "--offset", s(&b), "--offset-error-model", "nonsense"];
     args.extend_from_slice(&radii);
     refused(&host_sim(&args), "unknown error model");
+    // offset options without an offset well are a mistake, not ignored
+    refused(
+        &host_sim(&[s(&a), "--hole-radius-m", "0.1"]),
+        "needs --offset",
+    );
 }

@@ -176,6 +176,18 @@ struct Survey {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let o = &args.sep;
+    if o.offset.is_none() {
+        let given = [
+            ("--offset-tie-on-md", o.offset_tie_on_md.is_some()),
+            ("--offset-error-model", o.offset_error_model.is_some()),
+            ("--hole-radius-m", o.hole_radius_m.is_some()),
+            ("--offset-hole-radius-m", o.offset_hole_radius_m.is_some()),
+        ];
+        if let Some((flag, _)) = given.iter().find(|g| g.1) {
+            bail!("{flag} needs --offset (an offset well)");
+        }
+    }
     if let Some(dir) = &args.plot {
         // refused before any work: a file in the way is the user's mistake
         plot::prepare_dir(dir)?;
