@@ -120,7 +120,7 @@ fn well1_mwd_rev5_figures() {
         let text = svg_text(&svg);
         assert!(text.contains("ISCWSA MWD Rev5"), "{text}");
         assert!(text.contains("2-sigma"), "{text}");
-        assert!(text.contains("(m"), "unit missing: {text}");
+        assert!(text.contains("(m,"), "unit missing: {text}");
         let (w, h, drawn) = png_stats(&dir.join(format!("{stem}.png")));
         assert_eq!((w, h), SIZE);
         // path, ellipses, axes and text: far more than a few pixels
@@ -210,4 +210,26 @@ fn offset_well_is_drawn_without_ellipses() {
         assert_eq!(ellipses_in(&svg), n);
         assert!(svg_text(&svg).contains("offset well well1_stations.csv"));
     }
+}
+
+#[test]
+fn feet_file_plotted_in_feet() {
+    let dir = scratch("feet");
+    let path = dir.join("ft.csv");
+    std::fs::write(
+        &path,
+        "md_ft,inc_deg,azi_deg\n0,0,0\n1000,10,45\n2000,20,45\n3000,30,45\n",
+    )
+    .unwrap();
+    let plots = dir.join("figures");
+    let run = host_sim(&[s(&path), "--plot", s(&plots)]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    for stem in ["plan", "section"] {
+        let text = svg_text(&plots.join(format!("{stem}.svg")));
+        assert!(text.contains("(ft"), "{text}");
+        assert!(!text.contains("(m,") && !text.contains("(m)"), "{text}");
+    }
+    // TVD axis labels in feet: the well reaches ~2850 ft TVD, ~870 m
+    let section = svg_text(&plots.join("section.svg"));
+    assert!(section.lines().any(|l| l.trim() == "2500"), "{section}");
 }
