@@ -5,8 +5,10 @@ use super::limits::number_in;
 use super::site::SiteArgs;
 use anyhow::{bail, Context, Result};
 use host_sim::survey_error::Site;
+use host_sim::survey_listing::separation as sep;
 use host_sim::survey_listing::{
-    self as listing, ellipse::scale_2d, AzimuthReference, KnownModel, Row, StationFile, TieOnInput,
+    self as listing, ellipse::scale_2d, plot, AzimuthReference, KnownModel, LengthUnit, Row,
+    StationFile, TieOnInput,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -36,6 +38,12 @@ fn declination_deg(text: &str) -> Result<f64, String> {
 }
 fn azimuth_deg(text: &str) -> Result<f64, String> {
     number_in(text, "the vertical-section azimuth", (0.0, 360.0), "deg")
+}
+fn radius_m(text: &str) -> Result<f64, String> {
+    number_in(text, "a hole radius", (0.0, 10.0), "m")
+}
+fn margin_m(text: &str) -> Result<f64, String> {
+    number_in(text, "the margin", (0.0, 100.0), "m")
 }
 fn confidence(text: &str) -> Result<f64, String> {
     let p = number_in(text, "the confidence", (0.0, 1.0), "(probability)")?;
@@ -98,6 +106,61 @@ pub struct Args {
     /// Write a WITSML 1.4.1.1 trajectory here (XML).
     #[arg(long)]
     pub witsml: Option<PathBuf>,
+    /// Write plan.svg/.png and section.svg/.png (path and 2-sigma error
+    /// ellipses) into this directory (created if missing).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// The offset well and the separation rule's inputs (boxed: they
+    /// would make every command's argument enum as large as this one).
+    #[command(flatten)]
+    pub sep: Box<OffsetArgs>,
+}
+
+/// Anti-collision options.
+#[derive(clap::Args, Debug)]
+pub struct OffsetArgs {
+    /// Offset well (same CSV format and length unit): closest point,
+    /// centre-to-centre distance and ISCWSA separation factor per station.
+    #[arg(long)]
+    pub offset: Option<PathBuf>,
+    /// MD of the offset's tie-on (file's unit): its first station's MD.
+    #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
+    pub offset_tie_on_md: Option<f64>,
+    /// TVD of the offset's tie-on (file's unit).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
+    pub offset_tie_on_tvd: f64,
+    /// North of the offset's tie-on (file's unit, true north).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
+    pub offset_tie_on_north: f64,
+    /// East of the offset's tie-on (file's unit, true north).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
+    pub offset_tie_on_east: f64,
+    /// Error model of the offset well (default: --error-model).
+    #[arg(long)]
+    pub offset_error_model: Option<String>,
+    /// Open-hole radius of the reference well, m (needed with --offset).
+    #[arg(long, allow_hyphen_values = true, value_parser = radius_m)]
+    pub hole_radius_m: Option<f64>,
+    /// Open-hole radius of the offset well, m (needed with --offset).
+    #[arg(long, allow_hyphen_values = true, value_parser = radius_m)]
+    pub offset_hole_radius_m: Option<f64>,
+    /// Surface margin S_m of the separation rule, m.
+    #[arg(long, default_value_t = sep::SURFACE_MARGIN_M, allow_hyphen_values = true, value_parser = margin_m)]
+    pub surface_margin_m: f64,
+    /// Project-ahead 1-sigma uncertainty sigma_pa of the separation rule, m.
+    #[arg(long, default_value_t = sep::SIGMA_PA_M, allow_hyphen_values = true, value_parser = margin_m)]
+    pub sigma_pa_m: f64,
+}
+
+/// The offset well's separation from the reference stations.
+struct Offset {
+    name: String,
+    model: Option<&'static KnownModel>,
+    rule: sep::Rule,
+    seps: Vec<sep::Separation>,
+    /// The offset's file name (figures' legend) and its rows.
+    short_name: String,
+    rows: Vec<Row>,
 }
 
 /// What the outputs need besides the rows.
@@ -108,11 +171,33 @@ struct Survey {
     /// First station the model is not valid at.
     invalid_from: Option<listing::Invalid>,
     confidence: f64,
+    /// Length unit of the station file (the figures use it).
+    unit: LengthUnit,
+    offset: Option<Offset>,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let o = &args.sep;
+    if o.offset.is_none() {
+        let given = [
+            ("--offset-tie-on-md", o.offset_tie_on_md.is_some()),
+            ("--offset-error-model", o.offset_error_model.is_some()),
+            ("--hole-radius-m", o.hole_radius_m.is_some()),
+            ("--offset-hole-radius-m", o.offset_hole_radius_m.is_some()),
+        ];
+        if let Some((flag, _)) = given.iter().find(|g| g.1) {
+            bail!("{flag} needs --offset (an offset well)");
+        }
+    }
+    if let Some(dir) = &args.plot {
+        // refused before any work: a file in the way is the user's mistake
+        plot::prepare_dir(dir)?;
+    }
     let file = read(&args.stations)?;
-    let survey = compute(&args, &file)?;
+    let mut survey = compute(&args, &file)?;
+    if let Some(path) = &args.sep.offset {
+        survey.offset = Some(offset(&args, path, &file, &survey)?);
+    }
     report(&survey);
     write_outputs(&args, &survey)
 }
@@ -155,7 +240,121 @@ fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
         model,
         invalid_from,
         confidence: args.confidence,
+        unit: file.unit,
+        offset: None,
     })
+}
+
+/// The offset well positioned and given its covariance, and its separation
+/// from every reference station.
+fn offset(args: &Args, path: &Path, reference: &StationFile, s: &Survey) -> Result<Offset> {
+    let (Some(ref_radius_m), Some(offset_radius_m)) =
+        (args.sep.hole_radius_m, args.sep.offset_hole_radius_m)
+    else {
+        bail!("--offset needs --hole-radius-m and --offset-hole-radius-m (open-hole radii, m)");
+    };
+    let file = read(path).context("the offset well")?;
+    if file.unit != reference.unit {
+        bail!(
+            "{}: the offset well's length unit differs from the reference well's (give both in m or both in ft)",
+            path.display()
+        );
+    }
+    let reference_azimuths = match (args.azimuth_reference, args.convergence_deg) {
+        (Reference::Grid, Some(c)) => AzimuthReference::Grid(c.to_radians()),
+        _ => AzimuthReference::True,
+    };
+    let tie = TieOnInput {
+        md: args.sep.offset_tie_on_md,
+        tvd: args.sep.offset_tie_on_tvd,
+        north: args.sep.offset_tie_on_north,
+        east: args.sep.offset_tie_on_east,
+    };
+    let (mut rows, _) = listing::compute(&file, reference_azimuths, tie, None)
+        .with_context(|| format!("offset well {}", path.display()))?;
+    let name = args
+        .sep
+        .offset_error_model
+        .as_deref()
+        .or(args.error_model.as_deref());
+    let model = name.map(listing::model).transpose()?;
+    if let Some(m) = model {
+        let terms = listing::terms(m)?;
+        listing::apply_model(&mut rows, m, &terms, &model_site(args, m)?)
+            .with_context(|| format!("offset well {}", path.display()))?;
+    }
+    let rule = sep::Rule {
+        k: sep::K,
+        surface_margin_m: args.sep.surface_margin_m,
+        sigma_pa_m: args.sep.sigma_pa_m,
+        ref_radius_m,
+        offset_radius_m,
+    };
+    let seps = sep::separations(&s.rows, &rows, &rule)?;
+    Ok(Offset {
+        name: path.display().to_string(),
+        model,
+        rule,
+        seps,
+        short_name: path
+            .file_name()
+            .map_or_else(|| "offset".into(), |n| n.to_string_lossy().into_owned()),
+        rows,
+    })
+}
+
+fn sf_status(x: &sep::Separation) -> &'static str {
+    match x.sf {
+        None => "undetermined",
+        Some(f) if f < 1.0 => "violation",
+        Some(_) => "ok",
+    }
+}
+
+/// The minimum SF and the violations, as lines of text.
+fn separation_summary(s: &Survey) -> Vec<String> {
+    let Some(o) = &s.offset else {
+        return Vec::new();
+    };
+    let mut out = vec![format!(
+        "offset {}: model {}; ISCWSA separation rule (Sawaryn et al. 2019, SPE-187073-PA): k {}, S_m {} m, sigma_pa {} m, hole radii {} m / {} m",
+        o.name,
+        o.model.map_or("none", |m| m.name),
+        o.rule.k,
+        o.rule.surface_margin_m,
+        o.rule.sigma_pa_m,
+        o.rule.ref_radius_m,
+        o.rule.offset_radius_m
+    )];
+    match sep::minimum(&o.seps) {
+        Some((i, f)) => out.push(format!(
+            "minimum SF {:.3} at MD {:.2} m (offset MD {:.2} m, centre to centre {:.2} m +- {:.2} m 1-sigma)",
+            f,
+            s.rows[i].md_m,
+            o.seps[i].closest.md_m,
+            o.seps[i].ctc_m,
+            o.seps[i].sigma_s_m.unwrap_or(f64::NAN)
+        )),
+        None => out.push("minimum SF undetermined: no station has both wells' covariance".into()),
+    }
+    let bad: Vec<usize> = (0..o.seps.len())
+        .filter(|&i| sf_status(&o.seps[i]) == "violation")
+        .collect();
+    if let (Some(&a), Some(&b)) = (bad.first(), bad.last()) {
+        out.push(format!(
+            "VIOLATION of the separation rule (SF < 1) at {} stations, MD {:.2} to {:.2} m",
+            bad.len(),
+            s.rows[a].md_m,
+            s.rows[b].md_m
+        ));
+    }
+    let undetermined = o.seps.iter().filter(|x| x.sf.is_none()).count();
+    if undetermined > 0 {
+        out.push(format!(
+            "SF undetermined at {undetermined} stations (a covariance missing: no model, or beyond its validity)"
+        ));
+    }
+    out
 }
 
 fn model_site(args: &Args, model: &KnownModel) -> Result<Site> {
@@ -207,8 +406,11 @@ fn report(s: &Survey) {
             "sN m", "sE m", "sV m", "major m", "minor m", "az"
         );
     }
+    if s.offset.is_some() {
+        head += &format!(" {:>9} {:>7} {:>8}", "ctc m", "sS m", "SF");
+    }
     outln!("{head}");
-    for r in &s.rows {
+    for (k, r) in s.rows.iter().enumerate() {
         let mut line = format!(
             "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
             r.md_m, r.inc_deg, r.azi_deg, r.tvd_m, r.north_m, r.east_m, r.dls_deg_per_30m, r.vsec_m
@@ -231,10 +433,23 @@ fn report(s: &Survey) {
                 _ => line += "  (outside the model's validity)",
             }
         }
+        if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
+            let _ = write!(line, " {:>9.2}", x.ctc_m);
+            match (x.sigma_s_m, x.sf) {
+                (Some(sig), Some(f)) => {
+                    let flag = if f < 1.0 { " SF<1" } else { "" };
+                    let _ = write!(line, " {sig:>7.2} {f:>8.3}{flag}");
+                }
+                _ => line += "  SF undetermined",
+            }
+        }
         outln!("{line}");
     }
     if let Some(note) = validity_note(s) {
         outln!("note: {note}");
+    }
+    for l in separation_summary(s) {
+        outln!("{l}");
     }
 }
 
@@ -251,6 +466,27 @@ fn write_outputs(args: &Args, s: &Survey) -> Result<()> {
     if let Some(p) = &args.witsml {
         write(p, witsml_text(s))?;
     }
+    if let Some(dir) = &args.plot {
+        let well = args
+            .stations
+            .file_stem()
+            .map_or_else(|| "survey".into(), |n| n.to_string_lossy());
+        let figures = plot::SurveyPlot {
+            rows: &s.rows,
+            unit: s.unit,
+            vsec_azimuth: s.vsec_azimuth_deg.to_radians(),
+            well: &well,
+            model: s.model.map(|m| m.name),
+            offset: s
+                .offset
+                .as_ref()
+                .map(|o| (o.short_name.as_str(), o.rows.as_slice())),
+        };
+        let files = figures.write(dir)?;
+        for f in files {
+            outln!("wrote {}", f.display());
+        }
+    }
     Ok(())
 }
 
@@ -265,8 +501,11 @@ fn csv_text(s: &Survey) -> String {
     if s.model.is_some() {
         out += ",sigma_north_m,sigma_east_m,sigma_vert_m,ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg,confidence,error_model_valid";
     }
+    if s.offset.is_some() {
+        out += ",offset_md_m,ctc_m,sigma_s_m,sf,sf_status";
+    }
     out += "\n";
-    for r in &s.rows {
+    for (k, r) in s.rows.iter().enumerate() {
         let _ = write!(
             out,
             "{},{},{},{},{},{},{},{},{},{}",
@@ -300,6 +539,17 @@ fn csv_text(s: &Survey) -> String {
                 }
             }
         }
+        if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
+            let _ = write!(
+                out,
+                ",{},{},{},{},{}",
+                x.closest.md_m,
+                x.ctc_m,
+                opt(x.sigma_s_m),
+                opt(x.sf),
+                sf_status(x)
+            );
+        }
         out += "\n";
     }
     out
@@ -309,7 +559,8 @@ fn json_text(s: &Survey) -> Result<String> {
     let stations: Vec<serde_json::Value> = s
         .rows
         .iter()
-        .map(|r| {
+        .enumerate()
+        .map(|(k, r)| {
             let mut v = serde_json::json!({
                 "md_m": r.md_m, "inc_deg": r.inc_deg, "azi_deg": r.azi_deg,
                 "tvd_m": r.tvd_m, "north_m": r.north_m, "east_m": r.east_m,
@@ -328,6 +579,16 @@ fn json_text(s: &Survey) -> Result<String> {
                 v["ellipse_azimuth_deg"] = serde_json::json!(e.map(|e| e.azimuth_deg));
                 v["error_model_valid"] = serde_json::json!(r.cov.is_some());
             }
+            if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
+                let c = &x.closest;
+                v["offset_md_m"] = serde_json::json!(c.md_m);
+                v["offset_nev_m"] = serde_json::json!([c.nev.x, c.nev.y, c.nev.z]);
+                v["offset_nev_covariance_m2"] = serde_json::json!(c.cov);
+                v["ctc_m"] = serde_json::json!(x.ctc_m);
+                v["sigma_s_m"] = serde_json::json!(x.sigma_s_m);
+                v["sf"] = serde_json::json!(x.sf);
+                v["sf_status"] = serde_json::json!(sf_status(x));
+            }
             v
         })
         .collect();
@@ -341,6 +602,24 @@ fn json_text(s: &Survey) -> Result<String> {
         "note": validity_note(s),
         "stations": stations,
     });
+    let mut doc = doc;
+    if let Some(o) = &s.offset {
+        let min = sep::minimum(&o.seps);
+        doc["separation"] = serde_json::json!({
+            "offset": o.name,
+            "offset_error_model": o.model.map(|m| m.name),
+            "rule": "ISCWSA separation rule, Sawaryn et al. 2019 (SPE-187073-PA): SF = (D - R_ref - R_off - S_m) / (k sqrt(sigma_S^2 + sigma_pa^2)); offset covariance interpolated linearly in MD at the closest point",
+            "k": o.rule.k,
+            "surface_margin_m": o.rule.surface_margin_m,
+            "sigma_pa_m": o.rule.sigma_pa_m,
+            "hole_radius_m": o.rule.ref_radius_m,
+            "offset_hole_radius_m": o.rule.offset_radius_m,
+            "min_sf": min.map(|m| m.1),
+            "min_sf_md_m": min.map(|m| s.rows[m.0].md_m),
+            "violation": o.seps.iter().any(|x| x.sf.is_some_and(|f| f < 1.0)),
+            "summary": separation_summary(s),
+        });
+    }
     Ok(serde_json::to_string_pretty(&doc)? + "\n")
 }
 

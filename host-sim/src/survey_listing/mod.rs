@@ -9,6 +9,8 @@
 //! outputs). Outputs are in metres whatever the input unit.
 
 pub mod ellipse;
+pub mod plot;
+pub mod separation;
 
 use crate::analysis::text_records::{excerpt, for_each_record};
 use crate::survey_error::{self, Cov6, ErrorTerm, Site};
