@@ -319,8 +319,9 @@ impl Drilling {
         turns
     }
 
-    /// The first time the bit reaches `md` (bisection in its drill phase).
-    fn time_at_md(&self, md: f64) -> f64 {
+    /// The first time the bit reaches `md` (bisection in its drill phase;
+    /// the end of the run beyond the plan).
+    pub fn time_at_md(&self, md: f64) -> f64 {
         for ph in &self.phases {
             if let PhaseKind::Drill { length, .. } = ph.kind {
                 if md <= ph.md0 + length {
@@ -483,7 +484,9 @@ impl Drilling {
 
     /// Number of 20 Hz samples of the run.
     pub fn sample_count(&self, dt: f64) -> usize {
-        (self.duration / dt).ceil() as usize
+        // The last sample ends at or after the run's end (a duration on the
+        // grid up to rounding gives no extra sample).
+        (self.duration / dt - 1e-6).ceil().max(0.0) as usize
     }
 }
 

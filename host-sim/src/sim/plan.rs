@@ -113,14 +113,14 @@ pub struct Vibration {
 
 impl Vibration {
     /// The default: a moderate sliding environment, 2 g RMS lateral and
-    /// 1 g axial over 5-500 Hz, 5 deg/s angular, 6 shocks of 30 g per hour.
+    /// 1 g axial over 5-500 Hz, 1 deg/s angular, 6 shocks of 30 g per hour.
     pub const MODERATE: Self = Self {
         lateral_rms_g: 2.0,
         axial_rms_g: 1.0,
         band_low_hz: 5.0,
         band_high_hz: 500.0,
         sensor_lowpass_hz: 50.0,
-        angular_rms_deg_s: 5.0,
+        angular_rms_deg_s: 1.0,
         shocks_per_hour: 6.0,
         shock_peak_g: 30.0,
         shock_duration_ms: 1.0,
