@@ -70,7 +70,11 @@ pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
         // reports the sample saturated, not valid (firmware::scc1300::accel,
         // app::sensor_wire::raw_part). The counts are still sent.
         let accel_limit = (sensor_units::ACCEL_RANGE_G * sensor_units::ACCEL_LSB_PER_G) as i16;
-        let accel = if part.accel.iter().any(|c| c.unsigned_abs() > accel_limit as u16) {
+        let accel = if part
+            .accel
+            .iter()
+            .any(|c| c.unsigned_abs() > accel_limit as u16)
+        {
             raw_flags::ACCEL_SATURATED
         } else {
             raw_flags::ACCEL_VALID

@@ -59,7 +59,11 @@ fn truth_positions_match_minimum_curvature_at_the_plan_stations() {
         for (k, (&(md, inc, azi), nev)) in stations.iter().zip(&expected).enumerate() {
             let t = drilling.time_at_md(md);
             let truth = drilling.truth(t);
-            assert!((truth.md - md).abs() < 1e-6, "{name} station {k}: MD {}", truth.md);
+            assert!(
+                (truth.md - md).abs() < 1e-6,
+                "{name} station {k}: MD {}",
+                truth.md
+            );
             // MD is reached to 1e-6 m: positions agree to that.
             assert!(
                 (truth.point.nev - nev).norm() < 1e-5,
@@ -81,7 +85,10 @@ fn truth_positions_match_minimum_curvature_at_the_plan_stations() {
         while md < last {
             let truth = drilling.truth(drilling.time_at_md(md));
             let survey = plan.interpolate(truth.md).expect("inside the plan");
-            assert!((truth.point.nev - survey.nev).norm() < 1e-9, "{name} at {md}");
+            assert!(
+                (truth.point.nev - survey.nev).norm() < 1e-9,
+                "{name} at {md}"
+            );
             md += 23.3;
         }
     }
@@ -269,7 +276,15 @@ fn the_same_seed_gives_the_same_capture_and_another_seed_another() {
     let out = |seed: &str, name: &str| {
         let path = dir.join(name);
         let r = run(&[
-            "simulate", "--motion", "lateral", "--plan", s(&plan), "-o", s(&path), "--seed", seed,
+            "simulate",
+            "--motion",
+            "lateral",
+            "--plan",
+            s(&plan),
+            "-o",
+            s(&path),
+            "--seed",
+            seed,
         ]);
         assert_eq!(r.code, Some(0), "{}", r.stderr);
         std::fs::read(path).unwrap()
@@ -290,8 +305,8 @@ fn vibration_reaches_the_samples_as_stated_and_harsh_levels_clip() {
     let drilling = Drilling::new(plan.clone(), 2);
     let (mut still, mut moving) = (Vec::new(), Vec::new());
     let mut x = Vec::new();
-    for d in DrillingSimulator::new(&drilling, SensorModel::scc1300(2), SAMPLE_INTERVAL_S)
-        .take(200_000)
+    for d in
+        DrillingSimulator::new(&drilling, SensorModel::scc1300(2), SAMPLE_INTERVAL_S).take(200_000)
     {
         let dev = (d.sample.accel.norm() - 9.80665).abs();
         match d.truth.state {
@@ -318,8 +333,8 @@ fn vibration_reaches_the_samples_as_stated_and_harsh_levels_clip() {
     plan.drilling.vibration = Vibration::HARSH;
     let drilling = Drilling::new(plan, 2);
     let (mut over, mut drilled, mut over_still) = (0, 0, 0);
-    for d in DrillingSimulator::new(&drilling, SensorModel::scc1300(2), SAMPLE_INTERVAL_S)
-        .take(200_000)
+    for d in
+        DrillingSimulator::new(&drilling, SensorModel::scc1300(2), SAMPLE_INTERVAL_S).take(200_000)
     {
         match d.truth.state {
             DrillState::Drilling => {
@@ -387,7 +402,13 @@ fn bad_plans_and_arguments_are_refused_with_a_reason() {
         assert!(r.stderr.contains(needle), "{name}: {}", r.stderr);
         assert!(!r.stderr.contains("panicked"), "{name}: {}", r.stderr);
     }
-    let r = run(&["simulate", "--motion", "lateral", "-o", s(&dir.join("x.bin"))]);
+    let r = run(&[
+        "simulate",
+        "--motion",
+        "lateral",
+        "-o",
+        s(&dir.join("x.bin")),
+    ]);
     assert_eq!(r.code, Some(1));
     assert!(r.stderr.contains("--plan"), "{}", r.stderr);
     let r = run(&[

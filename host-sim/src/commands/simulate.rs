@@ -356,10 +356,12 @@ fn run_lateral(args: &Args) -> Result<()> {
             );
             write_capture(output, samples, site)?;
         }
-        OutputFormat::Csv if to_stdout => match samples_csv::write(std::io::stdout().lock(), samples) {
-            Err(e) if is_broken_pipe(&e) => {}
-            other => other?,
-        },
+        OutputFormat::Csv if to_stdout => {
+            match samples_csv::write(std::io::stdout().lock(), samples) {
+                Err(e) if is_broken_pipe(&e) => {}
+                other => other?,
+            }
+        }
         OutputFormat::Csv => write_csv(output, samples)?,
     }
     if let Some(e) = failure {

@@ -20,11 +20,11 @@
 //!   error model ([`SensorErrors`]).
 use super::plan::{BuiltPlan, PathPoint};
 use super::sensor::{SensorErrors, SensorModel, SimSample};
+use core::f64::consts::FRAC_PI_2;
 use mwd_core::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler, DEG};
 use mwd_core::earth::{LocalEarth, Position};
 use mwd_core::sensor_units::STANDARD_GRAVITY;
 use nalgebra::{Matrix3, Vector3};
-use core::f64::consts::FRAC_PI_2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Exp, StandardNormal};
@@ -267,7 +267,11 @@ impl Drilling {
             t = push(&mut phases, t, p.connection_still_s, md, PhaseKind::Still);
             let change = p.toolface_change_per_connection_deg * DEG;
             if end - md > 1e-9 && change > 0.0 {
-                let delta = if rng.random::<bool>() { change } else { -change };
+                let delta = if rng.random::<bool>() {
+                    change
+                } else {
+                    -change
+                };
                 let turn = change / turn_rate;
                 steps.push(Ramp {
                     t0: t,
@@ -302,9 +306,8 @@ impl Drilling {
             let md_b = self.plan.sections[k].start_md;
             let before = self.plan.at_in_section(md_b, k - 1);
             let after = self.plan.at_in_section(md_b, k);
-            let delta = wrap_pi(
-                self.plan.section_toolface(&after) - self.plan.section_toolface(&before),
-            );
+            let delta =
+                wrap_pi(self.plan.section_toolface(&after) - self.plan.section_toolface(&before));
             if delta.abs() < 1e-12 {
                 continue;
             }
@@ -466,8 +469,7 @@ impl Drilling {
     /// The surface depth log's MD for a true MD and TVD: md (1 + scale)
     /// + stretch md TVD (ISCWSA DSF and DST).
     pub fn logged_md(&self, md: f64, tvd: f64) -> f64 {
-        let d = &self.plan.drilling.depth_errors;
-        md * (1.0 + d.scale_ppm * 1e-6) + d.stretch_per_m * md * tvd
+        self.plan.logged_md(md, tvd)
     }
 
     /// The depth log: (time, logged MD) every `depth_log_interval_s`.
@@ -574,7 +576,8 @@ impl<'a> DrillingSimulator<'a> {
             let w_en = earth.transport_rate_n(&v);
             let t = s.tangent();
             // Along the arc: d(v t)/dt = v' t + v^2 kappa (k x t).
-            let a = t * s.accel_along + s.point.axis.cross(&t) * (s.speed * s.speed * s.point.curvature);
+            let a = t * s.accel_along
+                + s.point.axis.cross(&t) * (s.speed * s.speed * s.point.curvature);
             let c_nb = s.c_bn.transpose();
             (
                 c_nb * (w_ie + w_en),
@@ -726,7 +729,11 @@ mod tests {
             let now = sim.truth(t);
             let jump = wrap_pi(now.toolface - prev.toolface).abs();
             // At most the turn rate (10 deg/s) plus the arc's own change.
-            assert!(jump < 0.6 * DEG, "toolface jumps {} deg at {t} s", jump / DEG);
+            assert!(
+                jump < 0.6 * DEG,
+                "toolface jumps {} deg at {t} s",
+                jump / DEG
+            );
             prev = now;
             t += dt;
         }

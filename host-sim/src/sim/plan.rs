@@ -418,8 +418,9 @@ impl Plan {
         self.drilling.check()?;
         ensure!(!self.sections.is_empty(), "the plan has no sections");
 
-        let tie_on = TieOn::<TrueNorth>::new(t.md_m, t.tvd_m, t.north_m, t.east_m, Matrix3::zeros())
-            .map_err(|e| anyhow::anyhow!("tie_on: {e}"))?;
+        let tie_on =
+            TieOn::<TrueNorth>::new(t.md_m, t.tvd_m, t.north_m, t.east_m, Matrix3::zeros())
+                .map_err(|e| anyhow::anyhow!("tie_on: {e}"))?;
         let first = TrueStation::new(t.md_m, t.inclination_deg * DEG, t.azimuth_deg * DEG)
             .map_err(|e| anyhow::anyhow!("tie_on: {e}"))?;
         let mut stations = vec![first];
@@ -466,7 +467,11 @@ impl Plan {
                         "section {n} (curve): dls_deg_per_30m ({dls_deg_per_30m}) must be above 0 \
                          and at most {MAX_DLS_DEG_PER_30M} deg/30 m (no motor drills more)"
                     );
-                    check_direction(&format!("section {n} (curve)"), inclination_deg, azimuth_deg)?;
+                    check_direction(
+                        &format!("section {n} (curve)"),
+                        inclination_deg,
+                        azimuth_deg,
+                    )?;
                     let (inc, azi) = (inclination_deg * DEG, wrap_two_pi(azimuth_deg * DEG));
                     let beta = dogleg(last.inclination(), last.azimuth(), inc, azi);
                     ensure!(
@@ -505,14 +510,16 @@ impl Plan {
         let points = positions(&tie_on, &stations)
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| anyhow::anyhow!("the plan's stations: {e}"))?;
-        Ok(BuiltPlan {
+        let built = BuiltPlan {
             site: Position::from_degrees(s.latitude_deg, s.longitude_deg, s.height_m),
             tie_on,
             stations,
             points,
             sections,
             drilling: self.drilling,
-        })
+        };
+        built.check_depth_log_monotone()?;
+        Ok(built)
     }
 }
 
@@ -529,6 +536,33 @@ fn check_direction(what: &str, inclination_deg: f64, azimuth_deg: f64) -> Result
 }
 
 impl BuiltPlan {
+    /// The surface's MD for a true MD and TVD: md (1 + scale) + stretch md
+    /// TVD (ISCWSA DSF and DST).
+    pub fn logged_md(&self, md: f64, tvd: f64) -> f64 {
+        let d = &self.drilling.depth_errors;
+        md * (1.0 + d.scale_ppm * 1e-6) + d.stretch_per_m * md * tvd
+    }
+
+    /// The depth errors must keep the logged MD increasing with MD (a
+    /// stretch term of a hole climbing steeply could make it fall):
+    /// checked every metre and at the stations.
+    fn check_depth_log_monotone(&self) -> Result<()> {
+        let (start, end) = (self.start_md(), self.end_md());
+        let steps = (end - start).ceil().max(1.0) as usize;
+        let mut previous = self.logged_md(start, self.points[0].tvd());
+        for i in 1..=steps {
+            let md = (start + i as f64).min(end);
+            let logged = self.logged_md(md, self.at(md).nev.z);
+            ensure!(
+                logged > previous,
+                "drilling.depth_errors: the logged MD would decrease near MD {md:.0} m \
+                 (stretch x (TVD + MD cos I) below -(1 + scale))"
+            );
+            previous = logged;
+        }
+        Ok(())
+    }
+
     pub fn start_md(&self) -> f64 {
         self.stations[0].md()
     }
