@@ -431,7 +431,10 @@ impl Drilling {
 
     /// The truth at time t.
     pub fn truth(&self, t: f64) -> Truth {
-        let (md, speed, accel_along, state) = self.kinematics(t);
+        let (md, speed, accel_along, mut state) = self.kinematics(t);
+        if state == DrillState::Still && self.boundary_turning(t, t) {
+            state = DrillState::Connection;
+        }
         let point = self.plan.at(md);
         let toolface = wrap_pi(self.plan.section_toolface(&point) + self.toolface_offset(t));
         let c_bn = dcm_from_euler(&Euler::new(
@@ -452,11 +455,22 @@ impl Drilling {
         }
     }
 
-    /// Whether [t0, t1] lies in one still phase (nothing moves).
+    /// Whether a turn to a new section's toolface is under way in (t0, t1)
+    /// (it may begin in the still period before the stand that reaches the
+    /// boundary).
+    fn boundary_turning(&self, t0: f64, t1: f64) -> bool {
+        self.boundary_turns.iter().any(|r| r.t0 < t1 && r.t1 > t0)
+    }
+
+    /// Whether [t0, t1] lies in one still phase with nothing moving.
     fn still_interval(&self, t0: f64, t1: f64) -> Option<usize> {
         let k = self.phase_index(t0)?;
         let ph = &self.phases[k];
-        (ph.kind == PhaseKind::Still && t1 <= ph.t1 && t0 >= ph.t0).then_some(k)
+        (ph.kind == PhaseKind::Still
+            && t1 <= ph.t1
+            && t0 >= ph.t0
+            && !self.boundary_turning(t0, t1))
+        .then_some(k)
     }
 
     /// Whether the bit is on bottom (vibration, shocks) at t.
@@ -510,6 +524,9 @@ pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
     v * (theta / s)
 }
 
+/// Interval means of omega_ib^b (rad/s) and the specific force (m/s^2).
+type IdealMeans = (Vector3<f64>, Vector3<f64>);
+
 /// One simulated sample with the truth at its end and what clipped.
 #[derive(Clone, Debug)]
 pub struct DrillSample {
@@ -531,7 +548,7 @@ pub struct DrillingSimulator<'a> {
     vibration_rng: ChaCha8Rng,
     previous: Truth,
     /// Still phase index and ideal means of the last still interval.
-    still_cache: Option<(usize, (Vector3<f64>, Vector3<f64>))>,
+    still_cache: Option<(usize, IdealMeans)>,
     next_shock: usize,
     /// Per-sample vibration sigmas: accel (m/s^2) x, y, z and gyro (rad/s).
     accel_sigma: Vector3<f64>,
@@ -567,7 +584,7 @@ impl<'a> DrillingSimulator<'a> {
     }
 
     /// Ideal interval means (omega_ib^b, f^b) over [prev.time, end.time].
-    fn ideal_means(&self, start: &Truth, mid: &Truth, end: &Truth) -> (Vector3<f64>, Vector3<f64>) {
+    fn ideal_means(&self, start: &Truth, mid: &Truth, end: &Truth) -> IdealMeans {
         let earth = LocalEarth::at(&mid.position);
         let w_ie = earth.earth_rate_n();
         let g = earth.gravity_n();
@@ -737,6 +754,54 @@ mod tests {
             prev = now;
             t += dt;
         }
+    }
+
+    #[test]
+    fn a_turn_to_a_new_section_toolface_before_drilling_is_not_still() {
+        // The boundary 0.01 m into the second stand: the turn from
+        // toolface 150 deg to the build's 0 deg (15 s) starts at the
+        // connection, before drilling resumes.
+        let p = plan();
+        let mut plan = Plan {
+            site: Site::default(),
+            tie_on: TieOnSpec {
+                md_m: 3000.0,
+                tvd_m: 2000.0,
+                north_m: 0.0,
+                east_m: 0.0,
+                inclination_deg: 90.0,
+                azimuth_deg: 10.0,
+            },
+            sections: vec![
+                Section::Hold {
+                    end_md_m: 3009.01,
+                    toolface_deg: 150.0,
+                },
+                Section::Curve {
+                    dls_deg_per_30m: 6.0,
+                    inclination_deg: 92.0,
+                    azimuth_deg: 10.0,
+                },
+            ],
+            drilling: p.drilling,
+        };
+        plan.drilling.toolface_change_per_connection_deg = 0.0;
+        plan.drilling.sliding_toolface_steps_per_hour = 0.0;
+        let sim = Drilling::new(plan.build().expect("valid"), 1);
+        let dt = 0.05;
+        let mut prev = sim.truth(0.0);
+        let mut turning_at_rest = 0;
+        let mut t = dt;
+        while t < sim.duration() {
+            let now = sim.truth(t);
+            if (now.toolface - prev.toolface).abs() > 1e-9 && now.md == prev.md {
+                turning_at_rest += 1;
+                assert_eq!(now.state, DrillState::Connection, "at {t} s");
+            }
+            prev = now;
+            t += dt;
+        }
+        assert!(turning_at_rest > 10, "{turning_at_rest}");
     }
 
     #[test]
