@@ -234,6 +234,25 @@ fn cli_writes_truth_depth_log_and_a_capture_of_every_sample() {
         assert!((still.3 - (2000.0 + 10.0 * (i + 1) as f64)).abs() < 1e-6);
     }
     assert_eq!(runs.iter().filter(|r| r.0 == "connection").count(), 2);
+    // Each connection turns the toolface by the plan's 30 deg (default),
+    // MD unchanged.
+    let c_tf = col("toolface_deg");
+    let mut turns = 0;
+    for w in rows.windows(2) {
+        if w[0][c_state] == "still" && w[1][c_state] == "connection" {
+            let before = num(&w[0], c_tf);
+            let end = rows
+                .iter()
+                .skip_while(|r| num(r, c_t) <= num(&w[1], c_t))
+                .find(|r| r[c_state] != "connection")
+                .expect("drilling after the connection");
+            let turned = (num(end, c_tf) - before + 540.0).rem_euclid(360.0) - 180.0;
+            assert!((turned.abs() - 30.0).abs() < 0.01, "turned {turned} deg");
+            assert_eq!(num(end, c_md), num(&w[0], c_md));
+            turns += 1;
+        }
+    }
+    assert_eq!(turns, 2);
 
     // Depth log: monotone, and md_log - md = scale md + stretch md TVD.
     let (_, log) = parse_csv(&depth);

@@ -128,6 +128,22 @@ impl Ramp {
     }
 }
 
+/// An orienter step of `size` (rad) from the offset `offset` to the
+/// section's toolface: back towards it when off it, either way at random
+/// when on it. The driller holds the toolface the section needs; the steps
+/// stay within +-(the larger step size) of it.
+fn toward_section(offset: f64, size: f64, rng: &mut ChaCha8Rng) -> f64 {
+    if offset > 1e-12 {
+        -size
+    } else if offset < -1e-12 {
+        size
+    } else if rng.random::<bool>() {
+        size
+    } else {
+        -size
+    }
+}
+
 /// A connection: the still period's times and the MD there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Connection {
@@ -175,8 +191,10 @@ impl Truth {
 pub struct Drilling {
     plan: BuiltPlan,
     phases: Vec<Phase>,
-    /// Orienter steps (connections and sliding).
+    /// Orienter steps (connections and sliding), and the offset before
+    /// each.
     steps: Vec<Ramp>,
+    offsets: Vec<f64>,
     /// Turns to a new section's toolface: (the time the boundary is
     /// reached, the ramp that ends there).
     boundary_turns: Vec<Ramp>,
@@ -197,6 +215,10 @@ impl Drilling {
         let mut phases = Vec::new();
         let mut steps = Vec::new();
         let mut connections = Vec::new();
+        // The orienter's offset from the section's toolface, and its value
+        // before each step (for lookups without summing).
+        let mut offset = 0.0;
+        let mut offsets = Vec::new();
         let push = |phases: &mut Vec<Phase>, t0: f64, length: f64, md0: f64, kind| {
             if length > 0.0 {
                 phases.push(Phase {
@@ -248,12 +270,14 @@ impl Drilling {
                         if te + turn > t - ramp {
                             break;
                         }
-                        let delta = if rng.random::<bool>() { step } else { -step };
+                        let delta = toward_section(offset, step, &mut rng);
                         steps.push(Ramp {
                             t0: te,
                             t1: te + turn,
                             delta,
                         });
+                        offsets.push(offset);
+                        offset += delta;
                         te += turn;
                     }
                 }
@@ -267,17 +291,15 @@ impl Drilling {
             t = push(&mut phases, t, p.connection_still_s, md, PhaseKind::Still);
             let change = p.toolface_change_per_connection_deg * DEG;
             if end - md > 1e-9 && change > 0.0 {
-                let delta = if rng.random::<bool>() {
-                    change
-                } else {
-                    -change
-                };
+                let delta = toward_section(offset, change, &mut rng);
                 let turn = change / turn_rate;
                 steps.push(Ramp {
                     t0: t,
                     t1: t + turn,
                     delta,
                 });
+                offsets.push(offset);
+                offset += delta;
                 t = push(&mut phases, t, turn, md, PhaseKind::Turn);
             }
         }
@@ -286,6 +308,7 @@ impl Drilling {
             plan,
             phases,
             steps,
+            offsets,
             boundary_turns: Vec::new(),
             connections,
             shocks: Vec::new(),
@@ -410,14 +433,12 @@ impl Drilling {
 
     /// The orienter's toolface offset at t (rad).
     fn toolface_offset(&self, t: f64) -> f64 {
-        // Steps are sorted by start and do not overlap: all before the
-        // current one are complete.
+        // Steps are sorted by start and do not overlap: the last one begun
+        // sets the offset.
         let k = self.steps.partition_point(|r| r.t0 <= t);
-        let done: f64 = self.steps[..k.saturating_sub(1)]
-            .iter()
-            .map(|r| r.delta)
-            .sum();
-        let current = k.checked_sub(1).map_or(0.0, |i| self.steps[i].value(t));
+        let steps = k
+            .checked_sub(1)
+            .map_or(0.0, |i| self.offsets[i] + self.steps[i].value(t));
         // Boundary turns: in progress until the boundary, then absorbed by
         // the new section's toolface.
         let boundary: f64 = self
@@ -426,7 +447,7 @@ impl Drilling {
             .filter(|r| t < r.t1)
             .map(|r| r.value(t))
             .sum();
-        done + current + boundary
+        steps + boundary
     }
 
     /// The truth at time t.
@@ -751,6 +772,11 @@ mod tests {
                 "toolface jumps {} deg at {t} s",
                 jump / DEG
             );
+            // The orienter's steps stay around the section's toolface.
+            if !sim.boundary_turning(t, t) {
+                let off = wrap_pi(now.toolface - sim.plan().section_toolface(&now.point));
+                assert!(off.abs() <= 30.0 * DEG + 1e-9, "{} deg off", off / DEG);
+            }
             prev = now;
             t += dt;
         }

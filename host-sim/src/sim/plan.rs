@@ -237,13 +237,14 @@ pub struct DrillingParams {
     pub connection_still_s: f64,
     /// Still time at the tie-on before drilling starts (s): alignment.
     pub initial_still_s: f64,
-    /// Toolface change at each connection (deg; sign at random).
+    /// Toolface change at each connection (deg; back towards the section's
+    /// toolface, or either way at random from it).
     pub toolface_change_per_connection_deg: f64,
     /// Rate of the orienter's toolface turns (deg/s).
     pub toolface_turn_rate_deg_s: f64,
     /// Toolface steps while sliding (reactive torque, driller's
-    /// corrections): mean rate (per hour of drilling) and size (deg, sign
-    /// at random).
+    /// corrections): mean rate (per hour of drilling) and size (deg,
+    /// directed as the connection steps).
     pub sliding_toolface_steps_per_hour: f64,
     pub sliding_toolface_step_deg: f64,
     pub vibration: Vibration,
