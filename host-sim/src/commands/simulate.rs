@@ -111,7 +111,8 @@ impl TrajectoryArgs {
 pub struct Args {
     #[command(flatten)]
     pub trajectory: TrajectoryArgs,
-    /// Length of the run, seconds (toolface indexing: at least its script).
+    /// Length of the run, seconds (toolface indexing: at least its script;
+    /// --motion lateral: the plan sets it and this is not used).
     #[arg(long, default_value_t = 60.0, value_parser = limits::duration_s)]
     pub duration: f64,
     #[arg(long, value_enum, default_value_t = SensorKind::Scc1300)]
