@@ -133,15 +133,14 @@ impl Ramp {
 /// when on it. The driller holds the toolface the section needs; the steps
 /// stay within +-(the larger step size) of it.
 fn toward_section(offset: f64, size: f64, rng: &mut ChaCha8Rng) -> f64 {
-    if offset > 1e-12 {
-        -size
-    } else if offset < -1e-12 {
-        size
+    let direction = if offset.abs() > 1e-12 {
+        -offset.signum()
     } else if rng.random::<bool>() {
-        size
+        1.0
     } else {
-        -size
-    }
+        -1.0
+    };
+    size * direction
 }
 
 /// A connection: the still period's times and the MD there.
