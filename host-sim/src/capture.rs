@@ -66,7 +66,20 @@ pub fn raw_sample_from_si(sample: &SiSample) -> RawSample {
         } else {
             raw_flags::GYRO_VALID
         };
-        part.flags = gyro | raw_flags::ACCEL_VALID | raw_flags::GYRO_S_OK;
+        // An axis beyond the 6 g range: the part raises SAT and the driver
+        // reports the sample saturated, not valid (firmware::scc1300::accel,
+        // app::sensor_wire::raw_part). The counts are still sent.
+        let accel_limit = (sensor_units::ACCEL_RANGE_G * sensor_units::ACCEL_LSB_PER_G) as i16;
+        let accel = if part
+            .accel
+            .iter()
+            .any(|c| c.unsigned_abs() > accel_limit as u16)
+        {
+            raw_flags::ACCEL_SATURATED
+        } else {
+            raw_flags::ACCEL_VALID
+        };
+        part.flags = gyro | accel | raw_flags::GYRO_S_OK;
     }
     RawSample {
         time_us: sample_time_us(sample.index),
@@ -440,6 +453,15 @@ mod tests {
             raw_flags::GYRO_VALID | raw_flags::GYRO_S_OK | raw_flags::ACCEL_VALID
         );
         assert_eq!(raw.time_us, 150_000);
+        // 7 g along body y: both parts' accelerometers flag SAT (6 g range).
+        let mut s = sample(3);
+        s.accel_body_m_s2 = [[0.0, 7.0 * 9.80665, 0.0]; 2];
+        for p in raw_sample_from_si(&s).parts {
+            assert_eq!(
+                p.flags,
+                raw_flags::GYRO_VALID | raw_flags::GYRO_S_OK | raw_flags::ACCEL_SATURATED
+            );
+        }
         // The simulator's own capture: sample 0 at 0 us, as the probe.
         let samples = crate::sim::SensorSimulator::new(
             crate::sim::Trajectory::paper_static(mwd_core::conventions::Euler::new(0.0, 0.0, 0.0)),

@@ -38,6 +38,10 @@ fn run_case(title: &str, records: &[Record], config: &AlignmentConfig) -> Result
 }
 
 pub fn run(args: Args) -> Result<()> {
+    anyhow::ensure!(
+        !matches!(args.trajectory.motion, super::simulate::MotionKind::Lateral),
+        "--motion lateral is for `host-sim simulate --plan`; the demo runs at one place"
+    );
     let traj = args.trajectory.trajectory();
     // The paper's heading is known to be south-westerly from the parent
     // well: a prior within 90 deg resolves the north/south ambiguity.

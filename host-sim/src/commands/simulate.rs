@@ -4,9 +4,10 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::paper_mgwd::PUBLISHED;
+use host_sim::sim::plan::Vibration;
 use host_sim::sim::{
-    DeterministicErrors, Motion, SensorModel, SensorModelFile, SensorSimulator, SimSample,
-    Trajectory,
+    DeterministicErrors, Drilling, DrillingSimulator, Motion, Plan, SensorModel, SensorModelFile,
+    SensorSimulator, SimSample, Trajectory, Truth,
 };
 use host_sim::{capture, samples_csv};
 use mwd_core::conventions::{Euler, DEG};
@@ -30,6 +31,9 @@ pub enum MotionKind {
     /// Six-position calibration tumble (--dwell s per position); the CSV
     /// gets the `position` column `host-sim calibrate` reads.
     SixPosition,
+    /// Drilling a lateral along a well plan (--plan FILE; see
+    /// docs/drilling-simulation.md): the run lasts as the plan takes.
+    Lateral,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -85,6 +89,9 @@ impl TrajectoryArgs {
                 steps: self.steps,
             },
             MotionKind::SixPosition => Motion::SixPosition { dwell: self.dwell },
+            // The drilling simulator has its own trajectory (`run`); a
+            // command that only knows scripted motions sees the tool at rest.
+            MotionKind::Lateral => Motion::Static,
             MotionKind::Rotate => {
                 let r = |i: usize| self.body_rate.get(i).copied().unwrap_or(0.0) * DEG;
                 Motion::ConstantRate {
@@ -104,7 +111,8 @@ impl TrajectoryArgs {
 pub struct Args {
     #[command(flatten)]
     pub trajectory: TrajectoryArgs,
-    /// Length of the run, seconds (toolface indexing: at least its script).
+    /// Length of the run, seconds (toolface indexing: at least its script;
+    /// --motion lateral: the plan sets it and this is not used).
     #[arg(long, default_value_t = 60.0, value_parser = limits::duration_s)]
     pub duration: f64,
     #[arg(long, value_enum, default_value_t = SensorKind::Scc1300)]
@@ -129,6 +137,32 @@ pub struct Args {
     /// Output format; by default `bin` for a `.bin` output, else `csv`.
     #[arg(long, value_enum)]
     pub format: Option<OutputFormat>,
+    /// --motion lateral: the well plan (JSON, docs/drilling-simulation.md).
+    #[arg(long)]
+    pub plan: Option<PathBuf>,
+    /// --motion lateral: write the truth trajectory (CSV) here.
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+    /// --motion lateral: one truth row every N samples (20 = 1 s).
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=72_000))]
+    pub truth_every: u32,
+    /// --motion lateral: write the surface depth log (CSV: time_s, md_m,
+    /// with the plan's depth errors) here.
+    #[arg(long)]
+    pub depth_log: Option<PathBuf>,
+    /// --motion lateral: vibration level instead of the plan's.
+    #[arg(long, value_enum)]
+    pub vibration: Option<VibrationLevel>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VibrationLevel {
+    /// None at all.
+    None,
+    /// The default: 2 g RMS lateral, 1 g axial over 5-500 Hz, 6 shocks/h.
+    Moderate,
+    /// The paper's environment: 15 g RMS over 5-500 Hz, 60 shocks/h of 100 g.
+    Harsh,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -145,6 +179,17 @@ pub fn run(args: Args) -> Result<()> {
         let file = SensorModelFile::from_model(&SensorModel::scc1300(args.seed));
         outln!("{}", serde_json::to_string_pretty(&file)?);
         return Ok(());
+    }
+    if matches!(args.trajectory.motion, MotionKind::Lateral) {
+        return run_lateral(&args);
+    }
+    for (flag, given) in [
+        ("--plan", args.plan.is_some()),
+        ("--truth", args.truth.is_some()),
+        ("--depth-log", args.depth_log.is_some()),
+        ("--vibration", args.vibration.is_some()),
+    ] {
+        anyhow::ensure!(!given, "{flag} goes with --motion lateral");
     }
     let trajectory = args.trajectory.trajectory();
     let site = trajectory.position;
@@ -249,5 +294,174 @@ fn write_csv(path: &Path, samples: impl Iterator<Item = SimSample>) -> Result<()
     let mut out = std::io::BufWriter::new(file);
     samples_csv::write(&mut out, samples)?;
     out.flush()?;
+    Ok(())
+}
+
+/// `--motion lateral`: the drilling simulator along `--plan`.
+fn run_lateral(args: &Args) -> Result<()> {
+    let path = args
+        .plan
+        .as_ref()
+        .context("--motion lateral needs --plan FILE (a well plan, docs/drilling-simulation.md)")?;
+    let mut plan = Plan::load(path)?;
+    if let Some(level) = args.vibration {
+        plan.drilling.vibration = match level {
+            VibrationLevel::None => Vibration::NONE,
+            VibrationLevel::Moderate => Vibration::MODERATE,
+            VibrationLevel::Harsh => Vibration::HARSH,
+        };
+    }
+    let model = sensor_model(args)?;
+    let started = std::time::Instant::now();
+    let drilling = Drilling::new(plan, args.seed);
+    anyhow::ensure!(
+        drilling.duration() <= MAX_LATERAL_S,
+        "the plan takes {:.1} h to drill; at most {:.0} h are simulated",
+        drilling.duration() / 3600.0,
+        MAX_LATERAL_S / 3600.0
+    );
+    let n = drilling.sample_count(SAMPLE_INTERVAL_S);
+    let site = drilling.truth(0.0).position;
+    let output = &args.output;
+    let to_stdout = output.as_os_str() == "-";
+    let mut truth_out = match &args.truth {
+        Some(p) => {
+            let mut w = TruthWriter::create(p)?;
+            w.row(&drilling.truth(0.0))?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut counts = Counts::default();
+    let mut failure: Option<anyhow::Error> = None;
+    let every = args.truth_every as usize;
+    let samples = DrillingSimulator::new(&drilling, model, SAMPLE_INTERVAL_S)
+        .enumerate()
+        .map(|(i, d)| {
+            counts.accel_over_range += usize::from(d.accel_over_range);
+            counts.gyro_over_range += usize::from(d.gyro_over_range);
+            if let Some(w) = truth_out.as_mut() {
+                if (i + 1) % every == 0 {
+                    if let Err(e) = w.row(&d.truth) {
+                        failure.get_or_insert(e);
+                    }
+                }
+            }
+            d.sample
+        });
+    match output_format(args) {
+        OutputFormat::Bin => {
+            anyhow::ensure!(
+                !to_stdout,
+                "binary captures go to a file, not standard output"
+            );
+            write_capture(output, samples, site)?;
+        }
+        OutputFormat::Csv if to_stdout => {
+            match samples_csv::write(std::io::stdout().lock(), samples) {
+                Err(e) if is_broken_pipe(&e) => {}
+                other => other?,
+            }
+        }
+        OutputFormat::Csv => write_csv(output, samples)?,
+    }
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    if let Some(w) = truth_out {
+        w.finish()?;
+    }
+    if let Some(p) = &args.depth_log {
+        write_depth_log(p, &drilling)?;
+    }
+    let plan = drilling.plan();
+    eprintln!(
+        "drilled MD {:.2} -> {:.2} m in {:.2} h ({} connections, {} shocks): {n} samples to {} in {:.1} s; \
+         {} samples with an accelerometer axis beyond 6 g, {} with a gyro beyond 300 deg/s",
+        plan.start_md(),
+        plan.end_md(),
+        drilling.duration() / 3600.0,
+        drilling.connections().len(),
+        drilling.shocks().len(),
+        output.display(),
+        started.elapsed().as_secs_f64(),
+        counts.accel_over_range,
+        counts.gyro_over_range,
+    );
+    Ok(())
+}
+
+/// Longest drilling run simulated: 7 days (a 1000 m lateral at 30 m/h
+/// takes ~37 h).
+const MAX_LATERAL_S: f64 = 7.0 * 86_400.0;
+
+#[derive(Default)]
+struct Counts {
+    accel_over_range: usize,
+    gyro_over_range: usize,
+}
+
+/// The truth trajectory CSV.
+struct TruthWriter {
+    out: std::io::BufWriter<std::fs::File>,
+    path: PathBuf,
+}
+
+impl TruthWriter {
+    fn create(path: &Path) -> Result<Self> {
+        let file =
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let mut out = std::io::BufWriter::new(file);
+        writeln!(
+            out,
+            "time_s,md_m,tvd_m,north_m,east_m,inclination_deg,azimuth_deg,toolface_deg,\
+             roll_deg,pitch_deg,heading_deg,state"
+        )?;
+        Ok(Self {
+            out,
+            path: path.to_owned(),
+        })
+    }
+
+    fn row(&mut self, t: &Truth) -> Result<()> {
+        let e = t.euler();
+        let p = &t.point;
+        writeln!(
+            self.out,
+            "{:.3},{:.6},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}",
+            t.time,
+            t.md,
+            p.nev.z,
+            p.nev.x,
+            p.nev.y,
+            p.inclination / DEG,
+            p.azimuth / DEG,
+            mwd_core::conventions::wrap_two_pi(t.toolface) / DEG,
+            e.roll / DEG,
+            e.pitch / DEG,
+            e.heading / DEG,
+            t.state.name()
+        )
+        .with_context(|| format!("writing {}", self.path.display()))
+    }
+
+    fn finish(mut self) -> Result<()> {
+        self.out
+            .flush()
+            .with_context(|| format!("writing {}", self.path.display()))
+    }
+}
+
+/// The surface depth log: time_s, md_m (with the plan's depth errors).
+fn write_depth_log(path: &Path, drilling: &Drilling) -> Result<()> {
+    let file =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut out = std::io::BufWriter::new(file);
+    writeln!(out, "time_s,md_m")?;
+    for (t, md) in drilling.depth_log() {
+        writeln!(out, "{t:.3},{md:.4}")?;
+    }
+    out.flush()
+        .with_context(|| format!("writing {}", path.display()))?;
     Ok(())
 }

@@ -1,8 +1,14 @@
-//! Trajectory and sensor simulation of the probe.
+//! Trajectory and sensor simulation of the probe: scripted motions at one
+//! place (`trajectory`) and the drilling of a lateral along a well plan
+//! (`plan`, `drilling`).
+pub mod drilling;
 pub mod model_file;
+pub mod plan;
 pub mod sensor;
 pub mod trajectory;
 
+pub use drilling::{DrillSample, DrillState, Drilling, DrillingSimulator, Truth};
 pub use model_file::SensorModelFile;
-pub use sensor::{DeterministicErrors, SensorModel, SensorSimulator, SimSample};
+pub use plan::{BuiltPlan, Plan};
+pub use sensor::{DeterministicErrors, SensorErrors, SensorModel, SensorSimulator, SimSample};
 pub use trajectory::{Motion, Trajectory};

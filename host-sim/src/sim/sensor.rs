@@ -216,32 +216,79 @@ pub struct SimSample {
 /// Interval means of the ideal rate and specific force.
 type IdealMeans = (Vector3<f64>, Vector3<f64>);
 
-/// Generates the sample stream of a trajectory.
-pub struct SensorSimulator {
-    trajectory: Trajectory,
+/// The probe's sensor errors applied to ideal interval means: what any
+/// trajectory generator (the scripted motions here, the drilling simulator)
+/// feeds its ideal outputs through. Seeded by the model's seed.
+pub struct SensorErrors {
     model: SensorModel,
-    dt: f64,
-    index: u64,
     rng: ChaCha8Rng,
     accel: [AxisErrors; 3],
     gyro: [AxisErrors; 3],
+}
+
+impl SensorErrors {
+    pub fn new(model: SensorModel) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(model.seed);
+        let accel = model.noise.accel.map(|n| AxisErrors::new(n, &mut rng));
+        let gyro = model.noise.gyro.map(|n| AxisErrors::new(n, &mut rng));
+        Self {
+            model,
+            rng,
+            accel,
+            gyro,
+        }
+    }
+
+    pub fn model(&self) -> &SensorModel {
+        &self.model
+    }
+
+    /// The measured (gyro, accel) of one sample of length `dt` whose true
+    /// interval means are `true_rate` (omega_ib^b) and `true_accel`: the
+    /// deterministic errors, the random errors, then the part's LSB. Only
+    /// the x and z gyros exist; the y gyro is NaN.
+    pub fn measure(
+        &mut self,
+        dt: f64,
+        true_rate: &Vector3<f64>,
+        true_accel: &Vector3<f64>,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let d = &self.model.deterministic;
+        let mut accel = d.accel_matrix * true_accel + d.accel_bias;
+        let mut gyro = Vector3::new(f64::NAN, f64::NAN, f64::NAN);
+        for axis in 0..3 {
+            accel[axis] += self.accel[axis].next(dt, &mut self.rng);
+        }
+        for axis in [0, 2] {
+            gyro[axis] = (1.0 + d.gyro_scale[axis]) * true_rate[axis]
+                + d.gyro_bias[axis]
+                + self.gyro[axis].next(dt, &mut self.rng);
+        }
+        if self.model.quantize {
+            accel = accel.map(|v| libm::round(v / ACCEL_LSB) * ACCEL_LSB);
+            gyro = gyro.map(|v| libm::round(v / GYRO_LSB) * GYRO_LSB);
+        }
+        (gyro, accel)
+    }
+}
+
+/// Generates the sample stream of a trajectory.
+pub struct SensorSimulator {
+    trajectory: Trajectory,
+    dt: f64,
+    index: u64,
+    errors: SensorErrors,
     /// Attitude and ideal means of the last interval at rest.
     rest_cache: Option<(Matrix3<f64>, IdealMeans)>,
 }
 
 impl SensorSimulator {
     pub fn new(trajectory: Trajectory, model: SensorModel, dt: f64) -> Self {
-        let mut rng = ChaCha8Rng::seed_from_u64(model.seed);
-        let accel = model.noise.accel.map(|n| AxisErrors::new(n, &mut rng));
-        let gyro = model.noise.gyro.map(|n| AxisErrors::new(n, &mut rng));
         Self {
             trajectory,
-            model,
             dt,
             index: 0,
-            rng,
-            accel,
-            gyro,
+            errors: SensorErrors::new(model),
             rest_cache: None,
         }
     }
@@ -307,21 +354,7 @@ impl Iterator for SensorSimulator {
         self.index += 1;
         let time = self.index as f64 * self.dt;
         let (true_rate, true_accel) = self.ideal_means(t0);
-        let d = &self.model.deterministic;
-        let mut accel = d.accel_matrix * true_accel + d.accel_bias;
-        let mut gyro = Vector3::new(f64::NAN, f64::NAN, f64::NAN);
-        for axis in 0..3 {
-            accel[axis] += self.accel[axis].next(self.dt, &mut self.rng);
-        }
-        for axis in [0, 2] {
-            gyro[axis] = (1.0 + d.gyro_scale[axis]) * true_rate[axis]
-                + d.gyro_bias[axis]
-                + self.gyro[axis].next(self.dt, &mut self.rng);
-        }
-        if self.model.quantize {
-            accel = accel.map(|v| libm::round(v / ACCEL_LSB) * ACCEL_LSB);
-            gyro = gyro.map(|v| libm::round(v / GYRO_LSB) * GYRO_LSB);
-        }
+        let (gyro, accel) = self.errors.measure(self.dt, &true_rate, &true_accel);
         Some(SimSample {
             time,
             gyro,
