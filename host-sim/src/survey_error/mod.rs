@@ -552,40 +552,42 @@ struct Leg {
     course: f64,
 }
 
-fn legs(stations: &[Station], trig: &[StationTrig], opts: Options) -> Vec<Leg> {
-    let n = stations.len();
-    (1..n)
-        .map(|k| {
-            let s = &stations[k];
-            let course = s.md - stations[k - 1].md;
-            let len_b = if k == 1 && opts.tie_on == TieOn::CarriedByFirstStation {
-                // the tie-on's inclination/azimuth error is carried here
-                2.0 * (s.md - stations[0].md)
-            } else {
-                course
-            };
-            let len_a = if k + 1 < n {
-                stations[k + 1].md - s.md
-            } else {
-                0.0
-            };
-            let t = tangent(&trig[k]);
-            let tp = tangent(&trig[k - 1]);
-            let tn = if k + 1 < n { tangent(&trig[k + 1]) } else { t };
-            let dd_b: [f64; 3] = std::array::from_fn(|j| 0.5 * (tp[j] + t[j]));
-            let (si, ci) = (trig[k].sin_inc, trig[k].cos_inc);
-            let (sa, ca) = (trig[k].sin_azi, trig[k].cos_azi);
-            Leg {
-                dd_interior: std::array::from_fn(|j| dd_b[j] - 0.5 * (t[j] + tn[j])),
-                dd_last: dd_b,
-                h_interior: len_b / 2.0 + len_a / 2.0,
-                h_last: len_b / 2.0,
-                di: [ci * ca, ci * sa, -si],
-                da: [-si * sa, si * ca, 0.0],
-                course,
-            }
-        })
-        .collect()
+impl Leg {
+    /// Station `k` (>= 1) of `stations`, from the trigonometry of stations
+    /// k-1, k and k+1 (`next`: `None` at the last station).
+    fn at(
+        stations: &[Station],
+        k: usize,
+        prev: &StationTrig,
+        cur: &StationTrig,
+        next: Option<&StationTrig>,
+        opts: Options,
+    ) -> Self {
+        let s = &stations[k];
+        let course = s.md - stations[k - 1].md;
+        let len_b = if k == 1 && opts.tie_on == TieOn::CarriedByFirstStation {
+            // the tie-on's inclination/azimuth error is carried here
+            2.0 * (s.md - stations[0].md)
+        } else {
+            course
+        };
+        let len_a = stations.get(k + 1).map_or(0.0, |n| n.md - s.md);
+        let t = tangent(cur);
+        let tp = tangent(prev);
+        let tn = next.map_or(t, tangent);
+        let dd_b: [f64; 3] = std::array::from_fn(|j| 0.5 * (tp[j] + t[j]));
+        let (si, ci) = (cur.sin_inc, cur.cos_inc);
+        let (sa, ca) = (cur.sin_azi, cur.cos_azi);
+        Leg {
+            dd_interior: std::array::from_fn(|j| dd_b[j] - 0.5 * (t[j] + tn[j])),
+            dd_last: dd_b,
+            h_interior: len_b / 2.0 + len_a / 2.0,
+            h_last: len_b / 2.0,
+            di: [ci * ca, ci * sa, -si],
+            da: [-si * sa, si * ca, 0.0],
+            course,
+        }
+    }
 }
 
 /// Per-source and total covariances at every station.
@@ -652,7 +654,7 @@ impl Options {
 fn error_vector(
     term: &ErrorTerm,
     stations: &[Station],
-    trig: &[StationTrig],
+    trig: &StationTrig,
     leg: &Leg,
     k: usize,
     site: &SiteTerms,
@@ -665,14 +667,14 @@ fn error_vector(
             &term.weighting,
             s,
             &stations[k - 1],
-            &trig[k],
+            trig,
             sig,
             site,
             opts.xcl_azimuth,
         )?;
         return Some((v, v));
     }
-    let wt = weighting(&term.weighting, s, &trig[k], leg.course, site)?;
+    let wt = weighting(&term.weighting, s, trig, leg.course, site)?;
     // the angle part: d dr/dI w_I + d dr/dA w_A per unit half-length, or at
     // a vertical station the tabulated singularity vector
     let u: [f64; 3] = match (wt.singular, s.inc < site.vertical_limit) {
@@ -687,27 +689,24 @@ fn error_vector(
 
 /// Whether a source's weighting function is implemented: the dispatch is
 /// by name only, so asking at the tie-on answers for every station.
-fn implemented(
-    term: &ErrorTerm,
-    stations: &[Station],
-    trig: &[StationTrig],
-    site: &SiteTerms,
-) -> bool {
-    let s = &stations[0];
+fn implemented(term: &ErrorTerm, s: &Station, trig: &StationTrig, site: &SiteTerms) -> bool {
     if term.weighting.starts_with("XCL") {
-        xcl_vector(
-            &term.weighting,
-            s,
-            s,
-            &trig[0],
-            0.0,
-            site,
-            XclAzimuth::Angle,
-        )
-        .is_some()
+        xcl_vector(&term.weighting, s, s, trig, 0.0, site, XclAzimuth::Angle).is_some()
     } else {
-        weighting(&term.weighting, s, &trig[0], 0.0, site).is_some()
+        weighting(&term.weighting, s, trig, 0.0, site).is_some()
     }
+}
+
+/// One implemented source while the stations are walked: its running sum
+/// (SPE 67616: random sources add their covariances, the others their
+/// error vectors) and its covariance at the stations so far.
+struct Source<'a> {
+    term: &'a ErrorTerm,
+    random: bool,
+    /// Random: the covariance sum `[nn, ee, vv, ne, nv, ev]`; otherwise the
+    /// vector sum in the first three.
+    sum: [f64; 6],
+    covs: Vec<Cov6>,
 }
 
 /// Runs the model over a survey (first station = tie-on), with the Rev
@@ -726,63 +725,74 @@ pub fn run_with(
     let n = stations.len();
     let mut per_source = BTreeMap::new();
     let mut missing = Vec::new();
-    let mut total = vec![[0.0; 6]; n];
     if n == 0 {
         return ModelResult {
             per_source,
-            total,
+            total: Vec::new(),
             missing,
         };
     }
     let site = &SiteTerms::of(site);
-    // per station, once for all sources
-    let trig: Vec<StationTrig> = stations.iter().map(|s| StationTrig::of(s, site)).collect();
-    let legs = legs(stations, &trig, opts);
+    // Stations outside, sources inside: each station's trigonometry and leg
+    // geometry is computed once for all sources and kept only while it is
+    // needed (no per-station tables), and the sources' running sums lie
+    // together in one small array.
+    let mut prev = StationTrig::of(&stations[0], site);
+    let mut sources: Vec<Source> = Vec::with_capacity(terms.len());
     for term in terms {
-        if !implemented(term, stations, &trig, site) {
+        if !implemented(term, &stations[0], &prev, site) {
             missing.push(term.code.clone());
             continue;
         }
-        // the source's covariance at every station, filled in station
-        // order (no zero-fill first: the tie-on carries no error)
-        let mut covs: Vec<Cov6> = Vec::with_capacity(n);
+        let mut covs = Vec::with_capacity(n);
+        // the tie-on carries no error
         covs.push([0.0; 6]);
-        let vectors = (1..n).map(|k| {
-            // `implemented` said the name is known: the station cannot
-            // change that
-            error_vector(term, stations, &trig, &legs[k - 1], k, site, opts)
-                .unwrap_or(([0.0; 3], [0.0; 3]))
+        sources.push(Source {
+            term,
+            random: term.propagation == Propagation::Random,
+            sum: [0.0; 6],
+            covs,
         });
-        // Running sums over the stations before k (SPE 67616): random
-        // sources add their covariances, the others their vectors.
-        match term.propagation {
-            Propagation::Random => {
-                let mut sum = [0.0; 6];
-                for (interior, last) in vectors {
-                    let c = outer(last);
-                    covs.push(std::array::from_fn(|j| sum[j] + c[j]));
-                    let c = outer(interior);
-                    for j in 0..6 {
-                        sum[j] += c[j];
-                    }
+    }
+    let mut total = Vec::with_capacity(n);
+    total.push([0.0; 6]);
+    let mut cur = stations.get(1).map(|s| StationTrig::of(s, site));
+    for k in 1..n {
+        let Some(trig) = cur else { break };
+        let next = stations.get(k + 1).map(|s| StationTrig::of(s, site));
+        let leg = Leg::at(stations, k, &prev, &trig, next.as_ref(), opts);
+        let mut tot = [0.0; 6];
+        for src in &mut sources {
+            // `implemented` said the name is known: a station cannot change
+            // that (the dispatch is by name)
+            let (interior, last) = error_vector(src.term, stations, &trig, &leg, k, site, opts)
+                .unwrap_or(([0.0; 3], [0.0; 3]));
+            let c = if src.random {
+                let c = outer(last);
+                let c: Cov6 = std::array::from_fn(|j| src.sum[j] + c[j]);
+                let e = outer(interior);
+                for j in 0..6 {
+                    src.sum[j] += e[j];
                 }
-            }
-            Propagation::Systematic | Propagation::PerWell | Propagation::Global => {
-                let mut sum = [0.0; 3];
-                for (interior, last) in vectors {
-                    covs.push(outer(std::array::from_fn(|j| sum[j] + last[j])));
-                    for j in 0..3 {
-                        sum[j] += interior[j];
-                    }
+                c
+            } else {
+                let c = outer(std::array::from_fn(|j| src.sum[j] + last[j]));
+                for j in 0..3 {
+                    src.sum[j] += interior[j];
                 }
-            }
-        }
-        for (t, c) in total.iter_mut().zip(&covs) {
+                c
+            };
+            src.covs.push(c);
             for j in 0..6 {
-                t[j] += c[j];
+                tot[j] += c[j];
             }
         }
-        per_source.insert(term.code.clone(), covs);
+        total.push(tot);
+        prev = trig;
+        cur = next;
+    }
+    for src in sources {
+        per_source.insert(src.term.code.clone(), src.covs);
     }
     ModelResult {
         per_source,
