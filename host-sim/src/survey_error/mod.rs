@@ -343,7 +343,7 @@ impl std::ops::Deref for SiteTerms {
 }
 
 /// `None`: weighting function not implemented.
-#[inline]
+#[inline(always)]
 fn weighting(
     name: &str,
     s: &Station,
