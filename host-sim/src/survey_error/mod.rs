@@ -770,15 +770,14 @@ pub fn run_with(
             let c = if src.random {
                 let c = outer(last);
                 let c: Cov6 = std::array::from_fn(|j| src.sum[j] + c[j]);
-                let e = outer(interior);
-                for j in 0..6 {
-                    src.sum[j] += e[j];
+                for (a, e) in src.sum.iter_mut().zip(outer(interior)) {
+                    *a += e;
                 }
                 c
             } else {
                 let c = outer(std::array::from_fn(|j| src.sum[j] + last[j]));
-                for j in 0..3 {
-                    src.sum[j] += interior[j];
+                for (a, e) in src.sum.iter_mut().zip(interior) {
+                    *a += e;
                 }
                 c
             };

@@ -496,8 +496,8 @@ mod slow {
                     _ => {
                         let mut v = ev[k].1;
                         for e in &ev[1..k] {
-                            for j in 0..3 {
-                                v[j] += e.0[j];
+                            for (a, x) in v.iter_mut().zip(e.0) {
+                                *a += x;
                             }
                         }
                         outer(v)
