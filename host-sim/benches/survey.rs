@@ -12,7 +12,9 @@
 //! `survey_10001_cpu` in the benchmark thread's own on-CPU time (Linux
 //! `/proc/thread-self/schedstat`), which other processes on a shared,
 //! loaded machine inflate far less than the wall time (they still share the
-//! caches).
+//! caches). Whether the 11 MB of results land on fresh pages each iteration
+//! depends on glibc's heap; `GLIBC_TUNABLES=glibc.malloc.mmap_threshold=131072`
+//! makes them always fresh, as in a one-shot CLI run (see the doc).
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{criterion_group, criterion_main, Criterion};
