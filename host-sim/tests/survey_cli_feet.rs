@@ -17,7 +17,9 @@
 //! Tolerance: the one `host-sim/tests/iscwsa_error_model.rs` uses for well
 //! #2: a value passes within 5e-4 m^2 (the references carry 5e-5 m^2 of
 //! rounding, and the ISCWSA workbook itself reproduces the well #2 block
-//! only to 4.6e-4 m^2) or within 0.5 % of the reference.
+//! only to 4.6e-4 m^2) or within 0.5 % of the reference; and every value
+//! within 1 % (the acceptance the task quoted; no source for it was found
+//! in the test data, tests/data/iscwsa/README.md "What was not found").
 
 mod common;
 
@@ -236,4 +238,7 @@ fn iscwsa_well_2_in_feet() {
         100.0 * worst_rel
     );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // and the +-1 % acceptance the brief quotes (every compared value here
+    // is >= 0.24 m^2, so the relative test is meaningful at each)
+    assert!(worst_rel < 0.01, "worst relative {worst_rel}");
 }
