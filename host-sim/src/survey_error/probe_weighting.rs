@@ -128,7 +128,7 @@ pub(super) fn weighting(
 #[cfg(test)]
 mod tests {
     use super::super::probe_model::sensor_term_magnitudes;
-    use super::super::{weighting as engine_weighting, StationTrig};
+    use super::super::{weighting as engine_weighting, SiteTerms, StationTrig};
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -242,7 +242,7 @@ mod tests {
             tvd: 0.0,
             toolface: tf,
         };
-        engine_weighting(name, &s, &StationTrig::of(&s), 30.0, site)
+        engine_weighting(name, &s, &StationTrig::of(&s, site), 30.0, &SiteTerms::of(site))
             .expect("registered")
             .w[2]
     }

@@ -588,6 +588,7 @@ fn iscwsa_wells() -> Vec<(Vec<Station>, Site)> {
                         inc: v[1].to_radians(),
                         azi: v[2].to_radians(),
                         tvd: v[3] * unit,
+                        toolface: None,
                     }
                 })
                 .collect();
@@ -623,7 +624,13 @@ fn random_well(seed: u64) -> (Vec<Station>, Site) {
     let mut st = Vec::new();
     let (mut md, mut tvd, mut inc, mut azi) = (100.0 * rnd(), 0.0, 0.0_f64, 0.0_f64);
     for k in 0..400 {
-        st.push(Station { md, inc, azi, tvd });
+        st.push(Station {
+            md,
+            inc,
+            azi,
+            tvd,
+            toolface: None,
+        });
         let step = 0.5 + 99.5 * rnd();
         md += step;
         tvd += step * inc.cos();
