@@ -3,10 +3,13 @@
 //! the probe's solutions bit for bit).
 //!
 //! * [`raw`]: a raw sample's counts to calibrated body-frame rates and force.
-//! * [`navigator`]: coarse alignment, fine alignment, navigation.
+//! * [`navigator`]: coarse alignment, fine alignment, navigation with
+//!   station surveys at still periods.
+//! * [`still`]: the still detector.
 
 pub mod navigator;
 pub mod raw;
+pub mod still;
 
 pub use navigator::Navigator;
 pub use raw::body_sample;
