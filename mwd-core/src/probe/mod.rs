@@ -6,9 +6,11 @@
 //! * [`navigator`]: coarse alignment, fine alignment, navigation with
 //!   station surveys at still periods.
 //! * [`still`]: the still detector.
+//! * [`station`]: a station's drilling angles and their covariance.
 
 pub mod navigator;
 pub mod raw;
+pub mod station;
 pub mod still;
 
 pub use navigator::Navigator;
