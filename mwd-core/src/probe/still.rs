@@ -55,7 +55,6 @@
 //! with both parts are judged: with one part out a turn about the missing
 //! gyro's axis would not be seen, and the navigator resets the detector.
 
-use crate::ar::Ar4;
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::sensor_noise::{AxisNoise, ImuNoise};
 use crate::sensor_units::{ACCEL_LSB_PER_G, GYRO_LSB_PER_DEG_S, STANDARD_GRAVITY};
@@ -108,27 +107,47 @@ fn chi_square_quantile(nu: f64, z: f64) -> f64 {
     nu * base * base * base
 }
 
-/// Autocovariance of one axis' sample noise at `lag` (samples): white
-/// (and rounding) at lag 0, the AR(4) part at every lag.
-fn autocovariance(axis: &AxisNoise, rounding: f64, lag: usize) -> f64 {
-    let coloured = axis
-        .coloured
-        .as_ref()
-        .and_then(|ar: &Ar4| ar.autocovariance(lag))
-        .unwrap_or(0.0);
-    if lag == 0 {
-        square(axis.white_density) / SAMPLE_INTERVAL_S + rounding + coloured
+/// Autocovariance of one axis' sample noise at lags 0..WINDOW: white (and
+/// rounding) at lag 0, the AR(4) part at every lag. The first four lags
+/// come from the model's stationary solution, the rest from the
+/// Yule-Walker recursion (paper eq. 24: `ArModel::step` with no
+/// innovation), so the Lyapunov solver runs four times per axis, not once
+/// per lag (the probe computes this once, at boot, in soft f64).
+#[inline(never)]
+fn autocovariances(axis: &AxisNoise, rounding: f64) -> [f64; WINDOW] {
+    let mut g = [0.0; WINDOW];
+    if let Some(ar) = axis.coloured.as_ref() {
+        let lead: [Option<f64>; 4] = core::array::from_fn(|k| ar.autocovariance(k));
+        if let [Some(a), Some(b), Some(c), Some(d)] = lead {
+            let mut window = [a, b, c, d];
+            for (k, slot) in g.iter_mut().enumerate() {
+                *slot = match window_value(&window, k) {
+                    Some(v) => v,
+                    None => ar.step(&mut window, 0.0),
+                };
+            }
+        }
+    }
+    g[0] += square(axis.white_density) / SAMPLE_INTERVAL_S + rounding;
+    g
+}
+
+/// The leading autocovariance `k` (< 4), or None past them.
+fn window_value(lead: &[f64; 4], k: usize) -> Option<f64> {
+    if k < 4 {
+        lead.get(k).copied()
     } else {
-        coloured
+        None
     }
 }
 
 /// `sum_{j,k < n} rho(j - k)^2` of one axis.
-fn correlation_square_sum(axis: &AxisNoise, rounding: f64, n: usize) -> f64 {
-    let g0 = autocovariance(axis, rounding, 0);
+#[inline(never)]
+fn correlation_square_sum(g: &[f64; WINDOW]) -> f64 {
+    let n = WINDOW;
     let mut sum = n as f64;
     for lag in 1..n {
-        let rho = autocovariance(axis, rounding, lag) / g0;
+        let rho = g[lag] / g[0];
         sum += 2.0 * (n - lag) as f64 * rho * rho;
     }
     sum
@@ -136,11 +155,12 @@ fn correlation_square_sum(axis: &AxisNoise, rounding: f64, n: usize) -> f64 {
 
 /// `sum_{j,k < n} rho(j - k)` / n^2: the variance of the mean over the
 /// per-sample variance.
-fn mean_variance_ratio(axis: &AxisNoise, rounding: f64, n: usize) -> f64 {
-    let g0 = autocovariance(axis, rounding, 0);
+#[inline(never)]
+fn mean_variance_ratio(g: &[f64; WINDOW]) -> f64 {
+    let n = WINDOW;
     let mut sum = n as f64;
     for lag in 1..n {
-        sum += 2.0 * (n - lag) as f64 * autocovariance(axis, rounding, lag) / g0;
+        sum += 2.0 * (n - lag) as f64 * g[lag] / g[0];
     }
     sum / square(n as f64)
 }
@@ -158,7 +178,8 @@ fn satterthwaite(e: f64, v: f64) -> Threshold {
 
 impl StillThresholds {
     /// Thresholds for sensors with error budget `noise`, at a site whose
-    /// gravity is `gravity_m_s2`.
+    /// gravity is `gravity_m_s2`. Never inlined: it runs once, at boot.
+    #[inline(never)]
     pub fn from_budget(noise: &ImuNoise, gravity_m_s2: f64) -> Self {
         let gyro_q = (1.0 / f64::from(GYRO_LSB_PER_DEG_S)).to_radians();
         let accel_q = STANDARD_GRAVITY / f64::from(ACCEL_LSB_PER_G);
@@ -166,40 +187,41 @@ impl StillThresholds {
         // (two independent roundings: half the variance).
         let gyro_rounding = square(gyro_q) / 4.0;
         let accel_rounding = square(accel_q) / 8.0;
-        let n = WINDOW;
-        let nf = n as f64;
-
-        let gyros = GYRO_AXES.map(|axis| &noise.gyro[axis]);
-        let rate_variance = gyros.map(|g| autocovariance(g, gyro_rounding, 0));
-        let rate_e = 2.0 * nf;
-        let rate_v: f64 = gyros
-            .iter()
-            .map(|g| 2.0 * correlation_square_sum(g, gyro_rounding, n))
-            .sum();
-
-        let force_variance = noise
-            .accel
-            .each_ref()
-            .map(|a| autocovariance(a, accel_rounding, 0));
-        // E[sum (x - mean)^2] / s^2 = n (1 - var(mean)/s^2); the variance is
-        // the magnitude statistic's scaled by the same ratio (exact for
-        // white noise: 2 (n - 1)).
-        let mut force_e = 0.0;
-        let mut force_v = 0.0;
-        for a in &noise.accel {
-            let e = nf * (1.0 - mean_variance_ratio(a, accel_rounding, n));
-            force_e += e;
-            force_v += 2.0 * correlation_square_sum(a, accel_rounding, n) * e / nf;
+        let nf = WINDOW as f64;
+        // Body x and z gyros, then the three force axes: one loop, so the
+        // probe's code has one copy of each helper (flash is short).
+        let axes = [
+            (&noise.gyro[GYRO_AXES[0]], gyro_rounding),
+            (&noise.gyro[GYRO_AXES[1]], gyro_rounding),
+            (&noise.accel[0], accel_rounding),
+            (&noise.accel[1], accel_rounding),
+            (&noise.accel[2], accel_rounding),
+        ];
+        let mut variance = [0.0; 5];
+        let (mut rate_v, mut force_e, mut force_v, mut mean_var) = (0.0, 0.0, 0.0, 0.0f64);
+        for (k, (axis, rounding)) in axes.into_iter().enumerate() {
+            let g = autocovariances(axis, rounding);
+            variance[k] = g[0];
+            let squares = 2.0 * correlation_square_sum(&g);
+            if k < 2 {
+                rate_v += squares;
+            } else {
+                // E[sum (x - mean)^2] / s^2 = n (1 - var(mean)/s^2); the
+                // variance is the magnitude statistic's scaled by the same
+                // ratio (exact for white noise: 2 (n - 1)).
+                let ratio = mean_variance_ratio(&g);
+                let e = nf * (1.0 - ratio);
+                force_e += e;
+                force_v += squares * e / nf;
+                // |mean f| - g: the noise of the mean along gravity (the
+                // largest axis' bounds it).
+                mean_var = mean_var.max(g[0] * ratio);
+            }
         }
-
-        // |mean f| - g: the noise of the mean along gravity (the largest
-        // axis' bounds it) and the residual bias of calibration.
-        let mean_var = noise
-            .accel
-            .iter()
-            .zip(&force_variance)
-            .map(|(a, v)| v * mean_variance_ratio(a, accel_rounding, n))
-            .fold(0.0, f64::max);
+        let rate_e = 2.0 * nf;
+        let rate_variance = [variance[0], variance[1]];
+        let force_variance = [variance[2], variance[3], variance[4]];
+        // ... and the residual bias of calibration.
         let bias = noise
             .accel
             .iter()
