@@ -319,7 +319,7 @@ impl Navigator {
         let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
         let mut flags = station_flags::MAGNETIC_FREE;
         let inclination = angles.inclination;
-        if inclination < NEAR_VERTICAL || inclination > core::f64::consts::PI - NEAR_VERTICAL {
+        if !(NEAR_VERTICAL..=core::f64::consts::PI - NEAR_VERTICAL).contains(&inclination) {
             flags |= station_flags::NEAR_VERTICAL;
         }
         let mut survey = StationSurvey {

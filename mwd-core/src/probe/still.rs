@@ -121,24 +121,16 @@ fn autocovariances(axis: &AxisNoise, rounding: f64) -> [f64; WINDOW] {
         if let [Some(a), Some(b), Some(c), Some(d)] = lead {
             let mut window = [a, b, c, d];
             for (k, slot) in g.iter_mut().enumerate() {
-                *slot = match window_value(&window, k) {
-                    Some(v) => v,
-                    None => ar.step(&mut window, 0.0),
+                *slot = if k < window.len() {
+                    window[k]
+                } else {
+                    ar.step(&mut window, 0.0)
                 };
             }
         }
     }
     g[0] += square(axis.white_density) / SAMPLE_INTERVAL_S + rounding;
     g
-}
-
-/// The leading autocovariance `k` (< 4), or None past them.
-fn window_value(lead: &[f64; 4], k: usize) -> Option<f64> {
-    if k < 4 {
-        lead.get(k).copied()
-    } else {
-        None
-    }
 }
 
 /// `sum_{j,k < n} rho(j - k)^2` of one axis.

@@ -81,7 +81,11 @@ pub fn station_survey() -> Payload {
         flags: station_flags::MAGNETIC_FREE,
         start_sample: 24_000,
         end_sample: 27_599,
-        angles: [0.785_398_2, 2.094_395_1, 5.235_988],
+        angles: [
+            core::f32::consts::FRAC_PI_4,
+            2.0 * core::f32::consts::FRAC_PI_3,
+            5.0 * core::f32::consts::FRAC_PI_3,
+        ],
         angles_std: [0.000_872_7, 0.020_944, 0.001_221_7],
         correlations: [0.12, -0.35, 0.05],
         still_quality: 1.02,
