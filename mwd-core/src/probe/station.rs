@@ -9,12 +9,11 @@
 //! d(inc, azi, tf) = J phi, where J's rows are the pitch, heading and roll
 //! rows of `conventions::euler_error_jacobian` (the constant pi/2 and the
 //! wrap to [0, 2 pi) do not change derivatives), so their covariance is
-//! J P_phi J^T (the usual linear propagation; e.g. Groves, "Principles of
-//! GNSS, Inertial, and Multisensor Integrated Navigation Systems", 2nd
-//! ed., eq. 2.80 for Euler-angle errors, there with the opposite sign of
-//! phi, which does not change J P J^T). At a vertical tool axis azimuth and
-//! toolface are undefined and their rows infinite. Checked against central
-//! differences in the tests.
+//! J P_phi J^T (first-order propagation of a covariance through a
+//! function; J's derivation is written out at `euler_error_jacobian`; the
+//! sign convention of phi flips J but not J P J^T). At a vertical tool
+//! axis azimuth and toolface are undefined and their rows infinite.
+//! Checked against central differences in the tests.
 
 use crate::conventions::{euler_error_jacobian, euler_from_dcm, DrillingAngles};
 use crate::kalman::std_dev_of;

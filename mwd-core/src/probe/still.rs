@@ -23,10 +23,15 @@
 //! sum_jk rho_i(j - k)^2` from the autocorrelation of the budget's noise
 //! (white + the paper's AR(4) coloured part, `crate::ar`). The chi-square
 //! quantile is the Wilson-Hilferty approximation (Wilson & Hilferty 1931:
-//! `chi^2_p(nu) ~ nu (1 - 2/(9 nu) + z_p sqrt(2/(9 nu)))^3`, within 1 % for
-//! nu >= 20, our nu is ~40 and ~57). This is the GLRT/"SHOE" family of
-//! zero-velocity detectors (Skog et al., IEEE TBME 57(11), 2010, eq. 15 and
-//! its rate-only variant), with the thresholds from the budget.
+//! `chi^2_p(nu) ~ nu (1 - 2/(9 nu) + z_p sqrt(2/(9 nu)))^3`; nu is a few
+//! tens here; checked against tables at the 1e-3 quantile of chi^2(40) in
+//! the tests, an approximation at 1e-7 whose error only changes how rare
+//! a split station is; the moment match is Satterthwaite's, Biometrics
+//! Bulletin 2(6), 1946). This is the GLRT ("SHOE") family of zero-velocity
+//! detectors (Skog, Handel, Nilsson, Rantakokko, "Zero-velocity
+//! detection - an algorithm evaluation", IEEE Trans. Biomed. Eng. 57(11),
+//! 2010), split into its rate and force parts, with the thresholds from
+//! the budget instead of tuned.
 //!
 //! Per-sample variances: the white density squared times the sample rate,
 //! plus the AR model's stationary variance, plus the counts' rounding. The

@@ -144,7 +144,8 @@ pub mod nav_flags {
     /// One part is out: the solution rests on the other part alone.
     pub const SINGLE_PART: u16 = 1 << 6;
     /// Navigating, the probe is still (`probe::still`): a station survey
-    /// is being taken, with a zero-velocity update each cycle (bit 0).
+    /// is being taken, with a zero-velocity update each cycle (bit 0), up
+    /// to the longest station (then bit 7 alone).
     pub const STILL: u16 = 1 << 7;
 }
 
@@ -159,7 +160,8 @@ pub mod station_flags {
     pub const AZIMUTH_UNDETERMINED: u16 = 1 << 1;
     /// The still period reached the longest station
     /// (`probe::navigator::MAX_STATION_SAMPLES`): sent while the probe is
-    /// still still; no other station until it has moved.
+    /// still still; no more zero-velocity updates and no other station
+    /// until it has moved.
     pub const MAX_DURATION: u16 = 1 << 2;
     /// The tool axis is within `attitude::NEAR_VERTICAL` (5 deg) of
     /// vertical: azimuth and toolface are poorly defined (large sigmas).
