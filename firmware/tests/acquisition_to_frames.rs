@@ -62,7 +62,7 @@ fn driver_samples_travel_as_frames_and_come_back_in_body_axes() {
     let mut decoder = Decoder::new();
     let mut received = Vec::new();
     decoder.feed(&uart, |f| received.push(f));
-    assert_eq!(decoder.stats().frames, [200, 0, 0]);
+    assert_eq!(decoder.stats().frames, [200, 0, 0, 0]);
     assert_eq!(decoder.stats().lost, 0);
 
     let lsb_rate = gyro_count_to_rad_s(1);

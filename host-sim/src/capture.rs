@@ -172,6 +172,10 @@ pub fn write_simulated_probe<W: Write>(
         });
         capture.write(&Payload::Raw(raw))?;
         capture.write(&Payload::Nav(navigator.step(&raw)))?;
+        // As the probe: a finished station after its cycle's navigation.
+        if let Some(station) = navigator.take_station() {
+            capture.write(&Payload::Station(station))?;
+        }
     }
     Ok(())
 }
@@ -260,11 +264,12 @@ pub fn read_probe_capture(path: &Path) -> anyhow::Result<Capture> {
 impl fmt::Display for Capture {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let s = &self.stats;
-        let [raw, nav, event] = s.frames;
+        let [raw, nav, event, station] = s.frames;
         writeln!(f, "bytes            {}", s.bytes)?;
         writeln!(
             f,
-            "frames           {} good: raw sample {raw}, navigation {nav}, event {event}, unknown kind {}",
+            "frames           {} good: raw sample {raw}, navigation {nav}, event {event}, \
+             station survey {station}, unknown kind {}",
             s.good_frames(),
             s.unknown_kind
         )?;
@@ -291,6 +296,11 @@ impl fmt::Display for Capture {
                 last as f64 * 1e-6
             )?;
         }
+        for frame in &self.frames {
+            if let Payload::Station(st) = &frame.payload {
+                write!(f, "\nprobe {}", crate::display::station_text(st))?;
+            }
+        }
         Ok(())
     }
 }
@@ -304,11 +314,15 @@ p1_rate_rad_s,p1_ax_m_s2,p1_ay_m_s2,p1_az_m_s2,p1_gyro_temp_degc,\
 p2_rate_rad_s,p2_ax_m_s2,p2_ay_m_s2,p2_az_m_s2,p2_gyro_temp_degc,\
 nav_mode,nav_flags,roll_rad,pitch_rad,azimuth_rad,azimuth_status,vn_m_s,ve_m_s,vd_m_s,lat_rad,lon_rad,height_m,\
 sd_roll_rad,sd_pitch_rad,sd_azimuth_rad,sd_vn_m_s,sd_ve_m_s,sd_vd_m_s,sd_pn_m,sd_pe_m,sd_pd_m,\
-event,event_part,event_code,event_value";
+event,event_part,event_code,event_value,\
+st_number,st_flags,st_start_sample,st_end_sample,st_inclination_rad,st_azimuth_rad,st_azimuth_status,\
+st_toolface_rad,st_sd_inclination_rad,st_sd_azimuth_rad,st_sd_toolface_rad,\
+st_corr_inc_azi,st_corr_inc_tf,st_corr_azi_tf,st_still_quality";
 
 const RAW_COLS: usize = 24;
 const NAV_COLS: usize = 21;
 const EVENT_COLS: usize = 4;
+const STATION_COLS: usize = 15;
 
 fn empties(n: usize) -> String {
     ",".repeat(n)
@@ -341,7 +355,7 @@ pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
                         .chain(&n.velocity_std)
                         .chain(&n.position_std_ned),
                 );
-                cells += &empties(EVENT_COLS);
+                cells += &empties(EVENT_COLS + STATION_COLS);
                 ("nav", cells)
             }
             Payload::Event(e) => {
@@ -353,7 +367,29 @@ pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
                     e.code as u32,
                     e.value,
                 ]);
+                cells += &empties(STATION_COLS);
                 ("event", cells)
+            }
+            Payload::Station(st) => {
+                // The end sample goes in the sample_counter column.
+                let mut cells = format!(",{},{}", st.time_us, st.end_sample);
+                cells += &empties(RAW_COLS + NAV_COLS + EVENT_COLS);
+                cells += &join([
+                    u32::from(st.station),
+                    u32::from(st.flags),
+                    st.start_sample,
+                    st.end_sample,
+                ]);
+                cells += &join([st.angles[0]]);
+                cells += &station_azimuth_cells(st);
+                cells += &join(
+                    [st.angles[2]]
+                        .iter()
+                        .chain(&st.angles_std)
+                        .chain(&st.correlations)
+                        .chain([&st.still_quality]),
+                );
+                ("station", cells)
             }
         };
         writeln!(out, "{},{kind}{body}", frame.seq)?;
@@ -372,6 +408,21 @@ fn azimuth_cells(n: &mwd_core::protocol::NavSolution) -> String {
     } else {
         let wrapped = crate::display::deg_0_360(azimuth).to_radians();
         format!(",{},determined", wrapped as f32)
+    }
+}
+
+/// A station's azimuth cells, by the same rule plus its flag.
+fn station_azimuth_cells(st: &mwd_core::protocol::StationSurvey) -> String {
+    use mwd_core::protocol::frame::station_flags;
+    let (azimuth, sigma) = (f64::from(st.angles[1]), f64::from(st.angles_std[1]));
+    if !azimuth.is_finite() || sigma.is_nan() {
+        ",,n/a".to_string()
+    } else if st.flags & station_flags::AZIMUTH_UNDETERMINED != 0
+        || !crate::display::azimuth_is_determined(sigma)
+    {
+        ",,undetermined".to_string()
+    } else {
+        format!(",{},determined", st.angles[1])
     }
 }
 
@@ -394,7 +445,7 @@ fn raw_csv(r: &RawSample) -> String {
                 .chain([GYRO_TEMPERATURE.count_to_degc(p.gyro_temp)]),
         );
     }
-    cells + &empties(NAV_COLS + EVENT_COLS)
+    cells + &empties(NAV_COLS + EVENT_COLS + STATION_COLS)
 }
 
 #[cfg(test)]
@@ -496,7 +547,7 @@ mod tests {
         assert_eq!(bytes.len() as u64, n);
         assert_eq!(n, 27 + 100 * 51 + 106);
         let cap = decode_reader(&bytes[..]).unwrap();
-        assert_eq!(cap.stats.frames, [100, 1, 1]);
+        assert_eq!(cap.stats.frames, [100, 1, 1, 0]);
         assert_eq!(cap.stats.lost, 0);
         assert_eq!(
             cap.frames[5].payload,
@@ -550,6 +601,7 @@ mod tests {
             w.write(&example::raw_sample()).unwrap();
             w.write(&example::nav_solution()).unwrap();
             w.write(&example::boot_event()).unwrap();
+            w.write(&example::station_survey()).unwrap();
             w.finish().unwrap()
         })
         .frames;
@@ -557,7 +609,7 @@ mod tests {
         write_csv(&frames, &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines.len(), 4);
+        assert_eq!(lines.len(), 5);
         let columns = CSV_HEADER.split(',').count();
         for line in &lines {
             assert_eq!(line.split(',').count(), columns, "{line}");
@@ -565,6 +617,16 @@ mod tests {
         assert!(lines[1].starts_with("0,raw,61700000,1234,18,-1625,0,-3,650,"));
         assert!(lines[2].starts_with("1,nav,61700000,1234,"));
         assert!(lines[3].starts_with("2,event,0,,"));
-        assert!(lines[3].ends_with(",1,255,1,0"));
+        assert!(lines[3].contains(",1,255,1,0,"));
+        assert!(
+            lines[4].starts_with("3,station,1379950000,27599,"),
+            "{}",
+            lines[4]
+        );
+        assert!(
+            lines[4].ends_with(",3,1,24000,27599,0.7853982,2.0943952,determined,5.2359877,0.0008727,0.020944,0.0012217,0.12,-0.35,0.05,1.02"),
+            "{}",
+            lines[4]
+        );
     }
 }

@@ -5,6 +5,9 @@
 
 use mwd_core::alignment::MAX_DETERMINED_SIGMA;
 use mwd_core::conventions::wrap_two_pi;
+use mwd_core::protocol::frame::station_flags;
+use mwd_core::protocol::StationSurvey;
+use mwd_core::timing::SAMPLE_INTERVAL_S;
 
 /// An angle (rad) in degrees in [0, 360): azimuth and toolface.
 pub fn deg_0_360(angle_rad: f64) -> f64 {
@@ -40,10 +43,75 @@ pub fn azimuth_text(azimuth_rad: f64, sigma_rad: f64, decimals: usize) -> String
     }
 }
 
+/// "12.345 +- 0.050" (deg), "n/a" for a NaN value or sigma.
+fn angle_with_sigma(value_deg: f64, sigma_rad: f64) -> String {
+    if !value_deg.is_finite() || sigma_rad.is_nan() {
+        "n/a".to_string()
+    } else {
+        format!("{value_deg:.3} +- {:.3} deg", sigma_rad.to_degrees())
+    }
+}
+
+/// One station survey for people: number, span, the three drilling angles
+/// with their 1-sigma (azimuth "undetermined" when its sigma or flag says
+/// so), correlations, still quality and flags.
+pub fn station_text(s: &StationSurvey) -> String {
+    let [inc, azi, tf] = s.angles.map(f64::from);
+    let [s_inc, s_azi, s_tf] = s.angles_std.map(f64::from);
+    let azimuth = if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
+        "undetermined".to_string()
+    } else {
+        azimuth_text(azi, s_azi, 3)
+    };
+    let span_s = f64::from(s.end_sample.wrapping_sub(s.start_sample)) * SAMPLE_INTERVAL_S;
+    let names = [
+        (station_flags::MAGNETIC_FREE, "magnetic-free"),
+        (station_flags::AZIMUTH_UNDETERMINED, "azimuth undetermined"),
+        (station_flags::MAX_DURATION, "longest station reached"),
+        (station_flags::NEAR_VERTICAL, "near vertical"),
+        (station_flags::SOLUTION_INVALID, "INVALID"),
+    ];
+    let flags: Vec<&str> = names
+        .iter()
+        .filter(|(bit, _)| s.flags & bit != 0)
+        .map(|(_, name)| *name)
+        .collect();
+    let corr = |r: f32| {
+        if r.is_nan() {
+            "n/a".to_string()
+        } else {
+            format!("{r:.3}")
+        }
+    };
+    format!(
+        "station {} samples {}..{} ({span_s:.2} s still): inclination {}, azimuth {azimuth}, \
+         toolface {} (1 sigma); correlations inc-azi {} inc-tf {} azi-tf {}; \
+         still quality {:.2}; {}",
+        s.station,
+        s.start_sample,
+        s.end_sample,
+        angle_with_sigma(inc.to_degrees(), s_inc),
+        angle_with_sigma(
+            if tf.is_finite() {
+                deg_0_360(tf)
+            } else {
+                f64::NAN
+            },
+            s_tf
+        ),
+        corr(s.correlations[0]),
+        corr(s.correlations[1]),
+        corr(s.correlations[2]),
+        s.still_quality,
+        flags.join(", ")
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use mwd_core::conventions::DEG;
+    use mwd_core::protocol::Payload;
 
     #[test]
     fn azimuths_read_in_0_to_360() {
@@ -63,5 +131,30 @@ mod tests {
             azimuth_text(-30.0 * DEG, 1.5 * DEG, 2),
             "330.00 +- 1.50 deg (1 sigma)"
         );
+    }
+
+    #[test]
+    fn a_station_reads_with_its_sigmas_and_never_an_undetermined_azimuth() {
+        let Payload::Station(mut s) = mwd_core::protocol::example::station_survey() else {
+            unreachable!()
+        };
+        let text = station_text(&s);
+        assert!(
+            text.contains("station 3 samples 24000..27599 (179.95 s still)"),
+            "{text}"
+        );
+        assert!(text.contains("inclination 45.000 +- 0.050 deg"), "{text}");
+        assert!(text.contains("azimuth 120.000 +- 1.200 deg"), "{text}");
+        assert!(text.contains("toolface 300.000 +- 0.070 deg"), "{text}");
+        assert!(text.contains("magnetic-free"), "{text}");
+        s.flags |= station_flags::AZIMUTH_UNDETERMINED;
+        s.angles_std[1] = f32::INFINITY;
+        s.correlations[0] = f32::NAN;
+        let text = station_text(&s);
+        assert!(
+            text.contains("azimuth undetermined") && !text.contains("120.0"),
+            "{text}"
+        );
+        assert!(text.contains("inc-azi n/a"), "{text}");
     }
 }

@@ -12,6 +12,11 @@
 //! navigation dropped (a samples-dropped event) put the replay out of step:
 //! from there to the next boot its solutions are still given, but not
 //! compared, and the summary says from which sample.
+//!
+//! Station surveys (kind 4) are replayed the same way: the replay's
+//! navigator finishes its stations at the same samples, and each is
+//! compared bit for bit with the probe's station of the same number
+//! ([`Replayer::stations`]).
 
 use std::collections::HashMap;
 use std::io::{self, Write};
@@ -22,7 +27,7 @@ use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::decoder::starts_a_run;
 use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
-use mwd_core::protocol::{encode_body, EventKind, Frame, NavSolution, Payload};
+use mwd_core::protocol::{encode_body, EventKind, Frame, NavSolution, Payload, StationSurvey};
 
 use crate::display;
 
@@ -36,6 +41,31 @@ pub struct ReplayRow {
     pub matches_probe: Option<bool>,
     /// The replay had seen the same samples as the probe's navigation.
     pub in_step: bool,
+}
+
+/// One replayed station survey and how it compares with the probe's.
+#[derive(Debug, Clone, Copy)]
+pub struct StationRow {
+    pub station: StationSurvey,
+    /// Whether the probe's station of the same number was identical;
+    /// `None` while it has not arrived (or never did), and always for a
+    /// station replayed out of step.
+    pub matches_probe: Option<bool>,
+    pub in_step: bool,
+}
+
+/// What the replay did with station surveys.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StationSummary {
+    /// Stations the replay finished.
+    pub replayed: u64,
+    /// Station frames in the capture.
+    pub probe: u64,
+    pub matched: u64,
+    pub mismatched: u64,
+    /// Probe stations not compared: out of step, or the replay finished
+    /// no station of that number.
+    pub unchecked: u64,
 }
 
 /// What a replay did.
@@ -134,6 +164,12 @@ pub struct Replayer {
     step_losses: Vec<StepLoss>,
     /// Rows already handed out by [`Replayer::settled_rows`].
     settled: usize,
+    station_rows: Vec<StationRow>,
+    /// Replayed stations waiting for the probe's, by station number.
+    awaiting_station: HashMap<u16, usize>,
+    /// The probe's stations the replay has not finished yet.
+    early_station: HashMap<u16, StationSurvey>,
+    station_summary: StationSummary,
 }
 
 /// Whether the replay has seen what the probe's navigation saw.
@@ -171,6 +207,10 @@ impl Replayer {
             },
             step_losses: Vec::new(),
             settled: 0,
+            station_rows: Vec::new(),
+            awaiting_station: HashMap::new(),
+            early_station: HashMap::new(),
+            station_summary: StationSummary::default(),
         }
     }
 
@@ -223,10 +263,66 @@ impl Replayer {
                         self.awaiting_probe.insert(raw.sample_counter, index);
                     }
                 }
+                if let Some(station) = self.navigator.take_station() {
+                    self.replayed_station(station);
+                }
                 Some(solution)
+            }
+            Payload::Station(on_board) => {
+                self.station_summary.probe += 1;
+                match self.awaiting_station.remove(&on_board.station) {
+                    Some(index) => self.compare_station(index, &on_board),
+                    None => {
+                        self.early_station.insert(on_board.station, on_board);
+                    }
+                }
+                None
             }
             Payload::Event(_) => None,
         }
+    }
+
+    fn replayed_station(&mut self, station: StationSurvey) {
+        self.station_summary.replayed += 1;
+        let index = self.station_rows.len();
+        self.station_rows.push(StationRow {
+            station,
+            matches_probe: None,
+            in_step: self.step.in_step,
+        });
+        match self.early_station.remove(&station.station) {
+            Some(on_board) => self.compare_station(index, &on_board),
+            None => {
+                self.awaiting_station.insert(station.station, index);
+            }
+        }
+    }
+
+    fn compare_station(&mut self, index: usize, on_board: &StationSurvey) {
+        let Some(row) = self.station_rows.get_mut(index) else {
+            return;
+        };
+        if !row.in_step {
+            self.station_summary.unchecked += 1;
+            return;
+        }
+        let same = encoded_payload(&Payload::Station(*on_board))
+            == encoded_payload(&Payload::Station(row.station));
+        row.matches_probe = Some(same);
+        if same {
+            self.station_summary.matched += 1;
+        } else {
+            self.station_summary.mismatched += 1;
+        }
+    }
+
+    /// The replayed stations so far (in order) and their comparison; a
+    /// probe station whose partner has not been replayed counts as
+    /// unchecked.
+    pub fn stations(&self) -> (&[StationRow], StationSummary) {
+        let mut summary = self.station_summary;
+        summary.unchecked += self.early_station.len() as u64;
+        (&self.station_rows, summary)
     }
 
     /// A boot event: the probe started again, so does the replay.
@@ -237,6 +333,10 @@ impl Replayer {
         self.summary.unchecked += self.early_probe.len() as u64;
         self.awaiting_probe.clear();
         self.early_probe.clear();
+        // Station numbers start again at 1.
+        self.station_summary.unchecked += self.early_station.len() as u64;
+        self.awaiting_station.clear();
+        self.early_station.clear();
         self.step = StepTracker {
             seen_any: true,
             expected_seq: self.step.expected_seq,
@@ -335,8 +435,14 @@ impl Replayer {
 }
 
 fn encoded(nav: &NavSolution) -> Vec<u8> {
+    encoded_payload(&Payload::Nav(*nav))
+}
+
+/// The frame body (sequence number 0): the comparison bit for bit, NaN
+/// placeholders equal.
+fn encoded_payload(payload: &Payload) -> Vec<u8> {
     let mut body = [0u8; MAX_BODY_LEN];
-    let len = encode_body(0, &Payload::Nav(*nav), &mut body).unwrap_or(0);
+    let len = encode_body(0, payload, &mut body).unwrap_or(0);
     body[..len].to_vec()
 }
 
@@ -669,5 +775,79 @@ mod tests {
         let expected = (bias / f64::from(STANDARD_GRAVITY_M_S2)).atan();
         assert!(roll(&plain).abs() < 1e-3, "{}", roll(&plain));
         assert!((roll(&calibrated).abs() - expected).abs() < 0.05 * expected);
+    }
+
+    /// A probe run that navigates, turns, stops for 30 s and turns again,
+    /// as the probe sends it (the station frame after its cycle's
+    /// navigation frame): the replay finishes the same station and finds it
+    /// identical; a changed station is caught.
+    #[test]
+    fn station_surveys_are_replayed_and_compared_bit_for_bit() {
+        use mwd_core::sensor_units::rad_s_to_gyro_count;
+        let site = Position::paper_site();
+        let turning = |n: u32| {
+            let mut frame = raw(n);
+            if let Payload::Raw(r) = &mut frame.payload {
+                for (part, m) in r.parts.iter_mut().zip(PART_MOUNTINGS) {
+                    part.gyro_rate = rad_s_to_gyro_count(m.gyro_rate_from_body([0.0, 0.0, 0.05]));
+                }
+            }
+            frame
+        };
+        let aligned = 1200;
+        let mut navigator = Navigator::new(site);
+        let mut payloads = Vec::new();
+        for n in 0..aligned + 1000 {
+            let moving = (aligned..aligned + 100).contains(&n) || n >= aligned + 700;
+            let frame = if moving { turning(n) } else { raw(n) };
+            let Payload::Raw(r) = frame.payload else {
+                unreachable!()
+            };
+            payloads.push(Payload::Raw(r));
+            payloads.push(Payload::Nav(navigator.step(&r)));
+            payloads.extend(navigator.take_station().map(Payload::Station));
+        }
+        let stations: Vec<StationSurvey> = payloads
+            .iter()
+            .filter_map(|p| match p {
+                Payload::Station(s) => Some(*s),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(stations.len(), 1, "{stations:?}");
+        assert_eq!(stations[0].end_sample, aligned + 699);
+        let capture = numbered(0, payloads.clone());
+        let mut replayer = Replayer::new(site);
+        capture.iter().for_each(|f| {
+            replayer.push(f);
+        });
+        let (rows, summary) = replayer.stations();
+        assert_eq!(
+            summary,
+            StationSummary {
+                replayed: 1,
+                probe: 1,
+                matched: 1,
+                ..StationSummary::default()
+            }
+        );
+        assert_eq!(rows[0].matches_probe, Some(true));
+        // One bit of the probe's toolface sigma changed: caught.
+        let changed: Vec<Payload> = payloads
+            .into_iter()
+            .map(|p| match p {
+                Payload::Station(mut s) => {
+                    s.angles_std[2] = f32::from_bits(s.angles_std[2].to_bits() ^ 1);
+                    Payload::Station(s)
+                }
+                p => p,
+            })
+            .collect();
+        let mut replayer = Replayer::new(site);
+        numbered(0, changed).iter().for_each(|f| {
+            replayer.push(f);
+        });
+        let (_, summary) = replayer.stations();
+        assert_eq!((summary.matched, summary.mismatched), (0, 1));
     }
 }

@@ -16,6 +16,7 @@ fn main() {
         ("raw sample", example::raw_sample()),
         ("navigation solution", example::nav_solution()),
         ("boot event", example::boot_event()),
+        ("station survey", example::station_survey()),
     ] {
         let mut body = [0u8; frame::MAX_BODY_LEN];
         let mut wire = [0u8; mwd_core::protocol::MAX_WIRE_LEN];

@@ -441,6 +441,13 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.config.specific_force = SpecificForceInModel::MeasuredSample;
     }
 
+    /// Turns the zero-velocity update on (noise variance `variance`,
+    /// (m/s)^2) or off for the following steps: the navigator's station
+    /// surveys while the probe is still (`probe::navigator`).
+    pub fn set_zero_velocity(&mut self, variance: Option<f64>) {
+        self.config.zero_velocity_variance = variance;
+    }
+
     /// The navigation frame's rate in body axes at the current solution
     /// (the tool-axis rate of a still tool; [`Strapdown::frame_rate_in_body`]).
     pub fn frame_rate_in_body(&mut self) -> Vector3<f64> {

@@ -6,7 +6,7 @@ use mwd_core::protocol::frame::{MAX_BODY_LEN, NO_PART};
 use mwd_core::protocol::{
     cyclic_bytes_per_s, decode_body, encode_body, encode_frame, example, wire_len, Decoder, Event,
     EventKind, Frame, FrameEncoder, FrameKind, NavSolution, Payload, RawPart, RawSample,
-    MAX_WIRE_LEN, UART_BYTES_PER_S,
+    StationSurvey, MAX_WIRE_LEN, UART_BYTES_PER_S,
 };
 use proptest::prelude::*;
 
@@ -75,7 +75,27 @@ fn payload() -> impl Strategy<Value = Payload> {
                 value,
             })
         });
-    prop_oneof![raw, nav, event]
+    let station = (
+        any::<(u64, u16, u16, u32, u32)>(),
+        f32x3(),
+        f32x3(),
+        f32x3(),
+        f32_bits(),
+    )
+        .prop_map(|((t, station, flags, start, end), a, s, c, q)| {
+            Payload::Station(StationSurvey {
+                time_us: t,
+                station,
+                flags,
+                start_sample: start,
+                end_sample: end,
+                angles: a,
+                angles_std: s,
+                correlations: c,
+                still_quality: q,
+            })
+        });
+    prop_oneof![raw, nav, event, station]
 }
 
 fn body_bytes(seq: u16, payload: &Payload) -> Vec<u8> {
@@ -200,12 +220,14 @@ fn bandwidth_budget() {
     let raw = wire_len(FrameKind::RawSample.body_len());
     let nav = wire_len(FrameKind::NavSolution.body_len());
     let event = wire_len(FrameKind::Event.body_len());
-    assert_eq!((raw, nav, event), (51, 106, 27));
+    let station = wire_len(FrameKind::StationSurvey.body_len());
+    assert_eq!((raw, nav, event, station), (51, 106, 27, 71));
     // Measured, not just computed: encode real frames.
     for payload in [
         example::raw_sample(),
         example::nav_solution(),
         example::boot_event(),
+        example::station_survey(),
     ] {
         assert_eq!(
             wire_bytes(1, &payload).len(),
@@ -236,6 +258,7 @@ fn the_document_shows_the_current_bytes() {
         example::raw_sample(),
         example::nav_solution(),
         example::boot_event(),
+        example::station_survey(),
     ] {
         let body = hex(&body_bytes(seq, &payload));
         let wire = hex(&wire_bytes(seq, &payload));

@@ -70,7 +70,8 @@ pub const ACQUISITION_WORST_BYTES: usize =
     wire_len(FrameKind::RawSample.body_len()) + 4 * wire_len(FrameKind::Event.body_len());
 
 /// Room the main loop leaves in the transmit queue before it navigates a
-/// sample: its navigation frame, what the acquisition may queue before the
+/// sample: its navigation frame and the station survey the step may finish
+/// (kind 4, at most one per still period), what the acquisition may queue before the
 /// UART has drained as much (one period's worth: the UART drains 576 B per
 /// period, more than an acquisition's worst), and the main loop's own
 /// events after a recovery (two resets, the resynchronisation, a
@@ -78,11 +79,13 @@ pub const ACQUISITION_WORST_BYTES: usize =
 /// than dropping its frame, keeps every navigation frame (the samples wait
 /// in the inbox, which is sized for it).
 pub const NAV_ROOM_BYTES: usize = wire_len(FrameKind::NavSolution.body_len())
+    + wire_len(FrameKind::StationSurvey.body_len())
     + ACQUISITION_WORST_BYTES
     + 4 * wire_len(FrameKind::Event.body_len());
 
 // The navigation can go on at all only if the queue holds its room, and
-// in steady state (157 B per period) it never waits for it.
+// in steady state (157 B per period, 228 B in the period a station survey
+// is sent, of the 576 B the UART drains per period) it never waits for it.
 const _: () = assert!(TX_QUEUE_LEN >= 2 * NAV_ROOM_BYTES);
 
 /// The longest the main loop may go without feeding the watchdog: it feeds
@@ -118,6 +121,6 @@ mod tests {
         assert_eq!(NAV_INBOX_NEEDED, 41 + 6);
         assert_eq!(WATCHDOG_UNFED_WORST_MS, 1_000);
         assert_eq!(ACQUISITION_WORST_BYTES, 51 + 4 * 27);
-        assert_eq!(NAV_ROOM_BYTES, 106 + 159 + 108);
+        assert_eq!(NAV_ROOM_BYTES, 106 + 71 + 159 + 108);
     }
 }

@@ -107,7 +107,8 @@ impl<G, A, T: Transmitter> SharedProbe<G, A, T> {
     /// Navigates the waiting samples, oldest first, outside the critical
     /// section, as long as the transmit queue has room for their frames
     /// ([`ProbeState::next_sample_to_navigate`]; the rest wait for the
-    /// UART), and queues each solution; `on_solution` sees each first. The
+    /// UART), and queues each solution, and the station survey a step
+    /// finished after it; `on_solution` sees each solution first. The
     /// watchdog is fed after each step (the slowest,
     /// `budget::SLOWEST_NAVIGATION_STEP_MS`, is within its budget).
     pub fn navigate_waiting(
@@ -126,6 +127,13 @@ impl<G, A, T: Transmitter> SharedProbe<G, A, T> {
             feed_watchdog();
             on_solution(&solution);
             self.push(&Payload::Nav(solution));
+            // A station survey the step finished goes right after its
+            // navigation frame (docs/protocol.md, kind 4); the queue's room
+            // for it was checked with the navigation frame's
+            // (`budget::NAV_ROOM_BYTES`).
+            if let Some(station) = navigator.take_station() {
+                self.push(&Payload::Station(station));
+            }
         }
     }
 }

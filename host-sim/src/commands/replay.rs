@@ -19,7 +19,9 @@ use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::capture::{self, Capture};
 use host_sim::display;
 use host_sim::live::{self, LiveOptions, LiveSinks};
-use host_sim::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
+use host_sim::replay::{
+    self, ReplayRow, ReplaySummary, Replayer, StationRow, StationSummary, StepLoss,
+};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
 
@@ -43,7 +45,7 @@ mod status {
     after_help = "Exit status: 0 every probe solution compared was identical (or the \
 replay was post-processed with --calibration-file or a site option: differences are then \
 expected and reported, not a failure); 1 error (unreadable file, not a probe capture, bad \
-argument); 2 bad command line; 3 replayed solutions differ from the probe's; 4 all compared \
+argument); 2 bad command line; 3 replayed solutions or station surveys differ from the probe's; 4 all compared \
 solutions identical but some could not be compared (frames lost: the replay stops comparing \
 from the first sample after the loss and starts again at the probe's next boot event)."
 )]
@@ -105,6 +107,9 @@ struct Replayed {
     step_losses: Vec<StepLoss>,
     /// Live: the CSV was written while streaming.
     csv_written: bool,
+    /// Replayed station surveys and their comparison; `None` for a live
+    /// session (its stations are listed from the probe's frames only).
+    stations: Option<(Vec<StationRow>, StationSummary)>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -140,6 +145,8 @@ fn replay_file(
         replayer.push(frame);
     }
     let step_losses = replayer.step_losses().to_vec();
+    let (station_rows, station_summary) = replayer.stations();
+    let stations = Some((station_rows.to_vec(), station_summary));
     let (rows, summary) = replayer.finish();
     Ok(Replayed {
         source: file.display().to_string(),
@@ -148,6 +155,7 @@ fn replay_file(
         summary,
         step_losses,
         csv_written: false,
+        stations,
     })
 }
 
@@ -221,6 +229,7 @@ fn replay_live(
         summary: outcome.summary,
         step_losses: outcome.step_losses,
         csv_written: args.csv.is_some(),
+        stations: None,
     })
 }
 
@@ -237,6 +246,7 @@ fn report(
         summary,
         step_losses,
         csv_written,
+        stations,
     } = replayed;
     outln!("capture          {source}");
     outln!("{cap}");
@@ -256,6 +266,38 @@ fn report(
     for loss in step_losses {
         outln!("out of step      {loss}");
     }
+    let mut stations_differ = 0;
+    let mut stations_unchecked = 0;
+    match stations {
+        Some((rows, s)) => {
+            outln!(
+                "station parity   {} replayed, {} from the probe: {} identical, {} different, \
+                 {} not compared",
+                s.replayed,
+                s.probe,
+                s.matched,
+                s.mismatched,
+                s.unchecked
+            );
+            for row in rows {
+                let parity = match (row.in_step, row.matches_probe) {
+                    (false, _) => "not compared",
+                    (true, Some(true)) => "identical to the probe's",
+                    (true, Some(false)) => "DIFFERENT from the probe's",
+                    (true, None) => "no probe frame",
+                };
+                outln!(
+                    "replayed {} [{parity}]",
+                    display::station_text(&row.station)
+                );
+            }
+            stations_differ = s.mismatched;
+            stations_unchecked = s.unchecked;
+        }
+        None => {
+            outln!("station parity   not replayed live (the probe's stations are listed above)")
+        }
+    }
     if let Some(last) = rows.last() {
         let s = &last.solution;
         let [r, p, h] = s.attitude.map(f64::from);
@@ -274,7 +316,7 @@ fn report(
         outln!("csv              {} ({} rows)", out.display(), rows.len());
     }
     if post_processed {
-        if summary.mismatched > 0 {
+        if summary.mismatched > 0 || stations_differ > 0 {
             outln!(
                 "post-processed   with another calibration or site than the probe's defaults: \
                  differences from the probe's solutions are expected, not a parity failure"
@@ -282,12 +324,16 @@ fn report(
         }
         return Ok(ExitCode::from(status::PARITY));
     }
-    if summary.mismatched > 0 {
+    if summary.mismatched > 0 || stations_differ > 0 {
         eprintln!(
-            "error: {} replayed solutions differ from the probe's",
+            "error: {} replayed solutions and {stations_differ} station surveys differ from the probe's",
             summary.mismatched
         );
         return Ok(ExitCode::from(status::DIFFERENT));
+    }
+    if stations_unchecked > 0 {
+        eprintln!("warning: {stations_unchecked} probe station surveys could not be compared");
+        return Ok(ExitCode::from(status::INCOMPLETE));
     }
     if summary.unchecked > 0 || !step_losses.is_empty() {
         eprintln!(

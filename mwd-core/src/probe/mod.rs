@@ -3,12 +3,17 @@
 //! the probe's solutions bit for bit).
 //!
 //! * [`raw`]: a raw sample's counts to calibrated body-frame rates and force.
-//! * [`navigator`]: coarse alignment, fine alignment, navigation.
+//! * [`navigator`]: coarse alignment, fine alignment, navigation with
+//!   station surveys at still periods.
+//! * [`still`]: the still detector.
+//! * [`station`]: a station's drilling angles and their covariance.
 //! * [`tie_in`]: a start from a parent well's survey instead of the
 //!   static alignment.
 
 pub mod navigator;
 pub mod raw;
+pub mod station;
+pub mod still;
 pub mod tie_in;
 
 pub use navigator::Navigator;

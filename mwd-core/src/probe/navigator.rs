@@ -12,7 +12,17 @@
 //!    runs);
 //! 3. navigation: the same filter without the zero updates, so the
 //!    mechanization runs on (bias estimates still compensated through the
-//!    filter's dynamics) and the reported uncertainties grow honestly.
+//!    filter's dynamics) and the reported uncertainties grow honestly;
+//! 4. station surveys, within navigation: whenever the still detector
+//!    (`super::still`, thresholds from the noise budget) finds the probe
+//!    at rest (the string in the slips at a connection), each cycle gets a
+//!    zero-velocity update (the filter re-levels through it: the velocity
+//!    error is driven by the tilt error times g, derivation section 3),
+//!    and when motion resumes (or after [`MAX_STATION_SAMPLES`]) the
+//!    navigator hands out a station survey ([`Navigator::take_station`]):
+//!    inclination, azimuth and toolface of the last still cycle with their
+//!    covariance (`super::station`). No zero-position update: the probe's
+//!    position while drilling is not known.
 //!
 //! What the frames say besides the solution (docs/protocol.md, Kind 2;
 //! docs/filter-derivation.md section 5b): during the coarse alignment the
@@ -31,11 +41,13 @@
 use super::raw::{reading, Reading};
 use super::tie_in::TieIn;
 use crate::aid_sources::{NonHolonomic, DRILLING_VARIANCE};
+use super::station::{angle_uncertainty, angles_and_jacobian};
+use super::still::StillDetector;
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
-use crate::attitude::ToolAxisRate;
+use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
 use crate::calibration::ProbeCalibration;
-use crate::conventions::{euler_from_quat, quat_from_euler, Euler, DEG};
-use crate::earth::Position;
+use crate::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, Euler, DEG};
+use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
 use crate::fine_alignment::{FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior};
 use crate::kalman::UpdateReport;
@@ -43,7 +55,8 @@ use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
 use crate::protocol::frame::nav_mode;
-use crate::protocol::{NavSolution, RawSample};
+use crate::protocol::frame::station_flags;
+use crate::protocol::{NavSolution, RawSample, StationSurvey};
 use crate::sensor_noise::ImuNoise;
 use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
 use nalgebra::UnitQuaternion;
@@ -82,6 +95,23 @@ pub const UNMEASURED_RATE_SIGMA: f64 = 1.0 * DEG;
 /// about 10 mg, ten times the accelerometers' per-sample noise.
 pub const UNMEASURED_FORCE_SIGMA: f64 = 0.1;
 
+/// Zero-velocity update noise variance during a station, (m/s)^2: 1 cm/s,
+/// ten times the fine alignment's 1 mm/s, for a string held in the slips
+/// that may still sway and creep a little (the still detector cannot see a
+/// steady creep: `super::still`).
+pub const STATION_ZUPT_VARIANCE: f64 = 1e-4;
+
+/// The longest station (samples): 5 minutes, longer than a connection
+/// usually takes. A station still going on then is sent (flag
+/// `MAX_DURATION`) so the surface need not wait for motion, and the
+/// zero-velocity updates stop until the probe has moved: the filter's
+/// position sigma is not consistent under hours of them (the 24 h still
+/// run, `tests/tests/navigator_long_run.rs`, saw the down position drift
+/// ~0.33 m/h, linearly, while its sigma grew as a random walk: a residual
+/// velocity bias the model does not hold), so they are kept to station
+/// lengths, where the drift (~3 cm in 5 min) stays within the sigma.
+pub const MAX_STATION_SAMPLES: u32 = 6000;
+
 /// The filter's settings for a still probe at `position` whose coarse
 /// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
 fn filter_config(
@@ -101,8 +131,18 @@ enum Phase {
     Coarse(SegmentSums),
     /// The filter with zero updates; `samples` taken so far.
     Fine { samples: u32 },
-    /// The filter without zero updates.
+    /// The filter without zero updates, but for station surveys.
     Navigating,
+}
+
+/// A station in progress.
+struct Station {
+    /// Zero-velocity updates so far.
+    epochs: u32,
+    /// Sum of the still detector's largest normalised statistic.
+    quality_sum: f32,
+    /// The survey as of the last still cycle.
+    survey: StationSurvey,
 }
 
 /// The probe's navigation, one raw sample at a time.
@@ -135,6 +175,18 @@ pub struct Navigator {
     /// gyrocompassed from these sums.
     coarse_single_part: bool,
     flags: u16,
+    /// The still detector (navigation only).
+    still: StillDetector,
+    station: Option<Station>,
+    /// Stations started since boot.
+    stations: u16,
+    /// The current still period reached [`MAX_STATION_SAMPLES`].
+    station_capped: bool,
+    /// A finished station, until taken.
+    finished_station: Option<StationSurvey>,
+    /// The raw sample being processed.
+    time_us: u64,
+    sample_counter: u32,
 }
 
 impl Navigator {
@@ -159,39 +211,164 @@ impl Navigator {
             covariance_invalid: false,
             coarse_single_part: false,
             flags: 0,
+            still: StillDetector::scc1300(normal_gravity(position.lat, position.height)),
+            station: None,
+            stations: 0,
+            station_capped: false,
+            finished_station: None,
+            time_us: 0,
+            sample_counter: 0,
         }
     }
 
     /// Takes one raw sample and returns the solution after it.
     pub fn step(&mut self, raw: &RawSample) -> NavSolution {
         self.flags = 0;
-        match reading(raw, &self.calibration) {
+        self.time_us = raw.time_us;
+        self.sample_counter = raw.sample_counter;
+        let still = match reading(raw, &self.calibration) {
             Reading::Both(sample) => self.use_sample(&sample, None),
             Reading::Single {
                 sample,
                 missing_gyro,
             } => {
                 self.flags |= nav_flags::SENSOR_DEGRADED | nav_flags::SINGLE_PART;
-                self.use_sample(&sample, Some(missing_gyro));
+                self.use_sample(&sample, Some(missing_gyro))
             }
             // No valid data: the alignment waits, the filter coasts.
             Reading::Neither => {
                 self.flags |= nav_flags::SENSOR_DEGRADED;
                 self.coast();
+                self.is_navigating().then_some(false)
             }
-        }
+        };
         if self.is_aligned() && !self.covariance_invalid {
             self.covariance_invalid = !self.filter.filter().covariance_is_healthy(VARIANCE_LIMIT);
+        }
+        if let Some(still) = still {
+            self.track_station(still);
         }
         self.solution(raw)
     }
 
+    /// The station survey finished by the last [`step`](Self::step), if
+    /// any: the probe sends it after that step's navigation frame.
+    pub fn take_station(&mut self) -> Option<StationSurvey> {
+        self.finished_station.take()
+    }
+
+    /// Stations started since boot.
+    pub fn stations(&self) -> u16 {
+        self.stations
+    }
+
+    /// A navigation cycle, `still` or not: starts, extends or ends the
+    /// station.
+    fn track_station(&mut self, still: bool) {
+        if !still {
+            self.station_capped = false;
+            self.finish_station(0);
+            return;
+        }
+        if self.station_capped {
+            return;
+        }
+        let statistics = self.still.statistics();
+        let quality = statistics
+            .rate
+            .max(statistics.force)
+            .max(statistics.gravity);
+        let start = self.sample_counter;
+        if self.station.is_none() {
+            self.stations = self.stations.wrapping_add(1);
+            self.station = Some(Station {
+                epochs: 0,
+                quality_sum: 0.0,
+                survey: StationSurvey::default(),
+            });
+        }
+        let survey = self.station_survey();
+        let number = self.stations;
+        let Some(station) = self.station.as_mut() else {
+            return;
+        };
+        station.epochs += 1;
+        station.quality_sum += quality;
+        let start_sample = if station.epochs == 1 {
+            start
+        } else {
+            station.survey.start_sample
+        };
+        station.survey = StationSurvey {
+            station: number,
+            start_sample,
+            still_quality: station.quality_sum / station.epochs as f32,
+            ..survey
+        };
+        if station.epochs >= MAX_STATION_SAMPLES {
+            self.finish_station(station_flags::MAX_DURATION);
+            self.station_capped = true;
+        }
+    }
+
+    fn finish_station(&mut self, flags: u16) {
+        if let Some(station) = self.station.take() {
+            let mut survey = station.survey;
+            survey.flags |= flags;
+            self.finished_station = Some(survey);
+        }
+    }
+
+    /// The station survey at this cycle: the filter's attitude as drilling
+    /// angles, their covariance J P_phi J^T (`super::station`), the flags.
+    /// Everything but the station number, start and quality.
+    fn station_survey(&self) -> StationSurvey {
+        let state = self.filter.state();
+        let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
+        let mut flags = station_flags::MAGNETIC_FREE;
+        let inclination = angles.inclination;
+        if !(NEAR_VERTICAL..=core::f64::consts::PI - NEAR_VERTICAL).contains(&inclination) {
+            flags |= station_flags::NEAR_VERTICAL;
+        }
+        let mut survey = StationSurvey {
+            time_us: self.time_us,
+            end_sample: self.sample_counter,
+            angles: [angles.inclination, angles.azimuth, angles.toolface].map(|a| a as f32),
+            angles_std: [f32::NAN; 3],
+            correlations: [f32::NAN; 3],
+            ..StationSurvey::default()
+        };
+        if self.covariance_invalid {
+            survey.flags = flags | station_flags::SOLUTION_INVALID;
+            return survey;
+        }
+        let u = angle_uncertainty(&jacobian, &self.filter.attitude_error_covariance());
+        survey.angles_std = u.sigma.map(|s| s as f32);
+        survey.correlations = u.correlation.map(|r| r as f32);
+        // The navigation frames' rule for the azimuth (see `solution`).
+        let determined = self.coarse_std[2].is_finite() && self.flags & nav_flags::SINGLE_PART == 0;
+        if !determined {
+            flags |= station_flags::AZIMUTH_UNDETERMINED;
+            survey.angles_std[1] = f32::INFINITY;
+            survey.correlations[0] = f32::NAN;
+            survey.correlations[2] = f32::NAN;
+        }
+        let tilt = self.filter.euler_std();
+        if !(tilt.x <= TILT_SIGMA_LIMIT_RAD && tilt.y <= TILT_SIGMA_LIMIT_RAD) {
+            flags |= station_flags::SOLUTION_INVALID;
+        }
+        survey.flags = flags;
+        survey
+    }
+
     /// `sample`, with the gyro of index `missing_gyro` (in `GYRO_AXES`)
-    /// out when one part is.
-    fn use_sample(&mut self, sample: &ProbeSample, missing_gyro: Option<usize>) {
+    /// out when one part is. Returns, when navigating, whether the probe
+    /// was still (a zero-velocity update was made).
+    fn use_sample(&mut self, sample: &ProbeSample, missing_gyro: Option<usize>) -> Option<bool> {
         let mut sample = *sample;
         let mut coarse_done = None;
         let mut fine_done = false;
+        let mut navigating_still = None;
         let gap_ended = self.missed > 0;
         self.missed = 0;
         if gap_ended {
@@ -199,6 +376,16 @@ impl Navigator {
             // apart and count the held rate's turn twice: it starts again.
             self.input = ProbeInput::new();
         }
+        // Judged on the sample as measured (before the missing gyro's
+        // stand-in): with one part out a turn about its axis would not be
+        // seen, so stillness is judged on full samples only.
+        let still = match (&self.phase, missing_gyro) {
+            (Phase::Navigating, None) => self.still.update(&sample),
+            _ => {
+                self.still.reset();
+                false
+            }
+        };
         let filter = &mut self.filter;
         // The missing gyro's stand-in: the rate of a tool turning with the
         // navigation frame (a still tool), uncertain by
@@ -249,8 +436,20 @@ impl Navigator {
                 if tool_axis == ToolAxisRate::Unavailable {
                     self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
                 }
-                filter.step_with(&imu, &extra);
+                // No updates past the longest station (see
+                // `MAX_STATION_SAMPLES`): free navigation until it moves.
+                let update = still && !self.station_capped;
+                filter.set_zero_velocity(update.then_some(STATION_ZUPT_VARIANCE));
+                let report = filter.step_with(&imu, &extra);
                 self.held = Some(imu);
+                if still {
+                    self.flags |= nav_flags::STILL;
+                }
+                if report.zero_velocity.accepted > 0 {
+                    self.flags |= nav_flags::ZUPT_APPLIED;
+                    self.coasting = false;
+                }
+                navigating_still = Some(still && report.sample_used);
             }
         }
         if let Some(segment) = coarse_done {
@@ -264,6 +463,7 @@ impl Navigator {
             self.input = ProbeInput::new();
             self.phase = Phase::Navigating;
         }
+        navigating_still
     }
 
     /// A sample with no valid data: after the coarse alignment the filter
@@ -280,6 +480,9 @@ impl Navigator {
             return;
         }
         self.missed = self.missed.saturating_add(1);
+        // A gap ends any still period: stillness was not seen (and the
+        // step below makes no zero update).
+        self.still.reset();
         let growth = f64::from(2 * self.missed.min(1 << 20) - 1);
         let extra = StepNoise {
             attitude: growth * square(UNMEASURED_RATE_SIGMA * SAMPLE_INTERVAL_S),
@@ -447,6 +650,8 @@ fn square(v: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    extern crate std;
+    use super::super::still::DETECTION_DELAY_SAMPLES;
     use crate::calibration::TriadCalibration;
     use crate::protocol::frame::raw_flags;
     use crate::protocol::RawPart;
@@ -542,10 +747,11 @@ mod tests {
             );
         }
 
-        // Navigating without zero updates, the uncertainties grow.
+        // Navigating (turning, so not still) without zero updates, the
+        // uncertainties grow.
         let mut later = last;
         for n in ALL_ALIGNMENT + 1..ALL_ALIGNMENT + 200 {
-            later = navigator.step(&level_sample(n));
+            later = navigator.step(&turning_sample(n, 3.0));
             assert_eq!(later.mode, nav_mode::NAVIGATING);
             assert_eq!(later.flags & nav_flags::ZUPT_APPLIED, 0);
         }
@@ -713,5 +919,145 @@ mod tests {
             last.attitude_std[..2].iter().all(|s| s.is_finite()),
             "{last:?}"
         );
+    }
+
+    /// Navigating, a probe that turns, stops for a minute and turns again:
+    /// zero-velocity updates from the still detector's delay on, and one
+    /// station survey when it moves, with the attitude of the last still
+    /// cycle and the filter's uncertainty.
+    #[test]
+    fn a_stop_in_navigation_gives_zero_updates_and_one_station() {
+        let mut navigator = aligned_navigator();
+        let start = ALL_ALIGNMENT + 1;
+        let still_from = start + 100;
+        let still_to = still_from + 1200; // 60 s
+        let mut moving_end = NavSolution::default();
+        let mut last_still = NavSolution::default();
+        let mut stations = std::vec::Vec::new();
+        for n in start..still_to + 50 {
+            let still = (still_from..still_to).contains(&n);
+            let raw = if still {
+                level_sample(n)
+            } else {
+                turning_sample(n, 3.0)
+            };
+            let s = navigator.step(&raw);
+            stations.extend(navigator.take_station().map(|st| (n, st)));
+            let expect_zupt = still && n >= still_from + DETECTION_DELAY_SAMPLES - 1;
+            assert_eq!(
+                s.flags & (nav_flags::ZUPT_APPLIED | nav_flags::STILL) != 0,
+                expect_zupt,
+                "sample {n}: {s:?}"
+            );
+            if n == still_from - 1 {
+                moving_end = s;
+            }
+            if n == still_to - 1 {
+                last_still = s;
+            }
+        }
+        // The velocity uncertainty grown while turning was taken back
+        // (below the updates' own 1 cm/s), and the filter re-levelled: the
+        // tilt sigmas fell.
+        for i in 0..3 {
+            let (before, after) = (moving_end.velocity_std[i], last_still.velocity_std[i]);
+            assert!(
+                after < 0.01 && after < before,
+                "{moving_end:?} -> {last_still:?}"
+            );
+        }
+        for i in 0..2 {
+            assert!(
+                last_still.attitude_std[i] < 0.9 * moving_end.attitude_std[i],
+                "{moving_end:?} -> {last_still:?}"
+            );
+        }
+        assert_eq!(stations.len(), 1, "{stations:?}");
+        let (sent_at, st) = stations[0];
+        assert_eq!(sent_at, still_to, "sent with the first moving sample");
+        assert_eq!(st.station, 1);
+        assert_eq!(st.start_sample, still_from + DETECTION_DELAY_SAMPLES - 1);
+        assert_eq!(st.end_sample, still_to - 1);
+        assert_eq!(st.time_us, u64::from(still_to - 1) * 50_000);
+        // The level probe: inclination 90 deg; toolface = roll.
+        let [roll, pitch, heading] = last_still.attitude.map(f64::from);
+        let [inc, azi, tf] = st.angles.map(f64::from);
+        assert!(
+            (inc - (core::f64::consts::FRAC_PI_2 + pitch)).abs() < 1e-6,
+            "{st:?}"
+        );
+        assert!(
+            (crate::conventions::wrap_pi(tf - roll)).abs() < 1e-6,
+            "{st:?}"
+        );
+        assert!(
+            (crate::conventions::wrap_pi(azi - heading)).abs() < 1e-6,
+            "{st:?}"
+        );
+        // No earth rate in these samples: no heading was gyrocompassed, so
+        // the azimuth is undetermined, as in the navigation frames.
+        assert_eq!(
+            st.flags,
+            station_flags::MAGNETIC_FREE | station_flags::AZIMUTH_UNDETERMINED
+        );
+        assert_eq!(st.angles_std[1], f32::INFINITY);
+        assert!(st.correlations[0].is_nan() && st.correlations[2].is_nan());
+        assert!(st.correlations[1].abs() <= 1.0, "{st:?}");
+        // Inclination and toolface sigmas: pitch and roll's of the frame.
+        assert!((st.angles_std[0] - last_still.attitude_std[1]).abs() < 1e-3 * st.angles_std[0]);
+        assert!((st.angles_std[2] - last_still.attitude_std[0]).abs() < 1e-3 * st.angles_std[2]);
+        // Noise-free still samples: the quality is the detector's floor.
+        assert!(st.still_quality >= 0.0 && st.still_quality < 0.1, "{st:?}");
+    }
+
+    /// A stop longer than the longest station: the station is sent then,
+    /// the updates stop, and the next station comes after the next move.
+    #[test]
+    fn a_long_stop_is_sent_at_the_longest_station_and_once() {
+        let mut navigator = aligned_navigator();
+        let start = ALL_ALIGNMENT + 1;
+        let mut stations = std::vec::Vec::new();
+        let still_end = start + MAX_STATION_SAMPLES + 300;
+        for n in start..still_end + 200 {
+            let moving = (still_end..still_end + 20).contains(&n);
+            let raw = if moving {
+                turning_sample(n, 3.0)
+            } else {
+                level_sample(n)
+            };
+            let s = navigator.step(&raw);
+            if n == still_end - 1 {
+                // Past the longest station: still, but no more updates.
+                assert_eq!(
+                    s.flags & (nav_flags::ZUPT_APPLIED | nav_flags::STILL),
+                    nav_flags::STILL,
+                    "{s:?}"
+                );
+            }
+            stations.extend(navigator.take_station().map(|st| (n, st)));
+        }
+        // One station for the long stop, sent when it reached the longest
+        // station while the probe was still still; nothing when it moved.
+        assert_eq!(stations.len(), 1, "{stations:?}");
+        let (at, first) = stations[0];
+        // The detector's window began with the last aligned sample, the
+        // first one navigated.
+        let first_zupt = ALL_ALIGNMENT + DETECTION_DELAY_SAMPLES - 1;
+        assert_eq!(at, first_zupt + MAX_STATION_SAMPLES - 1);
+        assert_eq!(
+            (first.station, first.start_sample, first.end_sample),
+            (1, first_zupt, at)
+        );
+        assert_ne!(first.flags & station_flags::MAX_DURATION, 0);
+        // The stop after the move started station 2, not ended yet.
+        assert_eq!(navigator.stations(), 2);
+        let mut raw = level_sample(still_end + 200);
+        raw.parts[1].flags = 0;
+        navigator.step(&raw);
+        let second = navigator
+            .take_station()
+            .expect("a single part ends the station");
+        assert_eq!(second.station, 2);
+        assert_eq!(second.flags & station_flags::MAX_DURATION, 0);
     }
 }

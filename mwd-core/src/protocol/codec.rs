@@ -4,8 +4,8 @@
 use super::bytes::{OutOfRoom, Reader, Writer};
 use super::crc::crc32c;
 use super::frame::{
-    Event, EventKind, Frame, FrameKind, NavSolution, Payload, RawPart, RawSample, CRC_LEN,
-    HEADER_LEN, PROTOCOL_VERSION,
+    Event, EventKind, Frame, FrameKind, NavSolution, Payload, RawPart, RawSample, StationSurvey,
+    CRC_LEN, HEADER_LEN, PROTOCOL_VERSION,
 };
 
 /// Why a body was rejected.
@@ -82,6 +82,17 @@ fn write_payload(w: &mut Writer, payload: &Payload) -> Result<(), OutOfRoom> {
             w.u16(e.code)?;
             w.u32(e.value)?;
         }
+        Payload::Station(s) => {
+            w.u64(s.time_us)?;
+            w.u16(s.station)?;
+            w.u16(s.flags)?;
+            w.u32(s.start_sample)?;
+            w.u32(s.end_sample)?;
+            w.f32s(&s.angles)?;
+            w.f32s(&s.angles_std)?;
+            w.f32s(&s.correlations)?;
+            w.f32(s.still_quality)?;
+        }
     }
     Ok(())
 }
@@ -127,6 +138,17 @@ fn read_payload(kind: FrameKind, r: &mut Reader) -> Result<Payload, OutOfRoom> {
             part: r.u8()?,
             code: r.u16()?,
             value: r.u32()?,
+        }),
+        FrameKind::StationSurvey => Payload::Station(StationSurvey {
+            time_us: r.u64()?,
+            station: r.u16()?,
+            flags: r.u16()?,
+            start_sample: r.u32()?,
+            end_sample: r.u32()?,
+            angles: r.f32s()?,
+            angles_std: r.f32s()?,
+            correlations: r.f32s()?,
+            still_quality: r.f32()?,
         }),
     })
 }
@@ -201,6 +223,7 @@ mod tests {
             Payload::Raw(RawSample::default()),
             Payload::Nav(NavSolution::default()),
             event(),
+            Payload::Station(StationSurvey::default()),
         ] {
             let mut buf = [0u8; MAX_BODY_LEN];
             let n = encode_body(7, &payload, &mut buf).unwrap();
@@ -241,7 +264,7 @@ mod tests {
         with_crc(&mut v[..n]);
         assert_eq!(decode_body(&v[..n]), Err(FrameError::UnsupportedVersion(2)));
         let mut k = buf;
-        k[1] = 9;
+        k[1] = 9; // 4 is the station survey since version 1's fourth kind
         with_crc(&mut k[..n]);
         assert_eq!(
             decode_body(&k[..n]),

@@ -9,7 +9,7 @@
 //! boot events, and a large gap is checked against the raw frames' sample
 //! counters (`docs/protocol.md`, "Losses").
 
-use super::frame::{decode_body, EventKind, Frame, FrameError, Payload, MAX_BODY_LEN};
+use super::frame::{decode_body, EventKind, Frame, FrameError, FrameKind, Payload, MAX_BODY_LEN};
 use super::wire::{wire_len, DELIMITER};
 
 /// Largest chunk kept between delimiters: the longest valid encoded body.
@@ -23,8 +23,8 @@ pub const MAX_CHUNK_LEN: usize = wire_len(MAX_BODY_LEN) - 2;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct DecoderStats {
     /// Good frames by kind, indexed by `FrameKind::index`: raw sample,
-    /// navigation, event.
-    pub frames: [u64; 3],
+    /// navigation, event, station survey.
+    pub frames: [u64; FrameKind::COUNT],
     /// Good frames with a kind this decoder does not know (newer probe).
     pub unknown_kind: u64,
     /// Chunks whose CRC failed.
@@ -115,7 +115,7 @@ impl Decoder {
                 restarts: 0,
             },
             stats: DecoderStats {
-                frames: [0; 3],
+                frames: [0; FrameKind::COUNT],
                 unknown_kind: 0,
                 crc_errors: 0,
                 malformed: 0,
@@ -334,7 +334,7 @@ mod tests {
                 });
             }
             assert_eq!(seen, 8);
-            assert_eq!(dec.stats().frames, [0, 0, 8]);
+            assert_eq!(dec.stats().frames, [0, 0, 8, 0]);
             assert_eq!(dec.stats().corrupt(), 0);
             assert_eq!(dec.stats().lost, 0);
         }
@@ -432,6 +432,45 @@ mod tests {
         // Small gaps stay exact without any raw frame to check them.
         let stats = stats_of(run(100).filter(|(seq, _)| seq % 20 != 7));
         assert_eq!((stats.lost, stats.sequence_restarts), (10, 0), "{stats:?}");
+    }
+
+    /// A kind this decoder does not know (a newer probe's) is skipped, not
+    /// counted as corrupt, and its sequence number keeps the loss count
+    /// exact: the rule that lets a version-1 decoder that predates kind 4
+    /// (station survey) read a capture that holds them.
+    #[test]
+    fn an_unknown_kind_is_skipped_and_its_sequence_number_counted() {
+        use super::super::crc::crc32c;
+        let mut buf = [0u8; MAX_WIRE_LEN];
+        let mut dec = Decoder::new();
+        let mut seen = 0;
+        for seq in 0..3u16 {
+            let mut body = [0u8; MAX_BODY_LEN];
+            let n = super::super::frame::encode_body(seq, &event(0), &mut body).unwrap();
+            if seq == 1 {
+                body[1] = 0x77;
+                let crc = crc32c(&body[..n - 4]).to_le_bytes();
+                body[n - 4..n].copy_from_slice(&crc);
+            }
+            buf[0] = 0;
+            let len = cobs::try_encode(&body[..n], &mut buf[1..]).unwrap();
+            buf[len + 1] = 0;
+            dec.feed(&buf[..len + 2], |_| seen += 1);
+        }
+        let s = dec.stats();
+        assert_eq!((seen, s.unknown_kind, s.lost, s.corrupt()), (2, 1, 0, 0));
+    }
+
+    #[test]
+    fn a_station_survey_decodes_and_is_counted() {
+        let mut buf = [0u8; MAX_WIRE_LEN];
+        let station = super::super::example::station_survey();
+        let n = super::super::wire::encode_frame(5, &station, &mut buf).unwrap();
+        let mut dec = Decoder::new();
+        let mut got = None;
+        dec.feed(&buf[..n], |f| got = Some(f.payload));
+        assert_eq!(got, Some(station));
+        assert_eq!(dec.stats().frames, [0, 0, 0, 1]);
     }
 
     #[test]

@@ -3,8 +3,8 @@
 //! (`cargo run -p mwd-core --example protocol_example` prints them).
 
 use super::frame::{
-    nav_flags, nav_mode, raw_flags, Event, EventKind, NavSolution, Payload, RawPart, RawSample,
-    NO_PART,
+    nav_flags, nav_mode, raw_flags, station_flags, Event, EventKind, NavSolution, Payload, RawPart,
+    RawSample, StationSurvey, NO_PART,
 };
 use crate::earth::Position;
 
@@ -67,5 +67,27 @@ pub fn boot_event() -> Payload {
         part: NO_PART,
         code: 1,
         value: 0,
+    })
+}
+
+/// Station 3, still from sample 24000 to 27599 (20 min to 23 min after
+/// boot, 3 min of zero-velocity updates): inclination 45 deg +- 0.05,
+/// azimuth 120 deg +- 1.2, toolface 300 deg +- 0.07 (1 sigma),
+/// magnetic-free, still quality 1.02.
+pub fn station_survey() -> Payload {
+    Payload::Station(StationSurvey {
+        time_us: 1_379_950_000,
+        station: 3,
+        flags: station_flags::MAGNETIC_FREE,
+        start_sample: 24_000,
+        end_sample: 27_599,
+        angles: [
+            core::f32::consts::FRAC_PI_4,
+            2.0 * core::f32::consts::FRAC_PI_3,
+            5.0 * core::f32::consts::FRAC_PI_3,
+        ],
+        angles_std: [0.000_872_7, 0.020_944, 0.001_221_7],
+        correlations: [0.12, -0.35, 0.05],
+        still_quality: 1.02,
     })
 }

@@ -22,10 +22,21 @@ pub enum FrameKind {
     RawSample = 1,
     NavSolution = 2,
     Event = 3,
+    /// Added after the first three: a decoder that predates it skips it
+    /// as an unknown kind, its sequence number still counted
+    /// (docs/protocol.md, "Compatibility").
+    StationSurvey = 4,
 }
 
 impl FrameKind {
-    pub const ALL: [FrameKind; 3] = [Self::RawSample, Self::NavSolution, Self::Event];
+    pub const ALL: [FrameKind; 4] = [
+        Self::RawSample,
+        Self::NavSolution,
+        Self::Event,
+        Self::StationSurvey,
+    ];
+    /// Number of kinds (per-kind counters).
+    pub const COUNT: usize = Self::ALL.len();
 
     pub fn from_byte(byte: u8) -> Option<Self> {
         Self::ALL.into_iter().find(|k| *k as u8 == byte)
@@ -37,6 +48,7 @@ impl FrameKind {
             Self::RawSample => RAW_PAYLOAD_LEN,
             Self::NavSolution => NAV_PAYLOAD_LEN,
             Self::Event => EVENT_PAYLOAD_LEN,
+            Self::StationSurvey => STATION_PAYLOAD_LEN,
         }
     }
 
@@ -45,7 +57,7 @@ impl FrameKind {
         HEADER_LEN + self.payload_len() + CRC_LEN
     }
 
-    /// Index 0..3 for per-kind counters.
+    /// Index 0..COUNT for per-kind counters.
     pub const fn index(self) -> usize {
         self as usize - 1
     }
@@ -131,6 +143,63 @@ pub mod nav_flags {
     pub const COASTING: u16 = 1 << 5;
     /// One part is out: the solution rests on the other part alone.
     pub const SINGLE_PART: u16 = 1 << 6;
+    /// Navigating, the probe is still (`probe::still`): a station survey
+    /// is being taken, with a zero-velocity update each cycle (bit 0), up
+    /// to the longest station (then bit 7 alone).
+    pub const STILL: u16 = 1 << 7;
+}
+
+/// Bits of [`StationSurvey::flags`]; the rest are reserved (sent as 0).
+pub mod station_flags {
+    /// Always set: the survey uses no magnetometer (gyro and
+    /// accelerometers only), so magnetic interference cannot bias it.
+    pub const MAGNETIC_FREE: u16 = 1 << 0;
+    /// The azimuth is not determined (the same rule as the navigation
+    /// frames' azimuth sigma: no gyrocompassed heading, or one part); its
+    /// sigma is +inf and its correlations NaN.
+    pub const AZIMUTH_UNDETERMINED: u16 = 1 << 1;
+    /// The still period reached the longest station
+    /// (`probe::navigator::MAX_STATION_SAMPLES`): sent while the probe is
+    /// still still; no more zero-velocity updates and no other station
+    /// until it has moved.
+    pub const MAX_DURATION: u16 = 1 << 2;
+    /// The tool axis is within `attitude::NEAR_VERTICAL` (5 deg) of
+    /// vertical: azimuth and toolface are poorly defined (large sigmas).
+    pub const NEAR_VERTICAL: u16 = 1 << 3;
+    /// Do not use: the covariance failed its health check (sigmas NaN) or
+    /// a tilt sigma is beyond the small-angle limit (as navigation bit 4).
+    pub const SOLUTION_INVALID: u16 = 1 << 4;
+}
+
+/// A station survey (kind 4): the attitude at the end of a still period
+/// during navigation, after a zero-velocity update in each of its cycles,
+/// as drilling angles with their uncertainty (`probe::station`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StationSurvey {
+    /// Time of the last still sample (microseconds since boot).
+    pub time_us: u64,
+    /// Station number since boot, from 1.
+    pub station: u16,
+    /// [`station_flags`] bits.
+    pub flags: u16,
+    /// Sample counters of the first and last zero-velocity update of the
+    /// station (the probe had been still for `probe::still`'s detection
+    /// delay, 39 samples, before the first).
+    pub start_sample: u32,
+    pub end_sample: u32,
+    /// Inclination, azimuth, gravity toolface (rad): inclination in
+    /// [0, pi] from vertical down, azimuth and toolface in [0, 2 pi).
+    pub angles: [f32; 3],
+    /// Their 1-sigma (rad); +inf for an undetermined azimuth, NaN when the
+    /// covariance is invalid.
+    pub angles_std: [f32; 3],
+    /// Correlation coefficients inclination-azimuth,
+    /// inclination-toolface, azimuth-toolface.
+    pub correlations: [f32; 3],
+    /// The largest of the still detector's normalised statistics, averaged
+    /// over the station: about 1 for a probe that is still within its
+    /// noise, larger for a disturbed one.
+    pub still_quality: f32,
 }
 
 /// Navigation solution frame. Angles in rad, velocity in m/s (NED), position
@@ -228,6 +297,7 @@ pub enum Payload {
     Raw(RawSample),
     Nav(NavSolution),
     Event(Event),
+    Station(StationSurvey),
 }
 
 impl Payload {
@@ -236,6 +306,7 @@ impl Payload {
             Self::Raw(_) => FrameKind::RawSample,
             Self::Nav(_) => FrameKind::NavSolution,
             Self::Event(_) => FrameKind::Event,
+            Self::Station(_) => FrameKind::StationSurvey,
         }
     }
 }
@@ -254,6 +325,8 @@ pub const RAW_PAYLOAD_LEN: usize = 12 + 2 * RAW_PART_LEN;
 pub const NAV_PAYLOAD_LEN: usize = 15 + 24 + 16 + 40;
 /// time 8 + kind 1 + part 1 + code 2 + value 4.
 pub const EVENT_PAYLOAD_LEN: usize = 16;
+/// time 8 + station 2 + flags 2 + two counters 8 + 10 f32.
+pub const STATION_PAYLOAD_LEN: usize = 20 + 40;
 /// The longest body of any kind.
 pub const MAX_BODY_LEN: usize = HEADER_LEN + NAV_PAYLOAD_LEN + CRC_LEN;
 
@@ -269,6 +342,11 @@ mod tests {
         }
         assert_eq!(FrameKind::from_byte(0), None);
         assert_eq!(MAX_BODY_LEN, FrameKind::NavSolution.body_len());
+        for kind in FrameKind::ALL {
+            assert!(kind.body_len() <= MAX_BODY_LEN, "{kind:?}");
+            assert_eq!(FrameKind::ALL[kind.index()], kind);
+        }
+        assert_eq!(FrameKind::StationSurvey.body_len(), 68);
         for kind in [
             EventKind::Boot,
             EventKind::SensorFault,

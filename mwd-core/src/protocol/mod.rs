@@ -22,7 +22,7 @@ pub mod wire;
 pub use decoder::{Decoder, DecoderStats};
 pub use frame::{
     decode_body, encode_body, Event, EventKind, Frame, FrameError, FrameKind, NavSolution, Payload,
-    RawPart, RawSample, PROTOCOL_VERSION,
+    RawPart, RawSample, StationSurvey, PROTOCOL_VERSION,
 };
 pub use wire::{encode_frame, wire_len, FrameEncoder, MAX_WIRE_LEN};
 

@@ -137,3 +137,83 @@ fn boot_streaming_recovery_and_navigation_reach_the_uart_in_order() {
         assert_eq!(format!("{:?}", replay.step(raw)), format!("{nav:?}"));
     }
 }
+
+/// A still probe (the mock's constant level sample) past its alignment: it
+/// navigates, finds itself still, and at the longest station sends one
+/// station survey right after that cycle's navigation frame; a fresh
+/// navigator on the raw frames finishes the same station, bit for bit.
+#[test]
+fn a_station_survey_follows_its_navigation_frame_and_replays_identically() {
+    use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
+    use mwd_core::probe::still::DETECTION_DELAY_SAMPLES;
+    use mwd_core::protocol::frame::MAX_BODY_LEN;
+    use mwd_core::protocol::{encode_body, StationSurvey};
+    use mwd_core::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES};
+
+    use hil_mock::{MountedSource, StillProbe};
+    use mwd_core::sensor_units::PART_MOUNTINGS;
+
+    // The QEMU board's mock: a still probe with the budget's white noise
+    // and biases, each part its own noise stream.
+    let clock = SimClock::new();
+    let mocks = [0, 1].map(|i| {
+        let source = MountedSource {
+            body: StillProbe::paper_test(1 + i as u64),
+            mounting: PART_MOUNTINGS[i],
+        };
+        RefCell::new(Scc1300::new(&clock, source, 1 + i as u32))
+    });
+    let parts = [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
+    let mut delay = SimDelay::new(&clock);
+    let probe = SharedProbe::new(TestUart::default());
+    probe.announce_boot();
+    probe.start_streaming(parts, &mut delay, &mut || {});
+    let mut navigator = Navigator::new(Position::paper_site());
+    let samples = ALIGNMENT_SAMPLES
+        + FINE_ALIGNMENT_SAMPLES
+        + DETECTION_DELAY_SAMPLES
+        + MAX_STATION_SAMPLES
+        + 10;
+    let mut frames: Vec<Frame> = Vec::new();
+    let mut decoder = Decoder::new();
+    for _ in 0..samples {
+        clock.advance_ns(SAMPLE_PERIOD_NS);
+        probe.with(|shared| shared.acquire());
+        probe.main_loop_pass(&mut delay, &mut navigator, &mut || {}, |_, _| {}, |_| {});
+        drain(&probe);
+        let wire = probe.with(|shared| core::mem::take(&mut shared.transmitter_mut().wire));
+        decoder.feed(&wire, |f| frames.push(f));
+    }
+    assert_eq!((decoder.stats().corrupt(), decoder.stats().lost), (0, 0));
+    assert_eq!(decoder.stats().frames[3], 1, "{:?}", decoder.stats());
+    let at = frames
+        .iter()
+        .position(|f| matches!(f.payload, Payload::Station(_)))
+        .unwrap();
+    let (Payload::Nav(nav), Payload::Station(station)) =
+        (frames[at - 1].payload, frames[at].payload)
+    else {
+        panic!(
+            "the station follows a navigation frame: {:?}",
+            &frames[at - 2..=at]
+        );
+    };
+    assert_eq!(station.end_sample, nav.sample_counter);
+    assert_eq!(station.station, 1);
+
+    let body = |s: &StationSurvey| {
+        let mut buf = [0u8; MAX_BODY_LEN];
+        let n = encode_body(0, &Payload::Station(*s), &mut buf).unwrap();
+        buf[..n].to_vec()
+    };
+    let mut replay = Navigator::new(Position::paper_site());
+    let mut replayed = Vec::new();
+    for f in &frames {
+        if let Payload::Raw(raw) = f.payload {
+            replay.step(&raw);
+            replayed.extend(replay.take_station());
+        }
+    }
+    assert_eq!(replayed.len(), 1);
+    assert_eq!(body(&replayed[0]), body(&station));
+}
