@@ -11,7 +11,7 @@
 //! enough for its opt-level 3 code.
 //!
 //! The real board (`probe-stm32`) links with cortex-m-rt's `link.x` and that
-//! top-level `memory.x` on purpose (the probe's 128 KiB / 32 KiB budget): the
+//! top-level `memory.x` on purpose (the probe's 256 KiB / 32 KiB budget): the
 //! workspace root is put on the search path explicitly rather than relying
 //! on the linker's working directory, and `defmt.x` places defmt's tables.
 

@@ -40,4 +40,4 @@ stm32_dir="${CARGO_TARGET_DIR:-target}"
 cargo build -q -p firmware --profile probe --target "$target" --features board-stm32 --bin probe-stm32
 elf="$stm32_dir/$target/probe/probe-stm32"
 echo "== real board (arm-none-eabi-size -A $elf)"
-sizes "$elf" " of 128 KiB" " of 32 KiB"
+sizes "$elf" " of 256 KiB" " of 32 KiB"
