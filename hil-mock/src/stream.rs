@@ -154,7 +154,7 @@ pub enum StreamError {
 impl fmt::Display for StreamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Io(code) => write!(f, "the host could not read the stream (error {code})"),
+            Self::Io(code) => write!(f, "the host could not open or read it (host errno {code})"),
             Self::NoHeader => write!(f, "shorter than its {HEADER_LEN}-byte header"),
             Self::BadMagic => write!(f, "not a sensor stream (bad magic)"),
             Self::UnsupportedVersion(v) => write!(f, "stream version {v} (this reads {STREAM_VERSION})"),
