@@ -47,6 +47,4 @@ pub use source::{
 };
 pub use spi::{AccelSpi, GyroSpi, MockBusError};
 pub use still::StillProbe;
-pub use stream::{
-    StreamError, StreamHeader, StreamPlayer, StreamRead, StreamRecord, StreamSource,
-};
+pub use stream::{StreamError, StreamHeader, StreamPlayer, StreamRead, StreamRecord, StreamSource};

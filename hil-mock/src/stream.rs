@@ -40,6 +40,7 @@ pub const HEADER_LEN: usize = 20;
 /// f32 values per part in a record.
 pub const VALUES_PER_PART: usize = 5;
 pub const RECORD_LEN: usize = STREAM_PARTS * VALUES_PER_PART * 4;
+const _: () = assert!(RECORD_LEN >= HEADER_LEN);
 
 /// One record: both parts' readings at one sample.
 pub type StreamRecord = [PhysicalSample; STREAM_PARTS];
@@ -143,12 +144,18 @@ pub enum StreamError {
     /// The header says zero samples.
     Empty,
     /// The data ended inside record `index` (the header promised more).
-    Truncated { index: u32 },
+    Truncated {
+        index: u32,
+    },
     /// Record `index` holds a NaN or an infinity.
-    NotFinite { index: u32 },
+    NotFinite {
+        index: u32,
+    },
     /// Record `index` was asked for after a later one (the stream only
     /// goes forward) or beyond the stream's end.
-    OutOfOrder { index: u32 },
+    OutOfOrder {
+        index: u32,
+    },
 }
 
 impl fmt::Display for StreamError {
@@ -157,13 +164,19 @@ impl fmt::Display for StreamError {
             Self::Io(code) => write!(f, "the host could not open or read it (host errno {code})"),
             Self::NoHeader => write!(f, "shorter than its {HEADER_LEN}-byte header"),
             Self::BadMagic => write!(f, "not a sensor stream (bad magic)"),
-            Self::UnsupportedVersion(v) => write!(f, "stream version {v} (this reads {STREAM_VERSION})"),
-            Self::BadPartCount(n) => write!(f, "{n} parts per sample (the probe has {STREAM_PARTS})"),
+            Self::UnsupportedVersion(v) => {
+                write!(f, "stream version {v} (this reads {STREAM_VERSION})")
+            }
+            Self::BadPartCount(n) => {
+                write!(f, "{n} parts per sample (the probe has {STREAM_PARTS})")
+            }
             Self::BadSampleRate(r) => write!(f, "sample rate {r} Hz"),
             Self::Empty => write!(f, "the stream holds no samples"),
             Self::Truncated { index } => write!(f, "the data end inside record {index}"),
             Self::NotFinite { index } => write!(f, "record {index} holds a non-finite value"),
-            Self::OutOfOrder { index } => write!(f, "record {index} asked for out of order or beyond the end"),
+            Self::OutOfOrder { index } => {
+                write!(f, "record {index} asked for out of order or beyond the end")
+            }
         }
     }
 }
@@ -200,7 +213,8 @@ pub struct StreamPlayer<R, const N: usize> {
 impl<R: StreamRead, const N: usize> StreamPlayer<R, N> {
     /// Reads and checks the header and the first record.
     pub fn open(reader: R) -> Result<Self, StreamError> {
-        const { assert!(N >= RECORD_LEN && N >= HEADER_LEN) };
+        // A record is longer than the header: room for one is room for both.
+        const { assert!(N >= RECORD_LEN) };
         let mut player = Self {
             reader,
             buf: [0; N],
@@ -338,8 +352,14 @@ mod tests {
             player.advance_to(k).expect("in order");
             assert_eq!([player.part(0), player.part(1)], record(k));
         }
-        assert_eq!(player.advance_to(7), Err(StreamError::OutOfOrder { index: 7 }));
-        assert_eq!(player.advance_to(5), Err(StreamError::OutOfOrder { index: 5 }));
+        assert_eq!(
+            player.advance_to(7),
+            Err(StreamError::OutOfOrder { index: 7 })
+        );
+        assert_eq!(
+            player.advance_to(5),
+            Err(StreamError::OutOfOrder { index: 5 })
+        );
         let mut source = StreamSource {
             feed: |part| player.part(part),
             part: 1,
@@ -367,7 +387,10 @@ mod tests {
         let mut player =
             StreamPlayer::<_, 64>::open(&short[..HEADER_LEN + 3 * RECORD_LEN]).expect("header");
         assert_eq!(player.advance_to(2), Ok(()));
-        assert_eq!(player.advance_to(3), Err(StreamError::Truncated { index: 3 }));
+        assert_eq!(
+            player.advance_to(3),
+            Err(StreamError::Truncated { index: 3 })
+        );
         let mut nan = good;
         nan[HEADER_LEN + 4..HEADER_LEN + 8].copy_from_slice(&f32::NAN.to_le_bytes());
         assert_eq!(open(&nan), Some(StreamError::NotFinite { index: 0 }));

@@ -64,7 +64,13 @@ fn counts(p: &RawPart) -> (i16, [i16; 3], i16, i16) {
 fn simulate(dir: &Path, plan: &Path) {
     let host_sim = build_host_sim();
     let output = Command::new(&host_sim)
-        .args(["simulate", "--motion", "lateral", "--seed", &SEED.to_string()])
+        .args([
+            "simulate",
+            "--motion",
+            "lateral",
+            "--seed",
+            &SEED.to_string(),
+        ])
         .arg("--plan")
         .arg(plan)
         .arg("--sensor-stream")
@@ -170,8 +176,7 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
     assert_eq!(navs.len(), raws.len());
 
     // Every raw count is the stream's value quantised: record n <-> raw n.
-    let mut player =
-        StreamPlayer::<_, 4096>::open(&stream[..]).expect("the stream host-sim wrote");
+    let mut player = StreamPlayer::<_, 4096>::open(&stream[..]).expect("the stream host-sim wrote");
     assert_eq!(player.header().sample_count as usize, expected_samples);
     let valid = raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID;
     let mut compared = 0usize;
@@ -203,8 +208,7 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
 
     // The probe aligned during the still period at the tie-on and then
     // navigated through the drilling.
-    let aligned =
-        (timing::ALIGNMENT_SAMPLES + timing::FINE_ALIGNMENT_SAMPLES) as usize;
+    let aligned = (timing::ALIGNMENT_SAMPLES + timing::FINE_ALIGNMENT_SAMPLES) as usize;
     assert!(navs[aligned..]
         .iter()
         .all(|n| n.mode == nav_mode::NAVIGATING));
@@ -231,7 +235,11 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
     // Station surveys (frame kind 4) are not sent by this probe's
     // navigator yet: the capture must hold none, or this test must compare
     // them too (host_sim::replay's station comparison).
-    let known = [FrameKind::RawSample, FrameKind::NavSolution, FrameKind::Event];
+    let known = [
+        FrameKind::RawSample,
+        FrameKind::NavSolution,
+        FrameKind::Event,
+    ];
     let other: Vec<u8> = frames
         .iter()
         .map(|f| f.payload.kind())

@@ -74,8 +74,9 @@ impl SensorStreamWriter {
         );
         let record = part_record(s);
         anyhow::ensure!(
-            record.iter().all(|p| p.rate_rad_s.is_finite()
-                && p.accel_m_s2.iter().all(|a| a.is_finite())),
+            record
+                .iter()
+                .all(|p| p.rate_rad_s.is_finite() && p.accel_m_s2.iter().all(|a| a.is_finite())),
             "sample {} at {:.3} s is not finite: no stream record for it",
             self.written,
             s.time

@@ -217,9 +217,9 @@ pub fn inject_scheduled_faults(sample: u32) {
 }
 
 #[cfg(feature = "qemu-drilling")]
-pub use drilling::samples_to_run;
-#[cfg(feature = "qemu-drilling")]
 use drilling::part_source;
+#[cfg(feature = "qemu-drilling")]
+pub use drilling::samples_to_run;
 
 /// The drilling run's stream player, shared by both parts.
 #[cfg(feature = "qemu-drilling")]
