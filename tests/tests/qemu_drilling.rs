@@ -129,6 +129,7 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
     assert!(status.success(), "probe-qemu failed: {status}\n{stdout}");
     let uart = std::fs::read(&serial).expect("QEMU's serial capture");
     let stream = std::fs::read(dir.join("sensor-stream.bin")).expect("the stream");
+    let host_capture = std::fs::read(dir.join("host.bin")).expect("the host's capture");
     let _ = std::fs::remove_dir_all(&dir);
     eprintln!(
         "QEMU ran {:.1} simulated s in {:.1} s wall",
@@ -206,6 +207,43 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
     assert_eq!(compared, expected_samples * 2 * 6);
     eprintln!("raw counts: {compared} compared with the stream, all exact (tolerance 0 counts)");
 
+    // The same physics as the host's own capture of the run (`.bin`,
+    // quantised from the f64 samples where the stream carries f32): each
+    // count within 1 of it, most identical.
+    let host_raws: Vec<RawSample> = host_sim::capture::decode_bytes(&host_capture)
+        .frames
+        .iter()
+        .filter_map(|f| match f.payload {
+            Payload::Raw(r) => Some(r),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(host_raws.len(), raws.len());
+    let mut off_by_one = 0usize;
+    for (probe, host) in raws.iter().zip(&host_raws) {
+        for (a, b) in probe.parts.iter().zip(&host.parts) {
+            let (ga, aa, _, _) = counts(a);
+            let (gb, ab, _, _) = counts(b);
+            for (x, y) in aa.iter().chain([&ga]).zip(ab.iter().chain([&gb])) {
+                let d = (i32::from(*x) - i32::from(*y)).abs();
+                assert!(
+                    d <= 1,
+                    "sample {}: {probe:?} vs host {host:?}",
+                    probe.sample_counter
+                );
+                off_by_one += d as usize;
+            }
+        }
+    }
+    assert!(
+        off_by_one * 1000 < compared,
+        "{off_by_one} counts off by one"
+    );
+    eprintln!(
+        "host .bin: {off_by_one} of {} rate and acceleration counts differ by 1 (f64 vs f32 rounding), none by more",
+        raws.len() * 2 * 4
+    );
+
     // The probe aligned during the still period at the tie-on and then
     // navigated through the drilling.
     let aligned = (timing::ALIGNMENT_SAMPLES + timing::FINE_ALIGNMENT_SAMPLES) as usize;
@@ -252,4 +290,69 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
         other.len()
     );
     eprintln!("station frames: none in the capture, 0 checked");
+}
+
+/// Runs the drilling build in `dir` (its `sensor-stream.bin`, if any);
+/// returns whether QEMU succeeded and what the probe printed.
+fn run_in(dir: &Path, elf: &Path) -> (bool, String) {
+    let mut child = Command::new("qemu-system-arm")
+        .current_dir(dir)
+        .args(["-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-serial", "null", "-icount", "shift=0,sleep=off", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start qemu-system-arm");
+    let status = wait_or_kill(&mut child, "QEMU", QEMU_TIMEOUT);
+    let output = child.wait_with_output().expect("qemu output");
+    let text = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    (status.success(), text)
+}
+
+#[test]
+fn a_missing_or_bad_stream_ends_the_qemu_run_with_a_message() {
+    require_qemu();
+    let elf = build_firmware("qemu-drilling", "drilling");
+    let dir = std::env::temp_dir().join(format!("qemu-drilling-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let file = dir.join("sensor-stream.bin");
+    // A stream whose header promises 100 records and holds 30.
+    let header = hil_mock::StreamHeader {
+        sample_rate_hz: 20,
+        sample_count: 100,
+    };
+    let mut truncated = header.encode().to_vec();
+    for _ in 0..30 {
+        truncated.extend_from_slice(&hil_mock::stream::encode_record(&StreamRecord::default()));
+    }
+    let cases: [(&str, Option<Vec<u8>>, &str); 3] = [
+        ("missing", None, "could not open or read it"),
+        (
+            "not a stream",
+            Some(b"not a sensor stream".repeat(4)),
+            "bad magic",
+        ),
+        (
+            "truncated",
+            Some(truncated),
+            "the data end inside record 30",
+        ),
+    ];
+    for (name, content, message) in cases {
+        let _ = std::fs::remove_file(&file);
+        if let Some(bytes) = content {
+            std::fs::write(&file, bytes).expect("write the stream");
+        }
+        let (ok, text) = run_in(&dir, &elf);
+        assert!(!ok, "{name}: the run succeeded: {text}");
+        assert!(
+            text.contains(message) && text.contains("FAILED: the sensor stream could not be read"),
+            "{name}: {text}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
