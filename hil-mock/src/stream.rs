@@ -18,7 +18,8 @@
 //!
 //! then N records of 2 x 5 f32: per part (0 then 1) the rate about the
 //! part's gyro axis (rad/s), the specific force along the part's X, Y, Z
-//! (m/s^2) and the temperature (degC). A record's values must be finite.
+//! (m/s^2) and the temperature (degC). A record's values must be finite;
+//! bytes after the N-th record are not read (the count sets the run).
 //!
 //! # Timing
 //!

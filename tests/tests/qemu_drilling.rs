@@ -264,15 +264,15 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
         );
     }
     // The same through the host tool's replay (`host-sim replay`).
-    let (_, summary) = host_sim::replay::replay(&frames, Position::paper_site());
-    assert_eq!(
-        (summary.matched, summary.mismatched, summary.unchecked),
-        (navs.len() as u64, 0, 0)
-    );
-
+    let mut replayer = host_sim::replay::Replayer::new(Position::paper_site());
+    for frame in &frames {
+        replayer.push(frame);
+    }
     // Station surveys (frame kind 4) are not sent by this probe's
-    // navigator yet: the capture must hold none, or this test must compare
-    // them too (host_sim::replay's station comparison).
+    // navigator yet: the capture must hold none. With a navigator that
+    // sends them, this block becomes the replay's station comparison:
+    // `let (_, st) = replayer.stations();` then
+    // `assert_eq!((st.replayed, st.matched, st.mismatched, st.unchecked), (st.probe, st.probe, 0, 0))`.
     let known = [
         FrameKind::RawSample,
         FrameKind::NavSolution,
@@ -290,6 +290,11 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
         other.len()
     );
     eprintln!("station frames: none in the capture, 0 checked");
+    let (_, summary) = replayer.finish();
+    assert_eq!(
+        (summary.matched, summary.mismatched, summary.unchecked),
+        (navs.len() as u64, 0, 0)
+    );
 }
 
 /// Runs the drilling build in `dir` (its `sensor-stream.bin`, if any);
