@@ -21,6 +21,7 @@ cargo build -p firmware --profile probe --target thumbv7em-none-eabihf
 # The QEMU board binary, linted for its target (the end-to-end test in
 # tests/tests/qemu_probe.rs builds and runs it again on its own).
 cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features qemu-fault-demo --bin probe-qemu -- -D warnings
+cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features qemu-drilling --bin probe-qemu -- -D warnings
 cargo build -p firmware --profile probe --target thumbv7em-none-eabihf --features board-qemu --bin probe-qemu
 # The real board (STM32F411): linted and linked against the top-level
 # memory.x, so a build that outgrows the probe's budget fails here.

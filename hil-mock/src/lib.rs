@@ -35,6 +35,7 @@ pub mod part;
 pub mod source;
 pub mod spi;
 pub mod still;
+pub mod stream;
 
 pub use accel::ACCEL_SETTLE_NS;
 pub use clock::{SimClock, SimDelay, TimeSource, SAMPLE_PERIOD_NS};
@@ -46,3 +47,4 @@ pub use source::{
 };
 pub use spi::{AccelSpi, GyroSpi, MockBusError};
 pub use still::StillProbe;
+pub use stream::{StreamError, StreamHeader, StreamPlayer, StreamRead, StreamRecord, StreamSource};

@@ -5,6 +5,7 @@ use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::paper_mgwd::PUBLISHED;
 use host_sim::sim::plan::Vibration;
+use host_sim::sim::stream::SensorStreamWriter;
 use host_sim::sim::{
     DeterministicErrors, Drilling, DrillingSimulator, Motion, Plan, SensorModel, SensorModelFile,
     SensorSimulator, SimSample, Trajectory, Truth,
@@ -153,6 +154,12 @@ pub struct Args {
     /// --motion lateral: vibration level instead of the plan's.
     #[arg(long, value_enum)]
     pub vibration: Option<VibrationLevel>,
+    /// --motion lateral: also write the probe's physical input stream here
+    /// (what each part senses in its own axes, sensor errors applied; the
+    /// QEMU probe's `qemu-drilling` build reads it; format in
+    /// `hil_mock::stream`).
+    #[arg(long, value_name = "FILE")]
+    pub sensor_stream: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -188,6 +195,7 @@ pub fn run(args: Args) -> Result<()> {
         ("--truth", args.truth.is_some()),
         ("--depth-log", args.depth_log.is_some()),
         ("--vibration", args.vibration.is_some()),
+        ("--sensor-stream", args.sensor_stream.is_some()),
     ] {
         anyhow::ensure!(!given, "{flag} goes with --motion lateral");
     }
@@ -332,6 +340,10 @@ fn run_lateral(args: &Args) -> Result<()> {
         }
         None => None,
     };
+    let mut stream = match &args.sensor_stream {
+        Some(p) => Some(SensorStreamWriter::create(p, n)?),
+        None => None,
+    };
     let mut counts = Counts::default();
     let mut failure: Option<anyhow::Error> = None;
     let every = args.truth_every as usize;
@@ -345,6 +357,11 @@ fn run_lateral(args: &Args) -> Result<()> {
                     if let Err(e) = w.row(&d.truth) {
                         failure.get_or_insert(e);
                     }
+                }
+            }
+            if let Some(w) = stream.as_mut() {
+                if let Err(e) = w.push(&d.sample) {
+                    failure.get_or_insert(e);
                 }
             }
             d.sample
@@ -369,6 +386,9 @@ fn run_lateral(args: &Args) -> Result<()> {
         return Err(e);
     }
     if let Some(w) = truth_out {
+        w.finish()?;
+    }
+    if let Some(w) = stream {
         w.finish()?;
     }
     if let Some(p) = &args.depth_log {

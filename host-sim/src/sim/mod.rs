@@ -5,6 +5,7 @@ pub mod drilling;
 pub mod model_file;
 pub mod plan;
 pub mod sensor;
+pub mod stream;
 pub mod trajectory;
 
 pub use drilling::{DrillSample, DrillState, Drilling, DrillingSimulator, Truth};

@@ -16,7 +16,9 @@
 //!
 //! The run ends after `PROBE_QEMU_RUN_SECONDS` simulated seconds (a
 //! compile-time setting, default 60): the queue is drained, a summary is
-//! printed through semihosting, and QEMU exits with success.
+//! printed through semihosting, and QEMU exits with success. The drilling
+//! run (feature `qemu-drilling`, `mock_sensors.rs`) lasts as its sensor
+//! stream.
 #![no_std]
 #![no_main]
 #![deny(unsafe_code)]
@@ -25,6 +27,8 @@ mod exit;
 mod mock_sensors;
 mod registers;
 mod stack_paint;
+#[cfg(feature = "qemu-drilling")]
+mod stream_file;
 
 use core::sync::atomic::Ordering;
 
@@ -42,6 +46,7 @@ use registers::SYSTEM_CLOCK_HZ;
 
 /// Simulated seconds of streaming before the probe exits.
 const RUN_SECONDS: u32 = parse_seconds(option_env!("PROBE_QEMU_RUN_SECONDS"), 60);
+#[cfg_attr(feature = "qemu-drilling", allow(dead_code))]
 const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
 /// The sample rate, for counting seconds in samples.
 const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
@@ -100,11 +105,11 @@ fn SysTick() {
         // The run length is counted here, so the last sample is exact
         // whatever the main loop is doing.
         let samples = shared.probe().cycle().samples();
-        if samples >= SAMPLES_TO_RUN {
+        if samples >= mock_sensors::samples_to_run() {
             return;
         }
         if shared.probe().is_streaming() {
-            mock_sensors::inject_scheduled_faults(samples);
+            mock_sensors::before_sample(samples);
         }
         shared.acquire();
     });
@@ -188,7 +193,7 @@ fn main() -> ! {
             let done = p.queue().is_empty() && !s.transmitter().busy && p.nav_inbox().is_empty();
             (p.cycle().samples(), done)
         });
-        if samples >= SAMPLES_TO_RUN && idle {
+        if samples >= mock_sensors::samples_to_run() && idle {
             exit::finish(&summary(&cost));
         }
         // The cycle's work is done: SysTick counts since the period began

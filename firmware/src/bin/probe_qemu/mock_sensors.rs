@@ -4,6 +4,11 @@
 //! The parts read the board's time (whole 20 Hz timer periods), so their
 //! 800 ms start-up and any timed fault follow the same clock as the
 //! samples, and a run repeats exactly.
+//!
+//! The drilling run (feature `qemu-drilling`) feeds both parts from a
+//! simulated sensor stream read through semihosting (`stream_file.rs`,
+//! `hil_mock::stream`): raw sample `n` quantises the stream's record `n`,
+//! and the run ends with the stream.
 
 use core::cell::{OnceCell, RefCell};
 use core::sync::atomic::{AtomicU32, Ordering};
@@ -13,9 +18,12 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::scc1300::Part;
 use hil_mock::{
-    AccelSpi, Chance, GyroSpi, MockBusError, MountedSource, Scc1300, StillProbe,
-    TemperatureExcursion, TimeSource, Window, SAMPLE_PERIOD_NS,
+    AccelSpi, Chance, GyroSpi, MockBusError, Scc1300, TemperatureExcursion, TimeSource, Window,
+    SAMPLE_PERIOD_NS,
 };
+#[cfg(not(feature = "qemu-drilling"))]
+use hil_mock::{MountedSource, StillProbe};
+#[cfg(not(feature = "qemu-drilling"))]
 use mwd_core::sensor_units::PART_MOUNTINGS;
 
 use crate::SAMPLES_PER_SECOND;
@@ -50,7 +58,13 @@ impl DelayNs for TickDelay {
 /// The parts sense a probe lying still at the MGWD paper's site and
 /// attitude, with earth rate, gravity, residual biases and white noise
 /// (`hil_mock::StillProbe`); each part has its own noise stream.
-type MockPart = Scc1300<BoardClock, MountedSource<StillProbe>>;
+#[cfg(not(feature = "qemu-drilling"))]
+type PartSource = MountedSource<StillProbe>;
+/// The drilling run: each part reads its values of the stream's current
+/// record (already in its own axes, sensor errors applied by the host).
+#[cfg(feature = "qemu-drilling")]
+type PartSource = hil_mock::StreamSource<fn(usize) -> hil_mock::PhysicalSample>;
+type MockPart = Scc1300<BoardClock, PartSource>;
 
 /// The two simulated parts; set once at boot, then used from whichever
 /// context (timer interrupt or main loop) holds the driver.
@@ -93,14 +107,36 @@ impl SpiDevice for MockBus {
 /// The probe's two parts, as the driver sees them.
 pub type Sensors = firmware::app::Sensors<MockBus, MockBus>;
 
+/// The parts' source: the still probe, each part its own noise stream.
+#[cfg(not(feature = "qemu-drilling"))]
+fn part_source(index: usize) -> PartSource {
+    MountedSource {
+        body: StillProbe::paper_test(1 + index as u64),
+        mounting: PART_MOUNTINGS[index],
+    }
+}
+
+/// How many samples the run streams.
+#[cfg(not(feature = "qemu-drilling"))]
+pub fn samples_to_run() -> u32 {
+    crate::SAMPLES_TO_RUN
+}
+
+/// Called by the timer just before it takes raw sample `sample` (counted
+/// from the start of streaming).
+pub fn before_sample(sample: u32) {
+    inject_scheduled_faults(sample);
+    #[cfg(feature = "qemu-drilling")]
+    drilling::select(sample);
+}
+
 /// Powers the simulated parts up (now) and returns their drivers.
 pub fn power_up() -> Sensors {
+    #[cfg(feature = "qemu-drilling")]
+    drilling::open();
     critical_section::with(|cs| {
         for (index, cell) in PARTS.borrow(cs).iter().enumerate() {
-            let source = MountedSource {
-                body: StillProbe::paper_test(1 + index as u64),
-                mounting: PART_MOUNTINGS[index],
-            };
+            let source = part_source(index);
             // Already set only if called twice; keep the first parts then.
             let _ = cell.set(RefCell::new(Scc1300::new(
                 BoardClock,
@@ -178,4 +214,87 @@ pub fn inject_scheduled_faults(sample: u32) {
             _ => {}
         }
     });
+}
+
+#[cfg(feature = "qemu-drilling")]
+use drilling::part_source;
+#[cfg(feature = "qemu-drilling")]
+pub use drilling::samples_to_run;
+
+/// The drilling run's stream player, shared by both parts.
+#[cfg(feature = "qemu-drilling")]
+mod drilling {
+    use core::cell::RefCell;
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use cortex_m_semihosting::hprintln;
+    use critical_section::Mutex;
+    use hil_mock::{PhysicalSample, StreamError, StreamPlayer, StreamSource};
+
+    use super::PartSource;
+    use crate::stream_file::{self, HostFile};
+
+    /// The player's read buffer: 12 records (480 bytes), one semihosting
+    /// read per 0.6 s of samples. RAM: the buffer plus ~70 bytes of state
+    /// (the probe's 32 KiB budget, docs/budgets.md).
+    const BUFFER_LEN: usize = 12 * hil_mock::stream::RECORD_LEN;
+
+    type Player = StreamPlayer<HostFile, BUFFER_LEN>;
+
+    static PLAYER: Mutex<RefCell<Option<Player>>> = Mutex::new(RefCell::new(None));
+    /// The stream's length in samples: the run's length. Until the stream
+    /// is open, no limit.
+    static SAMPLES: AtomicU32 = AtomicU32::new(u32::MAX);
+
+    pub fn samples_to_run() -> u32 {
+        SAMPLES.load(Ordering::Relaxed)
+    }
+
+    fn fail(error: StreamError) -> ! {
+        hprintln!(
+            "probe-qemu: sensor stream {}: {}",
+            stream_file::path(),
+            error
+        );
+        crate::exit::fail("the sensor stream could not be read")
+    }
+
+    /// Opens the stream (its header and first record) or ends the run.
+    pub fn open() {
+        let player = match HostFile::open().and_then(Player::open) {
+            Ok(player) => player,
+            Err(e) => fail(e),
+        };
+        SAMPLES.store(player.header().sample_count, Ordering::Relaxed);
+        critical_section::with(|cs| *PLAYER.borrow_ref_mut(cs) = Some(player));
+    }
+
+    /// Makes record `sample` current (the timer never asks beyond the
+    /// stream's length: the run ends there).
+    pub fn select(sample: u32) {
+        let result = critical_section::with(|cs| match PLAYER.borrow_ref_mut(cs).as_mut() {
+            Some(player) => player.advance_to(sample),
+            None => Ok(()),
+        });
+        if let Err(e) = result {
+            fail(e);
+        }
+    }
+
+    /// Part `part`'s value in the current record.
+    fn feed(part: usize) -> PhysicalSample {
+        critical_section::with(|cs| {
+            PLAYER
+                .borrow_ref(cs)
+                .as_ref()
+                .map_or_else(PhysicalSample::default, |p| p.part(part))
+        })
+    }
+
+    pub fn part_source(index: usize) -> PartSource {
+        StreamSource {
+            feed: feed as fn(usize) -> PhysicalSample,
+            part: index,
+        }
+    }
 }
