@@ -125,7 +125,8 @@ fn scc1300_lateral_heading_north_is_undetermined_first_order() {
         run.stdout
     );
     assert!(
-        run.stdout.contains("single-station azimuth sigma 31.5 deg > 10.00 deg"),
+        run.stdout
+            .contains("single-station azimuth sigma 31.5 deg > 10.00 deg"),
         "{}",
         run.stdout
     );
@@ -281,7 +282,11 @@ fn error_model_file_bad_inputs() {
     let header = good.lines().next().unwrap().to_string() + "\n";
     let cases: [(&str, Option<String>, &str); 5] = [
         ("missing.csv", None, "No such file"),
-        ("not-a-table.csv", Some("md_m,inc_deg,azi_deg\n0,0,0\n".into()), "no column"),
+        (
+            "not-a-table.csv",
+            Some("md_m,inc_deg,azi_deg\n0,0,0\n".into()),
+            "no column",
+        ),
         ("unknown.csv", Some(unknown), "not implemented: PRB-NOSUCH"),
         ("magnitude.csv", Some(magnitude), "Magnitude"),
         ("empty.csv", Some(header), "no terms"),
@@ -308,7 +313,11 @@ fn error_model_file_bad_inputs() {
         s(&table),
     ]);
     assert_eq!(both.code, Some(2), "{}", both.stderr);
-    assert!(both.stderr.contains("cannot be used with"), "{}", both.stderr);
+    assert!(
+        both.stderr.contains("cannot be used with"),
+        "{}",
+        both.stderr
+    );
 }
 
 /// The model is among the names `--error-model` lists (the message of an

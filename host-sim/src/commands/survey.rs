@@ -79,7 +79,8 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_east: f64,
     /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS",
-    /// "PROBE-SCC1300" (this probe, valid through 90 deg).
+    /// "PROBE-SCC1300" (this probe, through 90 deg; at the SCC1300's noise
+    /// every station is beyond its first-order limit: docs/probe-tool-model.md).
     #[arg(long)]
     pub error_model: Option<String>,
     /// Error model from a term table (CSV in the format of host-sim/data/,

@@ -357,7 +357,11 @@ mod tests {
                 }
             }
         }
-        assert!((smallest.to_degrees() - 20.79).abs() < 0.01, "{}", smallest.to_degrees());
+        assert!(
+            (smallest.to_degrees() - 20.79).abs() < 0.01,
+            "{}",
+            smallest.to_degrees()
+        );
     }
 
     /// The gyro grade that passes (docs/probe-tool-model.md): a lateral at

@@ -374,7 +374,7 @@ impl Validity {
                 )?;
                 let limit = pw::first_order_azimuth_limit(inc, azi);
                 // NaN (a NaN magnitude) fails the test too: not valid
-                (!(sigma <= limit)).then(|| {
+                (sigma.is_nan() || sigma > limit).then(|| {
                     format!(
                         "leaves the azimuth undetermined at inclination {:.2} deg, azimuth {:.2} deg \
                          (first-order model not valid: single-station azimuth sigma {:.1} deg > {:.2} deg, \
@@ -426,7 +426,9 @@ pub const MODELS: [KnownModel; 4] = [
         validity: Validity::MaxInclination(89.0),
         magnetic: false,
     },
-    // this probe (docs/probe-tool-model.md): valid through 90 deg
+    // this probe (docs/probe-tool-model.md): through 90 deg, but only
+    // where one station's first-order azimuth sigma is within the limit
+    // (never for the SCC1300 at 120 s stations)
     KnownModel {
         name: "PROBE-SCC1300",
         table: include_str!("../../data/probe_scc1300_terms.csv"),
@@ -486,8 +488,7 @@ pub fn file_validity(terms: &[ErrorTerm]) -> Validity {
 /// run, and the outputs refer to it as to the embedded ones).
 pub fn model_from_file(path: &std::path::Path) -> Result<&'static KnownModel> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("error model file {name}"))?;
+    let text = std::fs::read_to_string(path).with_context(|| format!("error model file {name}"))?;
     let terms = survey_error::parse_term_table(&text, &name)
         .map_err(|e| anyhow!("error model file {name}: {e}"))?;
     if let Some(t) = terms.iter().find(|t| !t.magnitude_si.is_finite()) {
@@ -653,7 +654,10 @@ mod tests {
                 assert!(inv.reason.contains("first-order model not valid"));
                 assert!(rows.iter().all(|r| r.cov.is_none()));
                 // a gyro 100 times better passes
-                for t in terms.iter_mut().filter(|t| t.weighting.starts_with("PRB-G")) {
+                for t in terms
+                    .iter_mut()
+                    .filter(|t| t.weighting.starts_with("PRB-G"))
+                {
                     t.magnitude_si *= 0.01;
                 }
             }
