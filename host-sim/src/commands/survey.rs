@@ -79,9 +79,17 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_east: f64,
     /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS",
-    /// "PROBE-SCC1300" (this probe, valid through 90 deg).
+    /// "PROBE-SCC1300" (this probe, through 90 deg; at the SCC1300's noise
+    /// every station is beyond its first-order limit: docs/probe-tool-model.md).
     #[arg(long)]
     pub error_model: Option<String>,
+    /// Error model from a term table (CSV in the format of host-sim/data/,
+    /// e.g. the probe's table with another gyro's magnitudes). Validity:
+    /// the probe's rule (azimuth sensitivity and first-order azimuth sigma
+    /// limit, docs/probe-tool-model.md) if it has PRB-G* gyro terms, 89 deg
+    /// inclination if it has GXY-* terms, else none. Not with --error-model.
+    #[arg(long, conflicts_with = "error_model")]
+    pub error_model_file: Option<PathBuf>,
     /// Total magnetic field, nT (magnetic models).
     #[arg(long, value_parser = b_total_nt)]
     pub b_total_nt: Option<f64>,
@@ -135,7 +143,8 @@ pub struct OffsetArgs {
     /// East of the offset's tie-on (file's unit, true north).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
     pub offset_tie_on_east: f64,
-    /// Error model of the offset well (default: --error-model).
+    /// Error model of the offset well (default: --error-model or
+    /// --error-model-file).
     #[arg(long)]
     pub offset_error_model: Option<String>,
     /// Open-hole radius of the reference well, m (needed with --offset).
@@ -224,11 +233,14 @@ fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
     };
     let vsec = args.vsec_azimuth_deg.map(f64::to_radians);
     let (mut rows, direction) = listing::compute(file, reference, tie, vsec)?;
-    let model = args
-        .error_model
-        .as_deref()
-        .map(listing::model)
-        .transpose()?;
+    let model = match &args.error_model_file {
+        Some(path) => Some(listing::model_from_file(path)?),
+        None => args
+            .error_model
+            .as_deref()
+            .map(listing::model)
+            .transpose()?,
+    };
     let mut invalid_from = None;
     if let Some(m) = model {
         let terms = listing::terms(m)?;
@@ -272,12 +284,11 @@ fn offset(args: &Args, path: &Path, reference: &StationFile, s: &Survey) -> Resu
     };
     let (mut rows, _) = listing::compute(&file, reference_azimuths, tie, None)
         .with_context(|| format!("offset well {}", path.display()))?;
-    let name = args
-        .sep
-        .offset_error_model
-        .as_deref()
-        .or(args.error_model.as_deref());
-    let model = name.map(listing::model).transpose()?;
+    // default: the reference well's model (named or from a file)
+    let model = match args.sep.offset_error_model.as_deref() {
+        Some(name) => Some(listing::model(name)?),
+        None => s.model,
+    };
     if let Some(m) = model {
         let terms = listing::terms(m)?;
         listing::apply_model(&mut rows, m, &terms, &model_site(args, m)?)

@@ -323,4 +323,67 @@ mod tests {
             }
         }
     }
+
+    /// The SCC1300 at one 120 s station is beyond the first-order limit
+    /// everywhere: the smallest single-station azimuth sigma (equator,
+    /// S = 1, toolface known) is sqrt(5.04^2 + 2.1^2) / 15.04 deg/h = 0.36
+    /// rad = 20.8 deg > 10 deg. Checked over latitude 0-80 deg, every
+    /// inclination and azimuth (10 deg steps, where determined), with and
+    /// without a toolface.
+    #[test]
+    fn scc1300_single_station_sigma_is_beyond_the_first_order_limit_everywhere() {
+        use super::super::probe_weighting as pw;
+        let mags: std::collections::BTreeMap<_, _> = sensor_term_magnitudes().into_iter().collect();
+        let per_h = |x: f64| x.to_radians() / 3600.0;
+        let e = pw::GyroErrors {
+            noise: per_h(mags["PRB-GN"]),
+            bias_x: per_h(mags["PRB-GXB"]),
+            bias_z: per_h(mags["PRB-GZB"]),
+        };
+        let mut smallest = f64::INFINITY;
+        for lat in (0..=80).step_by(10) {
+            for inc in (0..=180).step_by(10) {
+                for azi in (0..360).step_by(10) {
+                    for tf in [None, Some(0.0), Some(1.0), Some(2.5)] {
+                        let (i, a) = (f64::from(inc).to_radians(), f64::from(azi).to_radians());
+                        let lat = f64::from(lat).to_radians();
+                        let Some(sigma) = pw::single_station_azimuth_sigma(i, a, tf, lat, 1.0, &e)
+                        else {
+                            continue;
+                        };
+                        assert!(sigma > pw::first_order_azimuth_limit(i, a));
+                        smallest = smallest.min(sigma);
+                    }
+                }
+            }
+        }
+        assert!(
+            (smallest.to_degrees() - 20.79).abs() < 0.01,
+            "{}",
+            smallest.to_degrees()
+        );
+    }
+
+    /// The gyro grade that passes (docs/probe-tool-model.md): a lateral at
+    /// 90 deg heading north at 45 deg latitude, no toolface, is determined
+    /// iff sqrt(N^2 + 2 B^2) <= 10 deg x 10.636 deg/h = 1.856 deg/h.
+    #[test]
+    fn gyro_grade_that_passes_heading_north_at_45_deg() {
+        use super::super::probe_weighting as pw;
+        let per_h = |x: f64| x.to_radians() / 3600.0;
+        let (inc, azi, lat) = (90_f64.to_radians(), 0.0, 45_f64.to_radians());
+        let limit = pw::first_order_azimuth_limit(inc, azi);
+        assert_eq!(limit, 10_f64.to_radians());
+        for (noise, bias) in [(1.856, 0.0), (1.716, 0.5), (1.202, 1.0), (0.0, 1.3125)] {
+            for (k, passes) in [(0.995, true), (1.005, false)] {
+                let e = pw::GyroErrors {
+                    noise: per_h(noise * k),
+                    bias_x: per_h(bias * k),
+                    bias_z: per_h(bias * k),
+                };
+                let sigma = pw::single_station_azimuth_sigma(inc, azi, None, lat, 1.0, &e).unwrap();
+                assert_eq!(sigma <= limit, passes, "N {noise} B {bias} x {k}");
+            }
+        }
+    }
 }
