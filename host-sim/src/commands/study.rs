@@ -45,6 +45,10 @@ pub struct CoverageArgs {
     /// probe does not flag still (for a navigator without its own).
     #[arg(long)]
     pub host_nhc: bool,
+    /// Run the probe without the calibration of the simulated parts'
+    /// deterministic errors (as `simulate`'s captures and the QEMU probe).
+    #[arg(long)]
+    pub uncalibrated: bool,
     /// Write the summary here (JSON).
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -75,6 +79,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
         depth_sigma,
         host_nhc: args.host_nhc,
+        uncalibrated: args.uncalibrated,
         terms,
         site: Site {
             gravity: 9.806_65,
@@ -104,13 +109,18 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     );
     bar.finish_and_clear();
     outln!(
-        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads{})",
+        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads{}{})",
         args.plan.display(),
         args.runs,
         args.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
-        if args.host_nhc { ", host NHC" } else { "" }
+        if args.host_nhc { ", host NHC" } else { "" },
+        if args.uncalibrated {
+            ", uncalibrated"
+        } else {
+            ""
+        }
     );
     out!("{}", table(&summary));
     if let Some(path) = &args.json {

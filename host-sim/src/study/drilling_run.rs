@@ -31,6 +31,11 @@ pub struct RunConfig {
     /// Call `Navigator::apply_non_holonomic` after every solution the probe
     /// does not flag still (for a navigator that does not do it itself).
     pub host_nhc: bool,
+    /// Run the navigator without the calibration that removes the
+    /// simulated parts' deterministic errors (as the QEMU probe and
+    /// `simulate`'s captures run); default: calibrated, as a probe in a
+    /// well is (residual errors: the noise model's).
+    pub uncalibrated: bool,
     pub terms: Vec<ErrorTerm>,
     pub site: Site,
 }
@@ -105,7 +110,11 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let drilling = Drilling::new(plan, seed);
     let site = drilling.truth(0.0).position;
     let model = SensorModel::scc1300(seed);
-    let mut navigator = Navigator::new(site);
+    let mut navigator = if config.uncalibrated {
+        Navigator::new(site)
+    } else {
+        Navigator::with_calibration(site, model.deterministic.calibration())
+    };
     let mut tied = false;
     let mut stations = Vec::new();
     let mut samples = 0;
@@ -146,7 +155,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         .map(|st| {
             let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
             let a = st.angles.map(f64::from);
-            StationCheck {
+            let c = StationCheck {
                 survey: *st,
                 error: [
                     a[0] - truth.point.inclination,
@@ -154,7 +163,8 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
                     wrap_pi(a[2] - truth.toolface),
                 ],
                 truth_md: truth.md,
-            }
+            };
+            c
         })
         .collect();
     let depth = DepthLog::new(drilling.depth_log())?;
