@@ -155,7 +155,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         .map(|st| {
             let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
             let a = st.angles.map(f64::from);
-            let c = StationCheck {
+            StationCheck {
                 survey: *st,
                 error: [
                     a[0] - truth.point.inclination,
@@ -163,8 +163,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
                     wrap_pi(a[2] - truth.toolface),
                 ],
                 truth_md: truth.md,
-            };
-            c
+            }
         })
         .collect();
     let depth = DepthLog::new(drilling.depth_log())?;
@@ -214,7 +213,8 @@ fn td_check(
     ];
     let (nn, ee, ne) = (c[0], c[1], c[3]);
     let det = nn * ee - ne * ne;
-    if !(det > 0.0) {
+    // also catches NaN
+    if det.is_nan() || det <= 0.0 {
         return (None, Some("TD covariance singular".into()));
     }
     let d2 = (ee * e[0] * e[0] - 2.0 * ne * e[0] * e[1] + nn * e[1] * e[1]) / det;

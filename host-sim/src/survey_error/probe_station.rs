@@ -249,7 +249,7 @@ mod tests {
         // azimuth north, horizontal: the error is east, L sigma at TD
         let st = straight(5, 25.0, 90.0, 0.0);
         let s = 0.01;
-        let c = angle_covariance(&st, &vec![sigma(0.0, s); 5]).unwrap();
+        let c = angle_covariance(&st, &[sigma(0.0, s); 5]).unwrap();
         let last = c[4];
         assert!((last[1].sqrt() - 100.0 * s).abs() < 1e-9, "{last:?}");
         assert!(last[0].abs() < 1e-18 && last[2].abs() < 1e-18);
@@ -277,7 +277,7 @@ mod tests {
     #[test]
     fn random_inclination_errors_add_in_quadrature_and_a_correlation_couples_them() {
         let st = straight(3, 10.0, 90.0, 0.0);
-        let c = angle_covariance(&st, &vec![sigma(0.001, 0.0); 3]).unwrap();
+        let c = angle_covariance(&st, &[sigma(0.001, 0.0); 3]).unwrap();
         // vertical: dr/dI = -sin I = -1 per unit length; h = 5, 10, 5
         let var = 0.001f64.powi(2) * (25.0 + 100.0 + 25.0);
         assert!((c[2][2] - var).abs() < 1e-15);
