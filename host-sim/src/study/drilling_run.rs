@@ -4,17 +4,19 @@
 //! `host-sim survey CAPTURE --depth` does ([`crate::survey_listing::drilling`]).
 
 use crate::capture::{raw_sample_from_si, SiSample};
-use crate::sim::{BuiltPlan, Drilling, DrillingSimulator, SensorModel};
+use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey_error::{ErrorTerm, Site};
 use crate::survey_listing::depth_log::DepthLog;
 use crate::survey_listing::drilling::{self, DrillingSurvey};
 use crate::survey_listing::TieOnInput;
 use anyhow::{anyhow, Context, Result};
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
+use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::{Navigator, TieIn};
 use mwd_core::protocol::frame::nav_flags;
-use mwd_core::protocol::StationSurvey;
+use mwd_core::protocol::{RawSample, StationSurvey};
 use mwd_core::timing::SAMPLE_INTERVAL_S;
+use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -95,6 +97,18 @@ fn tie_in(
     TieIn::new(angles, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
 }
 
+/// The raw frame of sample `index` of measured body rates and force (both
+/// parts' triads see the same force, as `capture::write_simulated_probe`).
+fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Result<RawSample> {
+    let force = [accel.x, accel.y, accel.z];
+    Ok(raw_sample_from_si(&SiSample {
+        index: u32::try_from(index).context("more than 2^32 samples")?,
+        gyro_body_xz_rad_s: [gyro.x, gyro.z],
+        accel_body_m_s2: [force, force],
+        temperature_degc: 25.0,
+    }))
+}
+
 /// Runs seed `seed`.
 pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x57D7_0000_0000_0013);
@@ -118,18 +132,18 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let mut tied = false;
     let mut stations = Vec::new();
     let mut samples = 0;
-    let sim = DrillingSimulator::new(&drilling, model, SAMPLE_INTERVAL_S);
+    let sim = DrillingSimulator::new(&drilling, model.clone(), SAMPLE_INTERVAL_S);
+    // the last sample's true means and whether the run ends still
+    let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        let accel = [s.accel.x, s.accel.y, s.accel.z];
-        let raw = raw_sample_from_si(&SiSample {
-            index: u32::try_from(index).context("more than 2^32 samples")?,
-            gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
-            accel_body_m_s2: [accel, accel],
-            temperature_degc: 25.0,
-        });
-        let solution = navigator.step(&raw);
+        let solution = navigator.step(&raw(index, &s.gyro, &s.accel)?);
         samples += 1;
+        last = Some((
+            s.true_rate,
+            s.true_accel,
+            d.truth.state == DrillState::Still,
+        ));
         if !tied && navigator.is_navigating() {
             // levelled and still at the window: the tie-in replaces the
             // gyrocompass azimuth
@@ -150,6 +164,25 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
             navigator.apply_non_holonomic();
         }
     }
+    // The run ends still at TD, where the probe sends its station when the
+    // string next moves or at its longest station: the still goes on (the
+    // same true means, fresh sensor noise) until the station comes out.
+    let run_samples = samples;
+    if let Some((rate, accel, true)) = last {
+        let mut tail = SensorErrors::new(SensorModel {
+            seed: seed ^ 0x7A11_0000_0000_0001,
+            ..model
+        });
+        for k in 0..MAX_STATION_SAMPLES as usize {
+            let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
+            navigator.step(&raw(run_samples + k, &gyro, &force)?);
+            samples += 1;
+            if let Some(station) = navigator.take_station() {
+                stations.push(station);
+                break;
+            }
+        }
+    }
     let checks: Vec<StationCheck> = stations
         .iter()
         .map(|st| {
@@ -166,7 +199,14 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
             }
         })
         .collect();
-    let depth = DepthLog::new(drilling.depth_log())?;
+    // the log goes on through the extended still, at the last MD
+    let log: Vec<(f64, f64)> = drilling.depth_log().collect();
+    let end = samples as f64 * SAMPLE_INTERVAL_S;
+    let tail = log
+        .last()
+        .filter(|(t, _)| *t < end)
+        .map(|&(_, md)| (end, md));
+    let depth = DepthLog::new(log.into_iter().chain(tail))?;
     let tie = TieOnInput {
         md: Some(tie_on.md()),
         tvd: tie_on.nev().z,
