@@ -11,5 +11,6 @@ pub mod paper_mgwd;
 pub mod replay;
 pub mod samples_csv;
 pub mod sim;
+pub mod study;
 pub mod survey_error;
 pub mod survey_listing;

@@ -27,7 +27,9 @@ mod paper_mgwd;
 mod replay;
 mod simulate;
 mod site;
+mod study;
 mod survey;
+mod survey_capture;
 
 #[derive(Parser, Debug)]
 #[command(name = "host-sim", version, about = "Host tool of the gyro MWD probe")]
@@ -61,6 +63,9 @@ pub enum Command {
     /// Survey stations (CSV): positions by minimum curvature, ISCWSA
     /// uncertainty and error ellipses; listing, CSV, JSON, WITSML exports.
     Survey(survey::Args),
+    /// Monte Carlo studies over simulated runs.
+    #[command(subcommand)]
+    Study(study::StudyCommand),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
@@ -110,6 +115,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Calibrate(args) => done(calibrate::run(args)),
         Command::Observability(args) => done(observability::run(args)),
         Command::Survey(args) => done(survey::run(args)),
+        Command::Study(cmd) => done(study::run(cmd)),
         Command::Paper(cmd) => done(paper::run(cmd)),
     }
 }

@@ -56,8 +56,12 @@ fn confidence(text: &str) -> Result<f64, String> {
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Station CSV: header with md_m (or md_ft), inc_deg, azi_deg; optional
-    /// toolface_deg, time_s.
+    /// toolface_deg, time_s. With --depth: a probe capture (.bin) whose
+    /// station surveys are listed (docs/drilling-survey.md).
     pub stations: PathBuf,
+    /// The capture's options (boxed, as `sep`).
+    #[command(flatten)]
+    pub capture: Box<super::survey_capture::CaptureArgs>,
     #[command(flatten)]
     pub site: SiteArgs,
     /// North reference of the azimuths (grid: give --convergence-deg).
@@ -197,6 +201,9 @@ pub fn run(args: Args) -> Result<()> {
         if let Some((flag, _)) = given.iter().find(|g| g.1) {
             bail!("{flag} needs --offset (an offset well)");
         }
+    }
+    if args.capture.depth.is_some() {
+        return super::survey_capture::run(&args);
     }
     if let Some(dir) = &args.plot {
         // refused before any work: a file in the way is the user's mistake

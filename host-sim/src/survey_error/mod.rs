@@ -88,6 +88,7 @@ pub struct ErrorTerm {
 }
 
 pub mod probe_model;
+pub mod probe_station;
 pub mod probe_weighting;
 #[cfg(test)]
 mod tests;

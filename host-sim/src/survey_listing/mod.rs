@@ -8,6 +8,9 @@
 //! `azi_deg` required; `toolface_deg`, `time_s` optional (carried to the
 //! outputs). Outputs are in metres whatever the input unit.
 
+pub mod depth_log;
+pub mod drilling;
+pub mod drilling_text;
 pub mod ellipse;
 pub mod plot;
 pub mod separation;

@@ -1,0 +1,131 @@
+//! `host-sim study drilling-coverage`: the coverage study of the probe's
+//! station sigmas over seeded simulated laterals (docs/drilling-survey.md).
+
+use super::limits::number_in;
+use anyhow::{Context, Result};
+use host_sim::sim::plan::Vibration;
+use host_sim::sim::Plan;
+use host_sim::study::drilling_coverage::{study, table};
+use host_sim::study::drilling_run::RunConfig;
+use host_sim::survey_error::Site;
+use host_sim::survey_listing::drilling::depth_terms;
+use std::path::PathBuf;
+
+#[derive(clap::Subcommand, Debug)]
+pub enum StudyCommand {
+    /// Seeded runs of a simulated lateral: do the probe's station sigmas
+    /// and the survey's TD ellipse cover the errors?
+    DrillingCoverage(CoverageArgs),
+}
+
+fn azimuth_sigma_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the tie-in azimuth sigma", (0.001, 30.0), "deg")
+}
+
+#[derive(clap::Args, Debug)]
+pub struct CoverageArgs {
+    /// Well plan (JSON, docs/drilling-simulation.md).
+    #[arg(long, default_value = "host-sim/data/plans/lateral-100m.json")]
+    pub plan: PathBuf,
+    /// Number of runs (seeds first-seed, first-seed + 1, ...).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub runs: u64,
+    #[arg(long, default_value_t = 1)]
+    pub first_seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+    /// 1-sigma of the parent well's azimuth at the tie-in, deg.
+    #[arg(long, default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
+    pub tie_in_azimuth_sigma_deg: f64,
+    /// Vibration level instead of the plan's.
+    #[arg(long, value_enum)]
+    pub vibration: Option<super::simulate::VibrationLevel>,
+    /// Apply a non-holonomic update from the host after every solution the
+    /// probe does not flag still (for a navigator without its own).
+    #[arg(long)]
+    pub host_nhc: bool,
+    /// Run the probe without the calibration of the simulated parts'
+    /// deterministic errors (as `simulate`'s captures and the QEMU probe).
+    #[arg(long)]
+    pub uncalibrated: bool,
+    /// Write the summary here (JSON).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn run(cmd: StudyCommand) -> Result<()> {
+    let StudyCommand::DrillingCoverage(args) = cmd;
+    let mut plan = Plan::load(&args.plan)?;
+    if let Some(level) = args.vibration {
+        use super::simulate::VibrationLevel as V;
+        plan.drilling.vibration = match level {
+            V::None => Vibration::NONE,
+            V::Moderate => Vibration::MODERATE,
+            V::Harsh => Vibration::HARSH,
+        };
+    }
+    let terms = depth_terms()?;
+    let magnitude = |w: &str| {
+        terms
+            .iter()
+            .find(|t| t.weighting == w)
+            .map(|t| t.magnitude_si)
+    };
+    let depth_sigma = magnitude("DSF").zip(magnitude("DST"));
+    let latitude = plan.site.lat;
+    let config = RunConfig {
+        plan,
+        tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
+        depth_sigma,
+        host_nhc: args.host_nhc,
+        uncalibrated: args.uncalibrated,
+        terms,
+        site: Site {
+            gravity: 9.806_65,
+            b_total: 0.0,
+            dip: 0.0,
+            declination: 0.0,
+            vertical_limit: 0.0001_f64.to_radians(),
+            latitude,
+            gyro_noise_reduction: 1.0,
+        },
+    };
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    );
+    let bar = indicatif::ProgressBar::new(args.runs);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})")
+            .context("progress bar")?,
+    );
+    let summary = study(
+        &config,
+        args.runs as usize,
+        args.first_seed,
+        threads,
+        &|| bar.inc(1),
+    );
+    bar.finish_and_clear();
+    outln!(
+        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads{}{})",
+        args.plan.display(),
+        args.runs,
+        args.first_seed,
+        args.tie_in_azimuth_sigma_deg,
+        threads,
+        if args.host_nhc { ", host NHC" } else { "" },
+        if args.uncalibrated {
+            ", uncalibrated"
+        } else {
+            ""
+        }
+    );
+    out!("{}", table(&summary));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&summary)? + "\n";
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,129 @@
+//! `host-sim survey CAPTURE.bin --depth DEPTH.csv`: the probe's station
+//! surveys of a drilling capture, paired with MD from the surface depth
+//! log, listed with their position uncertainty; `--trajectory OUT.csv`: the
+//! continuous trajectory from the 20 Hz solutions. docs/drilling-survey.md.
+
+use super::limits::number_in;
+use super::survey::Args;
+use anyhow::{bail, Context, Result};
+use host_sim::capture::read_probe_capture;
+use host_sim::survey_error::Site;
+use host_sim::survey_listing::depth_log::DepthLog;
+use host_sim::survey_listing::{drilling, drilling_text, TieOnInput};
+use mwd_core::protocol::Payload;
+use std::path::PathBuf;
+
+fn step_m(text: &str) -> Result<f64, String> {
+    let v = number_in(text, "the trajectory step", (0.0, 1000.0), "m")?;
+    if v == 0.0 {
+        return Err("the trajectory step must be above 0 m".into());
+    }
+    Ok(v)
+}
+
+/// Options of a capture survey.
+#[derive(clap::Args, Debug)]
+pub struct CaptureArgs {
+    /// The surface depth log (CSV: time_s, md_m): the input is then a probe
+    /// capture (.bin), and its station surveys are listed.
+    #[arg(long, value_name = "DEPTH.csv")]
+    pub depth: Option<PathBuf>,
+    /// With --depth: write the continuous trajectory (20 Hz attitude and
+    /// the depth log by minimum curvature) here (CSV).
+    #[arg(long, value_name = "OUT.csv", requires = "depth")]
+    pub trajectory: Option<PathBuf>,
+    /// MD step of the trajectory, m.
+    #[arg(long, default_value_t = 1.0, value_parser = step_m, requires = "trajectory")]
+    pub trajectory_step_m: f64,
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let unsupported = [
+        ("--json", args.json.is_some()),
+        ("--witsml", args.witsml.is_some()),
+        ("--plot", args.plot.is_some()),
+        ("--offset", args.sep.offset.is_some()),
+        ("--error-model", args.error_model.is_some()),
+        ("--vsec-azimuth-deg", args.vsec_azimuth_deg.is_some()),
+        ("--convergence-deg", args.convergence_deg.is_some()),
+    ];
+    if let Some((flag, _)) = unsupported.iter().find(|u| u.1) {
+        bail!(
+            "{flag} is not available for a capture survey (--depth): its uncertainty is the \
+             probe's own (docs/drilling-survey.md)"
+        );
+    }
+    let Some(depth_path) = &args.capture.depth else {
+        bail!("a capture survey needs --depth");
+    };
+    let capture = read_probe_capture(&args.stations)?;
+    let file = std::fs::File::open(depth_path)
+        .with_context(|| format!("reading {}", depth_path.display()))?;
+    let depth = DepthLog::read(file).with_context(|| format!("{}", depth_path.display()))?;
+    let stations: Vec<_> = capture
+        .frames
+        .iter()
+        .filter_map(|f| match f.payload {
+            Payload::Station(s) => Some(s),
+            _ => None,
+        })
+        .collect();
+    let tie = TieOnInput {
+        md: args.tie_on_md,
+        tvd: args.tie_on_tvd,
+        north: args.tie_on_north,
+        east: args.tie_on_east,
+    };
+    let site = Site {
+        gravity: 9.806_65,
+        b_total: 0.0,
+        dip: 0.0,
+        declination: 0.0,
+        vertical_limit: 0.0001_f64.to_radians(),
+        latitude: args.site.lat.to_radians(),
+        gyro_noise_reduction: 1.0,
+    };
+    let terms = drilling::depth_terms()?;
+    let survey = drilling::survey(&stations, &depth, tie, &terms, &site)
+        .with_context(|| format!("{}", args.stations.display()))?;
+    let s = &capture.stats;
+    let bad = s.crc_errors + s.malformed + s.unknown_kind;
+    if bad > 0 || s.lost > 0 {
+        outln!(
+            "capture: {bad} bad frames skipped, {} frames lost in sequence gaps",
+            s.lost
+        );
+    }
+    out!("{}", drilling_text::listing(&survey, args.confidence));
+    let write = |path: &PathBuf, text: String| {
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    };
+    if let Some(path) = &args.csv {
+        write(path, drilling_text::stations_csv(&survey, args.confidence))?;
+    }
+    if let Some(path) = &args.capture.trajectory {
+        let solutions: Vec<_> = capture
+            .frames
+            .iter()
+            .filter_map(|f| match f.payload {
+                Payload::Nav(n) => Some(n),
+                _ => None,
+            })
+            .collect();
+        let points = drilling::trajectory(
+            &solutions,
+            &depth,
+            &survey,
+            tie,
+            &terms,
+            &site,
+            args.capture.trajectory_step_m,
+        )?;
+        write(
+            path,
+            drilling_text::trajectory_csv(&points, args.confidence),
+        )?;
+        outln!("wrote {} ({} points)", path.display(), points.len());
+    }
+    Ok(())
+}

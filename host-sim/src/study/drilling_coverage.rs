@@ -1,0 +1,238 @@
+//! `host-sim study drilling-coverage`: N seeded runs of a simulated
+//! lateral ([`super::drilling_run`]) on all cores, and whether the probe's
+//! printed sigmas cover its errors (issue 13, "Checked by"): station
+//! azimuths within 2 sigma where determined (>= 93 %), inclination and
+//! toolface within 2 sigma (95 +- 3 %), TD inside the predicted 95 %
+//! horizontal ellipse (95 +- 3 % of runs).
+
+use super::drilling_run::{run, RunConfig, RunOutcome};
+use crate::survey_listing::ellipse::scale_2d;
+use mwd_core::protocol::frame::station_flags;
+use serde::Serialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// A fraction and its binomial standard error.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct Fraction {
+    pub inside: usize,
+    pub total: usize,
+    /// `None` with no cases: undetermined, never 0.
+    pub fraction: Option<f64>,
+    pub standard_error: Option<f64>,
+}
+
+impl Fraction {
+    fn of(inside: usize, total: usize) -> Self {
+        let p = (total > 0).then(|| inside as f64 / total as f64);
+        Self {
+            inside,
+            total,
+            fraction: p,
+            standard_error: p.map(|p| (p * (1.0 - p) / total as f64).sqrt()),
+        }
+    }
+}
+
+/// The study's results.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    pub runs: usize,
+    pub failed_runs: Vec<String>,
+    pub stations: usize,
+    pub invalid_stations: usize,
+    pub undetermined_azimuth_stations: usize,
+    pub azimuth_within_2_sigma: Fraction,
+    pub inclination_within_2_sigma: Fraction,
+    pub toolface_within_2_sigma: Fraction,
+    /// Runs whose TD lies inside the predicted 95 % horizontal ellipse.
+    pub td_inside_95_ellipse: Fraction,
+    /// Runs without a TD check, by reason.
+    pub td_unchecked: Vec<(String, usize)>,
+    /// RMS errors over the counted stations (deg) and TD (m); `None`
+    /// without cases.
+    pub rms_inclination_deg: Option<f64>,
+    pub rms_azimuth_deg: Option<f64>,
+    pub rms_toolface_deg: Option<f64>,
+    pub rms_td_horizontal_m: Option<f64>,
+    pub samples: usize,
+    pub wall_s: f64,
+}
+
+fn rms(values: &[f64]) -> Option<f64> {
+    (!values.is_empty())
+        .then(|| (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt())
+}
+
+/// Runs seeds `first_seed..first_seed + runs` on `threads` threads;
+/// `progress` is called after each run.
+pub fn study(
+    config: &RunConfig,
+    runs: usize,
+    first_seed: u64,
+    threads: usize,
+    progress: &(dyn Fn() + Sync),
+) -> Summary {
+    let started = std::time::Instant::now();
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<(u64, Result<RunOutcome, String>)>> = Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..threads.max(1) {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                if k >= runs {
+                    break;
+                }
+                let seed = first_seed + k as u64;
+                let outcome = run(config, seed).map_err(|e| format!("seed {seed}: {e:#}"));
+                if let Ok(mut r) = results.lock() {
+                    r.push((seed, outcome));
+                }
+                progress();
+            });
+        }
+    });
+    let mut results = results.into_inner().unwrap_or_default();
+    results.sort_by_key(|r| r.0);
+    let mut summary = summarise(&results);
+    summary.wall_s = started.elapsed().as_secs_f64();
+    summary
+}
+
+fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
+    let mut s = Summary {
+        runs: results.len(),
+        ..Summary::default()
+    };
+    let (mut inc, mut azi, mut tf, mut td) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut inside = [0usize; 4];
+    let mut totals = [0usize; 4];
+    let k2 = scale_2d(0.95).powi(2);
+    let mut unchecked: std::collections::BTreeMap<String, usize> = Default::default();
+    for (_, r) in results {
+        let o = match r {
+            Ok(o) => o,
+            Err(e) => {
+                s.failed_runs.push(e.clone());
+                continue;
+            }
+        };
+        s.samples += o.samples;
+        for st in &o.stations {
+            s.stations += 1;
+            let sd = st.survey.angles_std.map(f64::from);
+            if st.survey.flags & station_flags::SOLUTION_INVALID != 0
+                || !sd[0].is_finite()
+                || !sd[2].is_finite()
+            {
+                s.invalid_stations += 1;
+                continue;
+            }
+            let mut count = |i: usize, err: f64, sigma: f64, list: &mut Vec<f64>| {
+                totals[i] += 1;
+                inside[i] += usize::from(err.abs() <= 2.0 * sigma);
+                list.push(err.to_degrees());
+            };
+            count(0, st.error[0], sd[0], &mut inc);
+            count(2, st.error[2], sd[2], &mut tf);
+            if st.survey.flags & station_flags::AZIMUTH_UNDETERMINED != 0 || !sd[1].is_finite() {
+                s.undetermined_azimuth_stations += 1;
+            } else {
+                count(1, st.error[1], sd[1], &mut azi);
+            }
+        }
+        match (&o.td, &o.td_note) {
+            (Some(t), _) => {
+                totals[3] += 1;
+                inside[3] += usize::from(t.d2 <= k2);
+                td.push(t.error_ne[0].hypot(t.error_ne[1]));
+            }
+            (None, note) => {
+                let reason = note.clone().unwrap_or_else(|| "unknown".into());
+                // group by the reason's kind, not its numbers
+                let key = reason.split(':').next().unwrap_or("").to_string();
+                let key = if key.starts_with("last station at MD") {
+                    "last station not at TD".to_string()
+                } else {
+                    key
+                };
+                *unchecked.entry(key).or_default() += 1;
+            }
+        }
+    }
+    s.inclination_within_2_sigma = Fraction::of(inside[0], totals[0]);
+    s.azimuth_within_2_sigma = Fraction::of(inside[1], totals[1]);
+    s.toolface_within_2_sigma = Fraction::of(inside[2], totals[2]);
+    s.td_inside_95_ellipse = Fraction::of(inside[3], totals[3]);
+    s.td_unchecked = unchecked.into_iter().collect();
+    s.rms_inclination_deg = rms(&inc);
+    s.rms_azimuth_deg = rms(&azi);
+    s.rms_toolface_deg = rms(&tf);
+    s.rms_td_horizontal_m = rms(&td);
+    s
+}
+
+fn percent(f: &Fraction) -> String {
+    match (f.fraction, f.standard_error) {
+        (Some(p), Some(se)) => format!(
+            "{:.1} % +- {:.1} % ({} of {})",
+            100.0 * p,
+            100.0 * se,
+            f.inside,
+            f.total
+        ),
+        _ => "undetermined (no cases)".into(),
+    }
+}
+
+fn opt(v: Option<f64>, unit: &str) -> String {
+    v.map_or_else(
+        || "undetermined (no cases)".into(),
+        |v| format!("{v:.4} {unit}"),
+    )
+}
+
+/// The terminal table.
+pub fn table(s: &Summary) -> String {
+    let mut rows = vec![
+        (
+            "runs",
+            format!("{} ({} failed)", s.runs, s.failed_runs.len()),
+        ),
+        ("stations", s.stations.to_string()),
+        ("  invalid (not counted)", s.invalid_stations.to_string()),
+        (
+            "  azimuth undetermined",
+            s.undetermined_azimuth_stations.to_string(),
+        ),
+        (
+            "azimuth within 2 sigma (issue: >= 93 %)",
+            percent(&s.azimuth_within_2_sigma),
+        ),
+        (
+            "inclination within 2 sigma (95 +- 3 %)",
+            percent(&s.inclination_within_2_sigma),
+        ),
+        (
+            "toolface within 2 sigma (95 +- 3 %)",
+            percent(&s.toolface_within_2_sigma),
+        ),
+        (
+            "TD inside the 95 % ellipse (95 +- 3 %)",
+            percent(&s.td_inside_95_ellipse),
+        ),
+        ("RMS inclination error", opt(s.rms_inclination_deg, "deg")),
+        ("RMS azimuth error", opt(s.rms_azimuth_deg, "deg")),
+        ("RMS toolface error", opt(s.rms_toolface_deg, "deg")),
+        ("RMS TD horizontal error", opt(s.rms_td_horizontal_m, "m")),
+        ("samples", s.samples.to_string()),
+        ("wall time", format!("{:.1} s", s.wall_s)),
+    ];
+    for (reason, n) in &s.td_unchecked {
+        rows.push(("TD not checked", format!("{n} runs: {reason}")));
+    }
+    for e in s.failed_runs.iter().take(5) {
+        rows.push(("failed", e.clone()));
+    }
+    rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")).collect()
+}

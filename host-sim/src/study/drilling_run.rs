@@ -1,0 +1,262 @@
+//! One seeded run of the drilling-coverage study: a lateral simulated in
+//! process (no files), the probe's `Navigator` driven through it from a
+//! tie-in, its station surveys paired with the truth and surveyed as
+//! `host-sim survey CAPTURE --depth` does ([`crate::survey_listing::drilling`]).
+
+use crate::capture::{raw_sample_from_si, SiSample};
+use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
+use crate::survey_error::{ErrorTerm, Site};
+use crate::survey_listing::depth_log::DepthLog;
+use crate::survey_listing::drilling::{self, DrillingSurvey};
+use crate::survey_listing::TieOnInput;
+use anyhow::{anyhow, Context, Result};
+use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
+use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
+use mwd_core::probe::{Navigator, TieIn};
+use mwd_core::protocol::frame::nav_flags;
+use mwd_core::protocol::{RawSample, StationSurvey};
+use mwd_core::timing::SAMPLE_INTERVAL_S;
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+/// What a run is given besides its seed.
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    pub plan: BuiltPlan,
+    /// 1-sigma of the parent well's azimuth at the tie-in (rad).
+    pub tie_in_azimuth_sigma: f64,
+    /// Draw the depth log's scale and stretch per run from these 1-sigma
+    /// (the tool model's DSFS, DSTG); `None`: the plan's values.
+    pub depth_sigma: Option<(f64, f64)>,
+    /// Call `Navigator::apply_non_holonomic` after every solution the probe
+    /// does not flag still (for a navigator that does not do it itself).
+    pub host_nhc: bool,
+    /// Run the navigator without the calibration that removes the
+    /// simulated parts' deterministic errors (as the QEMU probe and
+    /// `simulate`'s captures run); default: calibrated, as a probe in a
+    /// well is (residual errors: the noise model's).
+    pub uncalibrated: bool,
+    pub terms: Vec<ErrorTerm>,
+    pub site: Site,
+}
+
+/// A station survey and the truth at its last still sample.
+#[derive(Clone, Copy, Debug)]
+pub struct StationCheck {
+    pub survey: StationSurvey,
+    /// Errors of inclination, azimuth, toolface (rad, wrapped).
+    pub error: [f64; 3],
+    pub truth_md: f64,
+}
+
+/// The run's TD: the last station's horizontal position against the truth.
+#[derive(Clone, Copy, Debug)]
+pub struct TdCheck {
+    /// North and east error, m.
+    pub error_ne: [f64; 2],
+    /// Squared Mahalanobis distance in the predicted NE covariance.
+    pub d2: f64,
+}
+
+/// What one run gave.
+#[derive(Clone, Debug)]
+pub struct RunOutcome {
+    pub seed: u64,
+    pub stations: Vec<StationCheck>,
+    /// `None`: the last station is not at TD or its position is
+    /// undetermined (`td_note` says which).
+    pub td: Option<TdCheck>,
+    pub td_note: Option<String>,
+    pub samples: usize,
+}
+
+/// The tie-in from the navigator's own levelling (its static alignment's
+/// inclination and toolface and their sigmas) and the parent well's
+/// azimuth: the truth plus an error drawn with `sigma_azi`.
+fn tie_in(
+    solution: &mwd_core::protocol::NavSolution,
+    truth_azimuth: f64,
+    sigma_azi: f64,
+    rng: &mut ChaCha8Rng,
+) -> Result<TieIn> {
+    let [roll, pitch, _] = solution.attitude.map(f64::from);
+    let [s_roll, s_pitch, _] = solution.attitude_std.map(f64::from);
+    let drawn: f64 = StandardNormal.sample(rng);
+    let angles = DrillingAngles {
+        inclination: std::f64::consts::FRAC_PI_2 + pitch,
+        azimuth: wrap_two_pi(truth_azimuth + sigma_azi * drawn),
+        toolface: wrap_two_pi(roll),
+    };
+    let sigma = DrillingAngles {
+        inclination: s_pitch,
+        azimuth: sigma_azi,
+        toolface: s_roll,
+    };
+    TieIn::new(angles, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
+}
+
+/// The raw frame of sample `index` of measured body rates and force (both
+/// parts' triads see the same force, as `capture::write_simulated_probe`).
+fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Result<RawSample> {
+    let force = [accel.x, accel.y, accel.z];
+    Ok(raw_sample_from_si(&SiSample {
+        index: u32::try_from(index).context("more than 2^32 samples")?,
+        gyro_body_xz_rad_s: [gyro.x, gyro.z],
+        accel_body_m_s2: [force, force],
+        temperature_degc: 25.0,
+    }))
+}
+
+/// Runs seed `seed`.
+pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x57D7_0000_0000_0013);
+    let mut plan = config.plan.clone();
+    if let Some((scale, stretch)) = config.depth_sigma {
+        let a: f64 = StandardNormal.sample(&mut rng);
+        let b: f64 = StandardNormal.sample(&mut rng);
+        plan.drilling.depth_errors.scale_ppm = a * scale * 1e6;
+        plan.drilling.depth_errors.stretch_per_m = b * stretch;
+    }
+    let tie_on = plan.tie_on;
+    let end_md = plan.end_md();
+    let drilling = Drilling::new(plan, seed);
+    let site = drilling.truth(0.0).position;
+    let model = SensorModel::scc1300(seed);
+    let mut navigator = if config.uncalibrated {
+        Navigator::new(site)
+    } else {
+        Navigator::with_calibration(site, model.deterministic.calibration())
+    };
+    let mut tied = false;
+    let mut stations = Vec::new();
+    let mut samples = 0;
+    let sim = DrillingSimulator::new(&drilling, model.clone(), SAMPLE_INTERVAL_S);
+    // the last sample's true means and whether the run ends still
+    let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
+    for (index, d) in sim.enumerate() {
+        let s = &d.sample;
+        let solution = navigator.step(&raw(index, &s.gyro, &s.accel)?);
+        samples += 1;
+        last = Some((
+            s.true_rate,
+            s.true_accel,
+            d.truth.state == DrillState::Still,
+        ));
+        if !tied && navigator.is_navigating() {
+            // levelled and still at the window: the tie-in replaces the
+            // gyrocompass azimuth
+            let t = tie_in(
+                &solution,
+                d.truth.point.azimuth,
+                config.tie_in_azimuth_sigma,
+                &mut rng,
+            )?;
+            navigator.start_from_tie_in(&t);
+            tied = true;
+            continue;
+        }
+        if let Some(station) = navigator.take_station() {
+            stations.push(station);
+        }
+        if config.host_nhc && tied && solution.flags & nav_flags::STILL == 0 {
+            navigator.apply_non_holonomic();
+        }
+    }
+    // The run ends still at TD, where the probe sends its station when the
+    // string next moves or at its longest station: the still goes on (the
+    // same true means, fresh sensor noise) until the station comes out.
+    let run_samples = samples;
+    if let Some((rate, accel, true)) = last {
+        let mut tail = SensorErrors::new(SensorModel {
+            seed: seed ^ 0x7A11_0000_0000_0001,
+            ..model
+        });
+        for k in 0..MAX_STATION_SAMPLES as usize {
+            let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
+            navigator.step(&raw(run_samples + k, &gyro, &force)?);
+            samples += 1;
+            if let Some(station) = navigator.take_station() {
+                stations.push(station);
+                break;
+            }
+        }
+    }
+    let checks: Vec<StationCheck> = stations
+        .iter()
+        .map(|st| {
+            let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
+            let a = st.angles.map(f64::from);
+            StationCheck {
+                survey: *st,
+                error: [
+                    a[0] - truth.point.inclination,
+                    wrap_pi(a[1] - truth.point.azimuth),
+                    wrap_pi(a[2] - truth.toolface),
+                ],
+                truth_md: truth.md,
+            }
+        })
+        .collect();
+    // the log goes on through the extended still, at the last MD
+    let log: Vec<(f64, f64)> = drilling.depth_log().collect();
+    let end = samples as f64 * SAMPLE_INTERVAL_S;
+    let tail = log
+        .last()
+        .filter(|(t, _)| *t < end)
+        .map(|&(_, md)| (end, md));
+    let depth = DepthLog::new(log.into_iter().chain(tail))?;
+    let tie = TieOnInput {
+        md: Some(tie_on.md()),
+        tvd: tie_on.nev().z,
+        north: tie_on.nev().x,
+        east: tie_on.nev().y,
+    };
+    let (td, td_note) = match drilling::survey(&stations, &depth, tie, &config.terms, &config.site)
+    {
+        Ok(survey) => td_check(&survey, &drilling, end_md),
+        Err(e) => (None, Some(format!("no survey: {e:#}"))),
+    };
+    Ok(RunOutcome {
+        seed,
+        stations: checks,
+        td,
+        td_note,
+        samples,
+    })
+}
+
+/// The last surveyed station against the truth, if it is at TD (within
+/// 1 m) and positioned.
+fn td_check(
+    survey: &DrillingSurvey,
+    drilling: &Drilling,
+    end_md: f64,
+) -> (Option<TdCheck>, Option<String>) {
+    let Some(last) = survey.rows.last() else {
+        return (None, Some("no station".into()));
+    };
+    let truth = drilling.truth((f64::from(last.survey.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
+    if (truth.md - end_md).abs() > 1.0 {
+        return (
+            None,
+            Some(format!("last station at MD {:.1} m, not at TD", truth.md)),
+        );
+    }
+    let Some(c) = last.row.cov.filter(|_| last.position_determined) else {
+        return (None, Some("TD position undetermined".into()));
+    };
+    let e = [
+        last.row.north_m - truth.point.nev.x,
+        last.row.east_m - truth.point.nev.y,
+    ];
+    let (nn, ee, ne) = (c[0], c[1], c[3]);
+    let det = nn * ee - ne * ne;
+    // also catches NaN
+    if det.is_nan() || det <= 0.0 {
+        return (None, Some("TD covariance singular".into()));
+    }
+    let d2 = (ee * e[0] * e[0] - 2.0 * ne * e[0] * e[1] + nn * e[1] * e[1]) / det;
+    (Some(TdCheck { error_ne: e, d2 }), None)
+}

@@ -1,0 +1,4 @@
+//! Monte Carlo studies over simulated runs (`host-sim study ...`).
+
+pub mod drilling_coverage;
+pub mod drilling_run;

@@ -1,0 +1,316 @@
+//! Position uncertainty from the probe's own station surveys: each
+//! station's inclination and azimuth 1-sigma (and their correlation), as
+//! the navigator reports them, propagated to NEV covariance with the
+//! engine's conventions (SPE 67616 balanced-tangential error vectors,
+//! random and systematic sources; see [`super`]).
+//!
+//! How the stations' errors are correlated (docs/drilling-survey.md):
+//! * azimuth: the probe carries its azimuth through drilling on the gyros
+//!   from the tie-in (or its first gyrocompass), so its error is a random
+//!   walk: each station's error is the previous one's plus an independent
+//!   increment. The covariance of stations j and k is then
+//!   `min(s_j^2, s_k^2)` (the Brownian kernel at "times" `s^2`, positive
+//!   semi-definite for any sigmas, so also when a bias update at a station
+//!   makes a sigma shrink). As error sources: one source per station,
+//!   systematic from that station on, of magnitude
+//!   `sqrt(s_(j)^2 - s_(j-1)^2)` in the order of the variances; the first
+//!   is the tie-in's part, systematic for the whole run;
+//! * inclination: re-levelled at every station through the zero-velocity
+//!   updates, so random from station to station, except for the part the
+//!   filter correlates with that station's azimuth:
+//!   `e_I,k = r_k (s_I,k / s_A,k) e_A,k + sqrt(1 - r_k^2) s_I,k v_k`,
+//!   `v_k` independent unit normals. This holds each station's sigmas and
+//!   correlation exactly and keeps the whole covariance a linear map of
+//!   independent sources (positive semi-definite by construction);
+//! * toolface does not enter the position.
+//!
+//! The first station is the tie-on (its position given): an angle error
+//! there acts over half the first leg, as at any other station (no
+//! doubling: [`super::TieOn::Exact`]). Depth errors are separate sources
+//! (the engine's DSF/DST, [`super::run`]).
+
+use super::{Cov6, Station};
+
+/// One station's angle uncertainty (rad), as the probe sends it. `azi`
+/// must be finite (an undetermined azimuth has no propagation: the caller
+/// stops before it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleSigma {
+    pub inc: f64,
+    pub azi: f64,
+    /// Correlation of the inclination and azimuth errors (NaN: taken as 0).
+    pub corr_inc_azi: f64,
+}
+
+/// Why a propagation was refused.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PropagationError {
+    /// Different numbers of stations and sigmas.
+    LengthMismatch,
+    /// A sigma is negative, NaN or infinite (station index).
+    BadSigma(usize),
+    /// MD not strictly increasing at this station.
+    MdNotIncreasing(usize),
+}
+
+impl std::fmt::Display for PropagationError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::LengthMismatch => f.write_str("one angle sigma per station is needed"),
+            Self::BadSigma(k) => {
+                write!(f, "station {k}: an angle sigma is not a finite number >= 0")
+            }
+            Self::MdNotIncreasing(k) => {
+                write!(f, "station {k}: MD not beyond the previous station's")
+            }
+        }
+    }
+}
+
+/// One independent unit source: its (inclination, azimuth) error at each
+/// station, rad.
+struct Source {
+    weights: Vec<[f64; 2]>,
+}
+
+/// The NEV covariance (m^2) at every station from the stations' angle
+/// errors, first station = tie-on (zero covariance there).
+pub fn angle_covariance(
+    stations: &[Station],
+    sigmas: &[AngleSigma],
+) -> Result<Vec<Cov6>, PropagationError> {
+    let n = stations.len();
+    if sigmas.len() != n {
+        return Err(PropagationError::LengthMismatch);
+    }
+    for (k, s) in sigmas.iter().enumerate() {
+        let ok = |x: f64| x.is_finite() && x >= 0.0;
+        if !(ok(s.inc) && ok(s.azi)) {
+            return Err(PropagationError::BadSigma(k));
+        }
+        if k > 0 && stations[k].md <= stations[k - 1].md {
+            return Err(PropagationError::MdNotIncreasing(k));
+        }
+    }
+    let sources = sources(sigmas);
+    let vectors = unit_vectors(stations);
+    let mut total = vec![[0.0; 6]; n];
+    for src in &sources {
+        // running sum of the interior contributions of stations before K
+        let mut sum = [0.0; 3];
+        for k in 0..n {
+            let [di, da] = src.weights[k];
+            let u = &vectors[k];
+            let angle: [f64; 3] = std::array::from_fn(|j| u.di[j] * di + u.da[j] * da);
+            if k > 0 {
+                let e: [f64; 3] = std::array::from_fn(|j| sum[j] + u.h_last * angle[j]);
+                add_outer(&mut total[k], e);
+            }
+            for j in 0..3 {
+                sum[j] += u.h_interior * angle[j];
+            }
+        }
+    }
+    Ok(total)
+}
+
+/// The independent sources of the module's model.
+fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
+    let n = sigmas.len();
+    // inclination's share of each station's azimuth error
+    let share: Vec<f64> = sigmas
+        .iter()
+        .map(|s| {
+            let r = if s.corr_inc_azi.is_finite() {
+                s.corr_inc_azi.clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
+            if s.azi > 0.0 {
+                r * s.inc / s.azi
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    // azimuth random walk in the order of the variances (stable: ties keep
+    // the station order and get zero-size increments)
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| sigmas[a].azi.total_cmp(&sigmas[b].azi));
+    let mut rank = vec![0; n];
+    for (r, &k) in order.iter().enumerate() {
+        rank[k] = r;
+    }
+    let mut out = Vec::with_capacity(2 * n);
+    let mut previous = 0.0;
+    for (r, &k) in order.iter().enumerate() {
+        let variance = sigmas[k].azi.powi(2);
+        let size = (variance - previous).max(0.0).sqrt();
+        previous = variance;
+        if size == 0.0 {
+            continue;
+        }
+        let weights = (0..n)
+            .map(|i| {
+                if rank[i] >= r {
+                    [share[i] * size, size]
+                } else {
+                    [0.0, 0.0]
+                }
+            })
+            .collect();
+        out.push(Source { weights });
+    }
+    for (k, s) in sigmas.iter().enumerate() {
+        let r = if s.corr_inc_azi.is_finite() && s.azi > 0.0 {
+            s.corr_inc_azi.clamp(-1.0, 1.0)
+        } else {
+            0.0
+        };
+        let size = s.inc * (1.0 - r * r).sqrt();
+        if size == 0.0 {
+            continue;
+        }
+        let mut weights = vec![[0.0, 0.0]; n];
+        weights[k] = [size, 0.0];
+        out.push(Source { weights });
+    }
+    out
+}
+
+/// d dr/dI and d dr/dA per unit length at a station and the half course
+/// lengths its angle error acts over (SPE 67616 balanced tangential: both
+/// legs at an interior station, the leg before at the station of
+/// interest).
+struct StationVectors {
+    di: [f64; 3],
+    da: [f64; 3],
+    h_interior: f64,
+    h_last: f64,
+}
+
+fn unit_vectors(stations: &[Station]) -> Vec<StationVectors> {
+    (0..stations.len())
+        .map(|k| {
+            let s = &stations[k];
+            let (si, ci) = s.inc.sin_cos();
+            let (sa, ca) = s.azi.sin_cos();
+            let before = if k == 0 {
+                0.0
+            } else {
+                s.md - stations[k - 1].md
+            };
+            let after = stations.get(k + 1).map_or(0.0, |nx| nx.md - s.md);
+            StationVectors {
+                di: [ci * ca, ci * sa, -si],
+                da: [-si * sa, si * ca, 0.0],
+                h_interior: 0.5 * (before + after),
+                h_last: 0.5 * before,
+            }
+        })
+        .collect()
+}
+
+fn add_outer(c: &mut Cov6, v: [f64; 3]) {
+    c[0] += v[0] * v[0];
+    c[1] += v[1] * v[1];
+    c[2] += v[2] * v[2];
+    c[3] += v[0] * v[1];
+    c[4] += v[0] * v[2];
+    c[5] += v[1] * v[2];
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn straight(n: usize, step: f64, inc_deg: f64, azi_deg: f64) -> Vec<Station> {
+        (0..n)
+            .map(|k| Station {
+                md: 3000.0 + step * k as f64,
+                inc: inc_deg.to_radians(),
+                azi: azi_deg.to_radians(),
+                tvd: 2450.0,
+                toolface: None,
+            })
+            .collect()
+    }
+
+    fn sigma(inc: f64, azi: f64) -> AngleSigma {
+        AngleSigma {
+            inc,
+            azi,
+            corr_inc_azi: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_constant_azimuth_error_moves_a_straight_horizontal_well_sideways_by_length_times_sigma() {
+        // azimuth north, horizontal: the error is east, L sigma at TD
+        let st = straight(5, 25.0, 90.0, 0.0);
+        let s = 0.01;
+        let c = angle_covariance(&st, &[sigma(0.0, s); 5]).unwrap();
+        let last = c[4];
+        assert!((last[1].sqrt() - 100.0 * s).abs() < 1e-9, "{last:?}");
+        assert!(last[0].abs() < 1e-18 && last[2].abs() < 1e-18);
+        assert_eq!(c[0], [0.0; 6]);
+    }
+
+    #[test]
+    fn a_random_walk_grows_less_than_a_systematic_error_of_the_same_final_sigma() {
+        let st = straight(5, 25.0, 90.0, 0.0);
+        let walk: Vec<AngleSigma> = (0..5)
+            .map(|k| sigma(0.0, 0.01 * (k as f64 / 4.0).sqrt()))
+            .collect();
+        let c = angle_covariance(&st, &walk).unwrap();
+        // balanced tangential by hand: station k's error acts over h_k,
+        // e_k the walk; var = sum_jk h_j h_k min(s_j^2, s_k^2)
+        let h = [12.5, 25.0, 25.0, 25.0, 12.5];
+        let var: f64 = (0..5)
+            .flat_map(|j| (0..5).map(move |k| (j, k)))
+            .map(|(j, k)| h[j] * h[k] * walk[j].azi.powi(2).min(walk[k].azi.powi(2)))
+            .sum();
+        assert!((c[4][1] - var).abs() < 1e-12 * var, "{} vs {var}", c[4][1]);
+        assert!(c[4][1] < (100.0f64 * 0.01).powi(2));
+    }
+
+    #[test]
+    fn random_inclination_errors_add_in_quadrature_and_a_correlation_couples_them() {
+        let st = straight(3, 10.0, 90.0, 0.0);
+        let c = angle_covariance(&st, &[sigma(0.001, 0.0); 3]).unwrap();
+        // vertical: dr/dI = -sin I = -1 per unit length; h = 5, 10, 5
+        let var = 0.001f64.powi(2) * (25.0 + 100.0 + 25.0);
+        assert!((c[2][2] - var).abs() < 1e-15);
+        let corr = vec![
+            AngleSigma {
+                inc: 0.001,
+                azi: 0.002,
+                corr_inc_azi: 0.9,
+            };
+            3
+        ];
+        let c = angle_covariance(&st, &corr).unwrap();
+        assert!(c[2][5].abs() > 0.0, "east-vertical coupled: {:?}", c[2]);
+        // still a covariance: |ev| <= sqrt(ee vv)
+        assert!(c[2][5].abs() <= (c[2][1] * c[2][2]).sqrt() * (1.0 + 1e-12));
+    }
+
+    #[test]
+    fn bad_input_is_refused() {
+        let st = straight(2, 10.0, 90.0, 0.0);
+        assert_eq!(
+            angle_covariance(&st, &[sigma(0.0, 0.1)]),
+            Err(PropagationError::LengthMismatch)
+        );
+        assert_eq!(
+            angle_covariance(&st, &[sigma(0.0, 0.1), sigma(f64::NAN, 0.1)]),
+            Err(PropagationError::BadSigma(1))
+        );
+        let mut same = st.clone();
+        same[1].md = same[0].md;
+        assert_eq!(
+            angle_covariance(&same, &[sigma(0.0, 0.1); 2]),
+            Err(PropagationError::MdNotIncreasing(1))
+        );
+    }
+}

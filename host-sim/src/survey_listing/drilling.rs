@@ -1,0 +1,350 @@
+//! A drilling run's survey (`host-sim survey CAPTURE.bin --depth LOG`):
+//! the probe's station surveys paired with MD from the surface depth log
+//! by time, positioned by minimum curvature from the tie-on, with their
+//! position covariance from the probe's own station sigmas
+//! ([`crate::survey_error::probe_station`]) and the depth log's scale and
+//! stretch errors (the engine's DSF/DST sources); and a continuous
+//! trajectory from the 20 Hz solutions. docs/drilling-survey.md.
+//!
+//! The first usable station is the tie-on: the probe surveys the window
+//! before drilling starts, and its position (TVD, north, east) is the
+//! parent well's. Its MD is the depth log's at that time, or `--tie-on-md`:
+//! then the whole log is shifted by the same amount (the driller's depth
+//! referenced to the parent well's MD at the window). Either way the depth
+//! errors counted are those of the MD drilled from the tie-on.
+
+use super::depth_log::DepthLog;
+use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
+use crate::survey_error::probe_station::{angle_covariance, AngleSigma};
+use crate::survey_error::{self, Cov6, ErrorTerm, Site, Station};
+use anyhow::{anyhow, bail, Result};
+use mwd_core::protocol::frame::{nav_flags, nav_mode, station_flags};
+use mwd_core::protocol::{NavSolution, StationSurvey};
+
+/// One station of the survey.
+#[derive(Clone, Copy, Debug)]
+pub struct DrillingRow {
+    pub survey: StationSurvey,
+    /// Time of the station (its last still sample), s since boot.
+    pub time_s: f64,
+    /// MD, inclination, azimuth, positions; `cov` only where the position
+    /// is determined.
+    pub row: Row,
+    pub azimuth_determined: bool,
+    /// Every station up to this one has a determined azimuth: N/E/TVD and
+    /// their covariance mean something.
+    pub position_determined: bool,
+}
+
+/// A station left out, and why.
+#[derive(Clone, Debug)]
+pub struct Skipped {
+    pub survey: StationSurvey,
+    pub reason: String,
+}
+
+/// The survey of a drilling run.
+#[derive(Clone, Debug)]
+pub struct DrillingSurvey {
+    pub rows: Vec<DrillingRow>,
+    pub skipped: Vec<Skipped>,
+    /// Added to the depth log's MD (m): `--tie-on-md` minus the log at the
+    /// first station; 0 without it.
+    pub md_offset_m: f64,
+}
+
+/// The depth terms of the probe's tool model (DSFS, DSTG): the depth log's
+/// scale and stretch errors, one place for their magnitudes.
+pub fn depth_terms() -> Result<Vec<ErrorTerm>> {
+    let model = super::model("PROBE-SCC1300")?;
+    let terms: Vec<ErrorTerm> = super::terms(model)?
+        .into_iter()
+        .filter(|t| t.weighting == "DSF" || t.weighting == "DST")
+        .collect();
+    if terms.len() != 2 {
+        bail!("the PROBE-SCC1300 table has no DSF and DST terms");
+    }
+    Ok(terms)
+}
+
+fn azimuth_determined(s: &StationSurvey) -> bool {
+    s.flags & station_flags::AZIMUTH_UNDETERMINED == 0 && s.angles_std[1].is_finite()
+}
+
+/// Why a station cannot be used at all, if so.
+fn unusable(s: &StationSurvey) -> Option<&'static str> {
+    if s.flags & station_flags::SOLUTION_INVALID != 0 {
+        return Some("the probe marked it invalid");
+    }
+    let inc_ok = s.angles[0].is_finite() && s.angles_std[0].is_finite();
+    if !inc_ok || !s.angles[1].is_finite() {
+        return Some("its angles or inclination sigma are not numbers");
+    }
+    None
+}
+
+/// The survey of `stations` (in the order the probe sent them) with MD
+/// from `depth`; `tie`: the tie-on's position, and its MD if given.
+pub fn survey(
+    stations: &[StationSurvey],
+    depth: &DepthLog,
+    tie: TieOnInput,
+    terms: &[ErrorTerm],
+    site: &Site,
+) -> Result<DrillingSurvey> {
+    let mut skipped = Vec::new();
+    let mut kept: Vec<(StationSurvey, f64, f64)> = Vec::new();
+    let (first, last) = depth.span();
+    for s in stations {
+        if let Some(reason) = unusable(s) {
+            skipped.push(Skipped {
+                survey: *s,
+                reason: reason.into(),
+            });
+            continue;
+        }
+        let time_s = s.time_us as f64 * 1e-6;
+        let md = depth.md_at(time_s).ok_or_else(|| {
+            anyhow!(
+                "station {} at {time_s:.2} s is outside the depth log's time span \
+                 ({first:.2} s to {last:.2} s): is it this run's log?",
+                s.station
+            )
+        })?;
+        if let Some((previous, ..)) = kept.last() {
+            if time_s <= previous.time_us as f64 * 1e-6 {
+                bail!(
+                    "station {} is not later than station {}: the capture holds more than \
+                     one run (split it at the boot event)",
+                    s.station,
+                    previous.station
+                );
+            }
+        }
+        // Not beyond the previous station: the string did not move in
+        // between; the later station (more still time behind it) stands.
+        while let Some((previous, _, prev_md)) = kept.last() {
+            if md > *prev_md {
+                break;
+            }
+            skipped.push(Skipped {
+                survey: *previous,
+                reason: format!("superseded by station {} at the same MD", s.station),
+            });
+            kept.pop();
+        }
+        kept.push((*s, time_s, md));
+    }
+    let Some(&(_, _, first_md)) = kept.first() else {
+        bail!("no usable station survey in the capture");
+    };
+    let md_offset_m = tie.md.map_or(0.0, |md| md - first_md);
+    let file = StationFile {
+        unit: LengthUnit::Metre,
+        stations: kept
+            .iter()
+            .map(|(s, time_s, md)| InputStation {
+                md: md + md_offset_m,
+                inc_deg: f64::from(s.angles[0]).to_degrees(),
+                azi_deg: f64::from(s.angles[1]).to_degrees(),
+                toolface_deg: Some(f64::from(s.angles[2]).to_degrees()),
+                time_s: Some(*time_s),
+            })
+            .collect(),
+    };
+    let tie_position = TieOnInput { md: None, ..tie };
+    let (rows, _) = compute(&file, AzimuthReference::True, tie_position, None)?;
+    let sigmas: Vec<Option<AngleSigma>> = kept
+        .iter()
+        .map(|(s, ..)| {
+            azimuth_determined(s).then(|| AngleSigma {
+                inc: f64::from(s.angles_std[0]),
+                azi: f64::from(s.angles_std[1]),
+                corr_inc_azi: f64::from(s.correlations[0]),
+            })
+        })
+        .collect();
+    let covs = covariance(&rows, &sigmas, terms, site)?;
+    let rows = kept
+        .iter()
+        .zip(rows)
+        .enumerate()
+        .map(|(k, ((s, time_s, _), mut row))| {
+            row.cov = covs.get(k).copied();
+            DrillingRow {
+                survey: *s,
+                time_s: *time_s,
+                row,
+                azimuth_determined: sigmas[k].is_some(),
+                position_determined: k < covs.len(),
+            }
+        })
+        .collect();
+    Ok(DrillingSurvey {
+        rows,
+        skipped,
+        md_offset_m,
+    })
+}
+
+/// NEV covariance of the rows up to (not including) the first one without
+/// a determined azimuth: the probe's angle errors plus the depth terms,
+/// the latter on MD counted from the tie-on (the log's error at the
+/// tie-on is in the tie-on's MD, not in the positions: module docs).
+pub fn covariance(
+    rows: &[Row],
+    sigmas: &[Option<AngleSigma>],
+    terms: &[ErrorTerm],
+    site: &Site,
+) -> Result<Vec<Cov6>> {
+    let valid = sigmas.iter().take_while(|s| s.is_some()).count();
+    if valid == 0 {
+        return Ok(Vec::new());
+    }
+    let md0 = rows[0].md_m;
+    let stations: Vec<Station> = rows[..valid]
+        .iter()
+        .map(|r| Station {
+            md: r.md_m,
+            inc: r.inc_deg.to_radians(),
+            azi: r.azi_deg.to_radians(),
+            tvd: r.tvd_m,
+            toolface: r.input.toolface_deg.map(f64::to_radians),
+        })
+        .collect();
+    let sig: Vec<AngleSigma> = sigmas[..valid].iter().flatten().copied().collect();
+    let angles = angle_covariance(&stations, &sig).map_err(|e| anyhow!("{e}"))?;
+    let from_tie_on: Vec<Station> = stations
+        .iter()
+        .map(|s| Station {
+            md: s.md - md0,
+            ..*s
+        })
+        .collect();
+    let mut depth = vec![[0.0; 6]; valid];
+    if valid > 1 {
+        let result = survey_error::run(terms, &from_tie_on, site);
+        if !result.missing.is_empty() {
+            bail!("depth terms not implemented: {}", result.missing.join(", "));
+        }
+        depth = result.total;
+    }
+    Ok(angles
+        .iter()
+        .zip(&depth)
+        .map(|(a, d)| std::array::from_fn(|j| a[j] + d[j]))
+        .collect())
+}
+
+/// One point of the continuous trajectory.
+#[derive(Clone, Copy, Debug)]
+pub struct TrajectoryPoint {
+    pub time_s: f64,
+    /// 1-sigma of inclination and azimuth (rad; azimuth +inf undetermined).
+    pub sigma_inc: f64,
+    pub sigma_azi: f64,
+    pub row: Row,
+    pub azimuth_determined: bool,
+    pub position_determined: bool,
+}
+
+/// The trajectory every `step_m` of MD from the survey's tie-on to the
+/// deepest MD the solutions reach: at each MD the attitude of the first
+/// navigation solution whose (log) MD reaches it (at 30 m/h the MD moves
+/// 0.4 mm per 20 Hz sample), positioned by minimum curvature from the
+/// tie-on, with the covariance model of the stations (module docs).
+pub fn trajectory(
+    solutions: &[NavSolution],
+    depth: &DepthLog,
+    survey: &DrillingSurvey,
+    tie: TieOnInput,
+    terms: &[ErrorTerm],
+    site: &Site,
+    step_m: f64,
+) -> Result<Vec<TrajectoryPoint>> {
+    if !(step_m.is_finite() && step_m > 0.0) {
+        bail!("the trajectory step must be a positive number of metres");
+    }
+    let Some(tie_row) = survey.rows.first() else {
+        bail!("no tie-on station");
+    };
+    let start_time = tie_row.time_s;
+    let mut points: Vec<(f64, f64, &NavSolution)> = Vec::new();
+    let mut next_md = tie_row.row.md_m + step_m;
+    for s in solutions {
+        let t = s.time_us as f64 * 1e-6;
+        let usable = s.mode == nav_mode::NAVIGATING
+            && s.flags & nav_flags::SOLUTION_INVALID == 0
+            && s.attitude.iter().all(|a| a.is_finite())
+            && s.attitude_std[1].is_finite();
+        if t <= start_time || !usable {
+            continue;
+        }
+        let Some(md) = depth.md_at(t) else { continue };
+        let md = md + survey.md_offset_m;
+        while md >= next_md {
+            points.push((t, next_md, s));
+            next_md += step_m;
+        }
+    }
+    let tie_in = tie_row.row.input;
+    let mut inputs = vec![tie_in];
+    let mut sig = vec![[
+        f64::from(tie_row.survey.angles_std[0]),
+        f64::from(tie_row.survey.angles_std[1]),
+    ]];
+    let mut determined = vec![tie_row.azimuth_determined];
+    for (t, md, s) in &points {
+        let [_, pitch, heading] = s.attitude.map(f64::from);
+        inputs.push(InputStation {
+            md: *md,
+            inc_deg: (std::f64::consts::FRAC_PI_2 + pitch).to_degrees(),
+            azi_deg: heading.rem_euclid(std::f64::consts::TAU).to_degrees(),
+            toolface_deg: Some(
+                f64::from(s.attitude[0])
+                    .rem_euclid(std::f64::consts::TAU)
+                    .to_degrees(),
+            ),
+            time_s: Some(*t),
+        });
+        sig.push([f64::from(s.attitude_std[1]), f64::from(s.attitude_std[2])]);
+        determined.push(s.attitude_std[2].is_finite());
+    }
+    let file = StationFile {
+        unit: LengthUnit::Metre,
+        stations: inputs,
+    };
+    let (rows, _) = compute(
+        &file,
+        AzimuthReference::True,
+        TieOnInput { md: None, ..tie },
+        None,
+    )?;
+    let sigmas: Vec<Option<AngleSigma>> = sig
+        .iter()
+        .zip(&determined)
+        .map(|(s, &d)| {
+            d.then_some(AngleSigma {
+                inc: s[0],
+                azi: s[1],
+                corr_inc_azi: f64::NAN,
+            })
+        })
+        .collect();
+    let covs = covariance(&rows, &sigmas, terms, site)?;
+    Ok(rows
+        .into_iter()
+        .enumerate()
+        .map(|(k, mut row)| {
+            row.cov = covs.get(k).copied();
+            TrajectoryPoint {
+                time_s: row.input.time_s.unwrap_or(f64::NAN),
+                sigma_inc: sig[k][0],
+                sigma_azi: sig[k][1],
+                row,
+                azimuth_determined: determined[k],
+                position_determined: k < covs.len(),
+            }
+        })
+        .collect())
+}

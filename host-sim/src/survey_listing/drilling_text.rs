@@ -1,0 +1,187 @@
+//! The drilling survey's listing (terminal) and CSV files: every angle and
+//! position with its sigma; an undetermined azimuth, and every position
+//! from the first one on, shown as undetermined, never as a number.
+
+use super::drilling::{DrillingRow, DrillingSurvey, TrajectoryPoint};
+use super::ellipse::scale_2d;
+use std::fmt::Write as _;
+
+/// Angle and its 1-sigma, deg: "91.082+-0.064".
+fn angle(value_deg: f64, sigma_rad: f64) -> String {
+    format!("{value_deg:.3}+-{:.3}", sigma_rad.to_degrees())
+}
+
+/// The listing: one line per station, then the skipped stations.
+pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{} stations from the probe's station surveys; MD from the depth log{}; N/E along true north, m",
+        s.rows.len(),
+        if s.md_offset_m == 0.0 {
+            String::new()
+        } else {
+            format!(" shifted by {:+.3} m to the tie-on MD", s.md_offset_m)
+        }
+    );
+    let _ = writeln!(
+        out,
+        "uncertainty: the probe's station sigmas (azimuth a random walk from the tie-in, inclination \
+         re-levelled per station) and the depth log's scale and stretch (DSFS, DSTG); angles 1-sigma; \
+         ellipse at {:.1} % (k = {:.4})",
+        100.0 * confidence,
+        scale_2d(confidence)
+    );
+    let _ =
+        writeln!(
+        out,
+        "{:>3} {:>9} {:>15} {:>16} {:>16} {:>9} {:>9} {:>9} {:>6} {:>6} {:>6} {:>7} {:>7} {:>5}",
+        "st", "MD m", "inc deg", "azi deg", "tf deg", "TVD m", "N m", "E m", "sN m", "sE m", "sV m",
+        "major m", "minor m", "az"
+    );
+    for r in &s.rows {
+        let _ = writeln!(out, "{}", line(r, confidence));
+    }
+    if let Some(u) = s.rows.iter().find(|r| !r.position_determined) {
+        let _ = writeln!(
+            out,
+            "note: azimuth undetermined from station {} (MD {:.2} m) on: no position from there on",
+            u.survey.station, u.row.md_m
+        );
+    }
+    for k in &s.skipped {
+        let _ = writeln!(out, "skipped station {}: {}", k.survey.station, k.reason);
+    }
+    out
+}
+
+fn line(r: &DrillingRow, confidence: f64) -> String {
+    let sd = r.survey.angles_std.map(f64::from);
+    let azi = if r.azimuth_determined {
+        angle(r.row.azi_deg, sd[1])
+    } else {
+        "undetermined".into()
+    };
+    let tf = match r.row.input.toolface_deg {
+        Some(tf) if sd[2].is_finite() => angle(tf, sd[2]),
+        _ => "n/a".into(),
+    };
+    let mut text = format!(
+        "{:>3} {:>9.2} {:>15} {:>16} {:>16}",
+        r.survey.station,
+        r.row.md_m,
+        angle(r.row.inc_deg, sd[0]),
+        azi,
+        tf
+    );
+    match (r.position_determined, r.row.cov, r.row.ellipse()) {
+        (true, Some(c), Some(e)) => {
+            let (a, b) = e.scaled(confidence);
+            let _ = write!(
+                text,
+                " {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2} {:>7.2} {:>5.1}",
+                r.row.tvd_m,
+                r.row.north_m,
+                r.row.east_m,
+                c[0].max(0.0).sqrt(),
+                c[1].max(0.0).sqrt(),
+                e.sigma_vert,
+                a,
+                b,
+                e.azimuth_deg
+            );
+        }
+        _ => text += "  position undetermined",
+    }
+    text
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |v| v.to_string())
+}
+
+/// Position columns, empty where undetermined.
+fn position_cells(row: &super::Row, determined: bool, confidence: f64) -> String {
+    match (determined, row.cov, row.ellipse()) {
+        (true, Some(c), Some(e)) => {
+            let (a, b) = e.scaled(confidence);
+            format!(
+                "{},{},{},{},{},{},{a},{b},{}",
+                row.tvd_m,
+                row.north_m,
+                row.east_m,
+                c[0].max(0.0).sqrt(),
+                c[1].max(0.0).sqrt(),
+                e.sigma_vert,
+                e.azimuth_deg
+            )
+        }
+        _ => ",,,,,,,,".into(),
+    }
+}
+
+const POSITION_HEADER: &str = "tvd_m,north_m,east_m,sigma_north_m,sigma_east_m,sigma_vert_m,\
+ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg";
+
+/// The stations as CSV (angles in deg, sigmas 1-sigma; empty cells:
+/// undetermined).
+pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
+    let mut out = format!(
+        "station,time_s,md_m,inc_deg,sigma_inc_deg,azi_deg,sigma_azi_deg,toolface_deg,sigma_toolface_deg,\
+         corr_inc_azi,{POSITION_HEADER},confidence\n"
+    );
+    for r in &s.rows {
+        let sd = r.survey.angles_std.map(f64::from);
+        let (azi, s_azi, corr) = if r.azimuth_determined {
+            (
+                Some(r.row.azi_deg),
+                Some(sd[1].to_degrees()),
+                Some(f64::from(r.survey.correlations[0])),
+            )
+        } else {
+            (None, None, None)
+        };
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{},{},{confidence}",
+            r.survey.station,
+            r.time_s,
+            r.row.md_m,
+            r.row.inc_deg,
+            sd[0].to_degrees(),
+            opt(azi),
+            opt(s_azi),
+            opt(r.row.input.toolface_deg),
+            sd[2].to_degrees(),
+            opt(corr.filter(|c| c.is_finite())),
+            position_cells(&r.row, r.position_determined, confidence)
+        );
+    }
+    out
+}
+
+/// The continuous trajectory as CSV.
+pub fn trajectory_csv(points: &[TrajectoryPoint], confidence: f64) -> String {
+    let mut out = format!(
+        "md_m,time_s,inc_deg,sigma_inc_deg,azi_deg,sigma_azi_deg,{POSITION_HEADER},confidence\n"
+    );
+    for p in points {
+        let (azi, s_azi) = if p.azimuth_determined {
+            (Some(p.row.azi_deg), Some(p.sigma_azi.to_degrees()))
+        } else {
+            (None, None)
+        };
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{confidence}",
+            p.row.md_m,
+            p.time_s,
+            p.row.inc_deg,
+            p.sigma_inc.to_degrees(),
+            opt(azi),
+            opt(s_azi),
+            position_cells(&p.row, p.position_determined, confidence)
+        );
+    }
+    out
+}

@@ -1,0 +1,333 @@
+//! `host-sim survey CAPTURE.bin --depth DEPTH.csv` and `host-sim study
+//! drilling-coverage`: station surveys paired with the depth log and
+//! positioned (synthetic stations with known answers; a simulated short
+//! lateral against its truth file), bad depth logs refused, and the
+//! coverage study's harness.
+mod common;
+
+use common::{run, s, scratch};
+use host_sim::survey_error::Site;
+use host_sim::survey_listing::depth_log::DepthLog;
+use host_sim::survey_listing::drilling::{depth_terms, survey};
+use host_sim::survey_listing::drilling_text::listing;
+use host_sim::survey_listing::TieOnInput;
+use mwd_core::protocol::frame::station_flags;
+use mwd_core::protocol::StationSurvey;
+use std::path::{Path, PathBuf};
+
+fn site() -> Site {
+    Site {
+        gravity: 9.806_65,
+        b_total: 0.0,
+        dip: 0.0,
+        declination: 0.0,
+        vertical_limit: 1e-4f64.to_radians(),
+        latitude: 45f64.to_radians(),
+        gyro_noise_reduction: 1.0,
+    }
+}
+
+/// A horizontal station heading east at time `t` s with azimuth sigma
+/// `s_azi` deg.
+fn station(number: u16, t: f64, s_azi: f64) -> StationSurvey {
+    StationSurvey {
+        time_us: (t * 1e6) as u64,
+        station: number,
+        flags: station_flags::MAGNETIC_FREE,
+        start_sample: 0,
+        end_sample: (t * 20.0) as u32,
+        angles: [90f32.to_radians(), 90f32.to_radians(), 0.0],
+        angles_std: [
+            0.05f32.to_radians(),
+            (s_azi as f32).to_radians(),
+            0.05f32.to_radians(),
+        ],
+        correlations: [0.0; 3],
+        still_quality: 1.0,
+    }
+}
+
+fn log() -> DepthLog {
+    // still at 1000 m to 100 s, then 10 m per stand, still at each
+    let points = [
+        (0.0, 1000.0),
+        (100.0, 1000.0),
+        (150.0, 1010.0),
+        (200.0, 1010.0),
+        (250.0, 1020.0),
+        (300.0, 1020.0),
+        (350.0, 1030.0),
+        (400.0, 1030.0),
+    ];
+    DepthLog::new(points).unwrap()
+}
+
+const TIE: TieOnInput = TieOnInput {
+    md: None,
+    tvd: 2000.0,
+    north: 0.0,
+    east: 0.0,
+};
+
+#[test]
+fn synthetic_stations_are_positioned_with_the_random_walk_and_depth_uncertainty() {
+    let sig = [0.1, 0.2, 0.3, 0.4];
+    let stations: Vec<StationSurvey> = (0..4)
+        .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, sig[k]))
+        .collect();
+    let terms = depth_terms().unwrap();
+    let out = survey(&stations, &log(), TIE, &terms, &site()).unwrap();
+    assert_eq!(out.rows.len(), 4);
+    for (k, r) in out.rows.iter().enumerate() {
+        assert!((r.row.md_m - (1000.0 + 10.0 * k as f64)).abs() < 1e-9);
+        // the frame's angles are f32: 90 deg is pi/2 to 4e-8 rad
+        assert!((r.row.east_m - 10.0 * k as f64).abs() < 1e-6);
+        assert!(r.row.north_m.abs() < 1e-5 && (r.row.tvd_m - 2000.0).abs() < 1e-5);
+        assert!(r.position_determined);
+    }
+    // north (across the hole): the azimuth random walk, by hand:
+    // sum_jk h_j h_k min(s_j^2, s_k^2), h = half the legs around each
+    let h = [5.0, 10.0, 10.0, 5.0];
+    let s2 = sig.map(|s: f64| s.to_radians().powi(2));
+    let mut var_n = 0.0;
+    for j in 0..4 {
+        for k in 0..4 {
+            var_n += h[j] * h[k] * s2[j].min(s2[k]);
+        }
+    }
+    let c = out.rows[3].row.cov.unwrap();
+    // (the frame's sigmas are f32: 1e-7 relative)
+    assert!((c[0] - var_n).abs() < 1e-6 * var_n, "{} vs {var_n}", c[0]);
+    // east (along the hole): depth scale and stretch on the 30 m drilled,
+    // MD counted from the tie-on (DSFS 560 ppm, DSTG 2.5e-7 /m)
+    let var_e = (560e-6 * 30.0f64).powi(2) + (2.5e-7 * 30.0 * 2000.0f64).powi(2);
+    assert!((c[1] - var_e).abs() < 1e-6 * var_e, "{} vs {var_e}", c[1]);
+    // vertical: the inclination, random per station
+    let var_v = 0.05f64.to_radians().powi(2) * h.iter().map(|x| x * x).sum::<f64>();
+    assert!((c[2] - var_v).abs() < 1e-6 * var_v);
+}
+
+#[test]
+fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
+    let mut stations: Vec<StationSurvey> = (0..4)
+        .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, 0.2))
+        .collect();
+    stations[2].flags |= station_flags::AZIMUTH_UNDETERMINED;
+    stations[2].angles_std[1] = f32::INFINITY;
+    let terms = depth_terms().unwrap();
+    let out = survey(&stations, &log(), TIE, &terms, &site()).unwrap();
+    let determined: Vec<bool> = out.rows.iter().map(|r| r.position_determined).collect();
+    assert_eq!(determined, [true, true, false, false]);
+    assert!(out.rows[3].azimuth_determined && out.rows[3].row.cov.is_none());
+    let text = listing(&out, 0.95);
+    let lines: Vec<&str> = text.lines().filter(|l| l.contains("  1030.00")).collect();
+    assert_eq!(lines.len(), 1, "{text}");
+    assert!(lines[0].contains("position undetermined"), "{text}");
+    assert!(text.contains("undetermined from station 3"), "{text}");
+    // an invalid station is skipped, with its reason
+    stations[1].flags |= station_flags::SOLUTION_INVALID;
+    let out = survey(&stations, &log(), TIE, &terms, &site()).unwrap();
+    assert_eq!(out.rows.len(), 3);
+    assert!(out.skipped[0].reason.contains("invalid"));
+}
+
+#[test]
+fn a_station_outside_the_log_or_a_log_that_is_not_one_is_refused() {
+    let terms = depth_terms().unwrap();
+    let late = [station(1, 100.0, 0.1), station(2, 500.0, 0.1)];
+    let err = survey(&late, &log(), TIE, &terms, &site()).unwrap_err();
+    assert!(
+        format!("{err:#}").contains("outside the depth log"),
+        "{err:#}"
+    );
+    for bad in [
+        "",
+        "md_m,inc_deg,azi_deg\n0,1,2\n",
+        "time_s,md_m\n5,1\n4,2\n",
+    ] {
+        assert!(DepthLog::read(bad.as_bytes()).is_err(), "{bad:?}");
+    }
+}
+
+fn plan(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/plans")
+        .join(name)
+}
+
+/// CSV text as rows of named cells.
+fn table(text: &str) -> Vec<std::collections::HashMap<String, String>> {
+    let mut lines = text.lines();
+    let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            head.iter()
+                .cloned()
+                .zip(l.split(',').map(String::from))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(row: &std::collections::HashMap<String, String>, key: &str) -> Option<f64> {
+    row.get(key).and_then(|v| v.parse().ok())
+}
+
+#[test]
+fn a_simulated_short_lateral_is_surveyed_against_its_truth() {
+    let dir = scratch("drilling-survey", "short");
+    let (bin, truth, depth) = (
+        dir.join("run.bin"),
+        dir.join("truth.csv"),
+        dir.join("depth.csv"),
+    );
+    let sim = run(&[
+        "simulate",
+        "--motion",
+        "lateral",
+        "--plan",
+        s(&plan("qemu-short.json")),
+        "--seed",
+        "5",
+        "-o",
+        s(&bin),
+        "--truth",
+        s(&truth),
+        "--truth-every",
+        "1",
+        "--depth-log",
+        s(&depth),
+    ]);
+    assert_eq!(sim.code, Some(0), "{}", sim.stderr);
+    let (csv, traj) = (dir.join("stations.csv"), dir.join("trajectory.csv"));
+    let out = run(&[
+        "survey",
+        s(&bin),
+        "--depth",
+        s(&depth),
+        "--tie-on-md",
+        "3000",
+        "--tie-on-tvd",
+        "2450",
+        "--tie-on-north",
+        "420",
+        "--tie-on-east",
+        "310",
+        "--csv",
+        s(&csv),
+        "--trajectory",
+        s(&traj),
+    ]);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let truth = table(&std::fs::read_to_string(&truth).unwrap());
+    let stations = table(&std::fs::read_to_string(&csv).unwrap());
+    assert!(!stations.is_empty(), "{}", out.stdout);
+    let truth_at = |t: f64| {
+        truth
+            .iter()
+            .min_by(|a, b| {
+                let d = |r: &std::collections::HashMap<String, String>| {
+                    (num(r, "time_s").unwrap() - t).abs()
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    for st in &stations {
+        let t = num(st, "time_s").unwrap();
+        let tr = truth_at(t);
+        // MD: the log referenced to the tie-on; its scale and stretch over
+        // the 3 m drilled are millimetres
+        let md = num(st, "md_m").unwrap();
+        assert!(
+            (md - num(tr, "md_m").unwrap()).abs() < 0.02,
+            "{st:?} vs {tr:?}"
+        );
+        assert!(num(st, "sigma_inc_deg").unwrap() > 0.0);
+        match num(st, "azi_deg") {
+            // positioned: within 5 sigma of the truth on each axis
+            Some(_) if num(st, "north_m").is_some() => {
+                for (k, sk) in [("north_m", "sigma_north_m"), ("east_m", "sigma_east_m")] {
+                    let (v, sig) = (num(st, k).unwrap(), num(st, sk).unwrap());
+                    assert!(
+                        (v - num(tr, k).unwrap()).abs() <= 5.0 * sig + 1e-6,
+                        "{k}: {st:?}"
+                    );
+                }
+            }
+            // no azimuth, no position: empty cells, never a number
+            _ => assert!(num(st, "north_m").is_none() && num(st, "sigma_north_m").is_none()),
+        }
+    }
+    let points = table(&std::fs::read_to_string(&traj).unwrap());
+    let mds: Vec<f64> = points.iter().map(|p| num(p, "md_m").unwrap()).collect();
+    assert!(mds.len() >= 3, "{mds:?}");
+    assert!(
+        mds.windows(2).all(|w| (w[1] - w[0] - 1.0).abs() < 1e-9),
+        "{mds:?}"
+    );
+    // a depth log that does not cover the capture: a clear error
+    let short = dir.join("short-log.csv");
+    std::fs::write(&short, "time_s,md_m\n0,3000\n10,3000\n").unwrap();
+    let bad = run(&["survey", s(&bin), "--depth", s(&short)]);
+    assert_eq!(bad.code, Some(1), "{}", bad.stderr);
+    assert!(
+        bad.stderr.contains("outside the depth log"),
+        "{}",
+        bad.stderr
+    );
+    // a station file is not a depth log
+    let stations_file = dir.join("stations-in.csv");
+    std::fs::write(&stations_file, "md_m,inc_deg,azi_deg\n3000,90,120\n").unwrap();
+    let bad = run(&["survey", s(&bin), "--depth", s(&stations_file)]);
+    assert_eq!(bad.code, Some(1), "{}", bad.stderr);
+    assert!(bad.stderr.contains("not a depth log"), "{}", bad.stderr);
+    assert!(!bad.stderr.contains("panicked"));
+}
+
+#[test]
+fn the_coverage_study_harness_runs_a_short_plan() {
+    let dir = scratch("drilling-survey", "study");
+    let json = dir.join("study.json");
+    let out = run(&[
+        "study",
+        "drilling-coverage",
+        "--plan",
+        s(&plan("qemu-short.json")),
+        "--runs",
+        "12",
+        "--json",
+        s(&json),
+    ]);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    assert!(
+        out.stdout.contains("azimuth within 2 sigma"),
+        "{}",
+        out.stdout
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["runs"], 12);
+    assert_eq!(v["failed_runs"].as_array().unwrap().len(), 0, "{v}");
+    // every run surveys the window and the stand's end at least
+    assert!(v["stations"].as_u64().unwrap() >= 24, "{v}");
+    for key in [
+        "azimuth_within_2_sigma",
+        "inclination_within_2_sigma",
+        "toolface_within_2_sigma",
+    ] {
+        let f = &v[key];
+        let (inside, total) = (f["inside"].as_u64().unwrap(), f["total"].as_u64().unwrap());
+        assert!(total > 0 && inside <= total, "{key}: {f}");
+        let p = f["fraction"].as_f64().unwrap();
+        assert!((p - inside as f64 / total as f64).abs() < 1e-12);
+    }
+    let td = v["td_inside_95_ellipse"]["total"].as_u64().unwrap();
+    let unchecked: u64 = v["td_unchecked"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x[1].as_u64().unwrap())
+        .sum();
+    assert_eq!(td + unchecked, 12, "{v}");
+}
