@@ -96,6 +96,11 @@ impl InboxReader<'_> {
         self.consumer.dequeue()
     }
 
+    /// Bytes waiting.
+    pub fn pending(&self) -> usize {
+        self.consumer.len()
+    }
+
     /// Bytes dropped because the queue was full.
     pub fn overflowed(&self) -> u32 {
         self.overflowed.load(Ordering::Relaxed)
