@@ -215,3 +215,58 @@ fn the_longest_command_fits_its_buffer() {
     assert_eq!(MAX_COMMAND_BODY_LEN, 121);
     assert_eq!(MAX_COMMAND_WIRE_LEN, 124);
 }
+
+fn hex(bytes: &[u8]) -> String {
+    bytes
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `docs/protocol.md`'s uplink examples are the bytes this code makes, and
+/// decode to what the document says they are.
+#[test]
+fn the_document_shows_the_current_uplink_bytes() {
+    use mwd_core::protocol::example;
+    use mwd_core::protocol::uplink::reply::encode_reply;
+    use mwd_core::protocol::uplink::{CommandKind, Field, Received};
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md"))
+        .expect("docs/protocol.md");
+    let uplink = &doc[doc.find("## Uplink").expect("an Uplink section")..];
+    let seq = example::EXAMPLE_COMMAND_SEQ;
+    let command = example::set_site_command();
+    let mut body = [0u8; MAX_COMMAND_BODY_LEN];
+    let n = encode_command_body(seq, &command, &mut body).unwrap();
+    let mut wire = [0u8; MAX_COMMAND_WIRE_LEN];
+    let w = encode_command(seq, &command, &mut wire).unwrap();
+    for text in [hex(&body[..n]), hex(&wire[..w])] {
+        assert!(uplink.contains(&text), "docs/protocol.md lacks {text}");
+    }
+    assert_eq!(
+        decode_command(&wire_to_body(&wire[..w])),
+        Ok(Received {
+            seq: 7,
+            command: Command::SetSite(Position::from_degrees(45.777_55, 126.687_898, 124.0))
+        })
+    );
+    for reply in [example::ack_reply(), example::nak_reply()] {
+        let mut body = [0u8; REPLY_BODY_LEN];
+        let n = encode_reply_body(example::EXAMPLE_SEQ, &reply, &mut body).unwrap();
+        let mut wire = [0u8; 32];
+        let w = encode_reply(example::EXAMPLE_SEQ, &reply, &mut wire).unwrap();
+        for text in [hex(&body[..n]), hex(&wire[..w])] {
+            assert!(uplink.contains(&text), "docs/protocol.md lacks {text}");
+        }
+    }
+    // The tables name every kind and the codes the examples use.
+    for kind in CommandKind::ALL {
+        let row = format!("| {:#04x} |", kind as u8);
+        assert!(uplink.contains(&row), "no row for kind {row}");
+    }
+    assert_eq!(Field::ZStay as u8, 0x10);
+    assert!(uplink.contains("detail 0x10 (field 16, z_stay)"));
+    assert!(uplink.contains("16 z_stay"));
+    assert_eq!(NakReason::OutOfRange.to_byte(), 4);
+    assert!(uplink.contains("4 out of range"));
+}
