@@ -171,20 +171,25 @@ pub fn read_tie_in(r: &mut Reader) -> Result<(DrillingAngles, DrillingAngles), R
     Ok((angles, sigma))
 }
 
-/// Largest accelerometer bias accepted (m/s^2), 0.1 g: far beyond the
-/// residual offset of a working part; a larger one is a wrong calibration
-/// (or a wrong unit), which would bias every tilt.
-pub const MAX_ACCEL_BIAS_M_S2: f64 = 0.1 * crate::sensor_units::STANDARD_GRAVITY;
-/// Diagonal of the accelerometer correction `M = K^-1` (scale factor):
-/// within 10 % of 1.
-pub const ACCEL_CORRECTION_DIAGONAL: (f64, f64) = (0.9, 1.1);
-/// Off-diagonal of `M` (misalignment, rad): at most 0.05, 2.9 deg.
-pub const MAX_ACCEL_CORRECTION_OFF_DIAGONAL: f64 = 0.05;
-/// Largest gyro bias accepted (rad/s), 5 deg/s: beyond it the gyro is
-/// broken or the number is in the wrong unit.
-pub const MAX_GYRO_BIAS_RAD_S: f64 = 5.0 * crate::conventions::DEG;
-/// The gyro scale factor: within 10 % of 1.
-pub const GYRO_SCALE: (f64, f64) = (0.9, 1.1);
+// The calibration's ranges are the host's calibration-file limits
+// (`host_sim::analysis::calibration_file::limits`), so that every file the
+// host accepts, the probe accepts: physical bounds far beyond a working
+// SCC1300's errors, beyond which a number is a unit mistake or a failed
+// fit, never a calibration.
+
+/// Largest accelerometer bias accepted (m/s^2): 1 g (the part's offset is
+/// tens of mg).
+pub const MAX_ACCEL_BIAS_M_S2: f64 = crate::sensor_units::STANDARD_GRAVITY;
+/// Diagonal of the accelerometer correction `M = K^-1`: the inverse of a
+/// scale factor, 0.5 to 2.
+pub const ACCEL_CORRECTION_DIAGONAL: (f64, f64) = (0.5, 2.0);
+/// Off-diagonal of `M`: cross-coupling up to 0.2 (11 deg of misalignment).
+pub const MAX_ACCEL_CORRECTION_OFF_DIAGONAL: f64 = 0.2;
+/// Largest gyro bias accepted (rad/s): 10 deg/s (more is deg/s written as
+/// rad/s, or a broken gyro).
+pub const MAX_GYRO_BIAS_RAD_S: f64 = 10.0 * crate::conventions::DEG;
+/// The gyro scale factor: 0.5 to 2 (the part's error is a few %).
+pub const GYRO_SCALE: (f64, f64) = (0.5, 2.0);
 
 /// A part's calibration: accelerometer bias f64 x3 (m/s^2), correction
 /// f64 x9 (row-major), gyro bias f64 (rad/s), gyro scale f64.

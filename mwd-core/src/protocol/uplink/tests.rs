@@ -173,22 +173,22 @@ fn each_out_of_range_field_is_named() {
         (tie_in, 24, 0.0, K::SetTieIn, Field::InclinationSigma),
         (tie_in, 32, -1.0, K::SetTieIn, Field::AzimuthSigma),
         (tie_in, 40, 4.0, K::SetTieIn, Field::ToolfaceSigma),
-        (calibration, 1, 1.0, K::SetCalibration, Field::AccelBias),
+        (calibration, 1, 10.0, K::SetCalibration, Field::AccelBias),
         (
             calibration,
             25,
-            0.5,
+            0.4,
             K::SetCalibration,
             Field::AccelCorrection,
         ),
         (
             calibration,
             33,
-            0.06,
+            0.25,
             K::SetCalibration,
             Field::AccelCorrection,
         ),
-        (calibration, 97, 0.1, K::SetCalibration, Field::GyroBias),
+        (calibration, 97, 0.2, K::SetCalibration, Field::GyroBias),
         (calibration, 105, 0.0, K::SetCalibration, Field::GyroScale),
     ];
     for (command, at, value, kind, field) in cases {
