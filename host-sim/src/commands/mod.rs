@@ -24,6 +24,7 @@ mod limits;
 mod observability;
 mod paper;
 mod paper_mgwd;
+mod probe;
 mod replay;
 mod simulate;
 mod site;
@@ -61,6 +62,9 @@ pub enum Command {
     /// Survey stations (CSV): positions by minimum curvature, ISCWSA
     /// uncertainty and error ellipses; listing, CSV, JSON, WITSML exports.
     Survey(survey::Args),
+    /// Commands to a live probe over its serial port: configure (a job
+    /// file), status, align, station, reboot.
+    Probe(probe::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
@@ -110,6 +114,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Calibrate(args) => done(calibrate::run(args)),
         Command::Observability(args) => done(observability::run(args)),
         Command::Survey(args) => done(survey::run(args)),
+        Command::Probe(args) => done(probe::run(args)),
         Command::Paper(cmd) => done(paper::run(cmd)),
     }
 }

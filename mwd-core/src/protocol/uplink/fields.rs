@@ -46,6 +46,35 @@ pub enum Field {
 }
 
 impl Field {
+    pub const ALL: [Field; 21] = [
+        Field::Latitude,
+        Field::Longitude,
+        Field::Height,
+        Field::Inclination,
+        Field::Azimuth,
+        Field::Toolface,
+        Field::InclinationSigma,
+        Field::AzimuthSigma,
+        Field::ToolfaceSigma,
+        Field::Part,
+        Field::AccelBias,
+        Field::AccelCorrection,
+        Field::GyroBias,
+        Field::GyroScale,
+        Field::ZEnter,
+        Field::ZStay,
+        Field::EnterEpochs,
+        Field::MaxStationSamples,
+        Field::ZuptVelocitySigma,
+        Field::IndexPositions,
+        Field::IndexDwell,
+    ];
+
+    /// The field of a NAK's detail code.
+    pub fn from_byte(code: u8) -> Option<Self> {
+        Self::ALL.into_iter().find(|f| *f as u8 == code)
+    }
+
     /// The field's name as `docs/protocol.md` writes it.
     pub fn name(self) -> &'static str {
         match self {

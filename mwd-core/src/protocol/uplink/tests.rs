@@ -280,6 +280,16 @@ fn integer_and_cross_field_ranges() {
 }
 
 #[test]
+fn field_codes_are_one_to_twenty_one() {
+    for (i, field) in Field::ALL.iter().enumerate() {
+        assert_eq!(*field as usize, i + 1);
+        assert_eq!(Field::from_byte(i as u8 + 1), Some(*field));
+    }
+    assert_eq!(Field::from_byte(0), None);
+    assert_eq!(Field::from_byte(22), None);
+}
+
+#[test]
 fn a_nak_quotes_the_command_and_the_field() {
     let err = UplinkError::OutOfRange {
         seq: 8,
