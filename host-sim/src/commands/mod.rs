@@ -63,7 +63,7 @@ pub enum Command {
     /// uncertainty and error ellipses; listing, CSV, JSON, WITSML exports.
     Survey(survey::Args),
     /// Commands to a live probe over its serial port: configure (a job
-    /// file), status, align, station, reboot.
+    /// file), status, align, station, index, reboot.
     Probe(probe::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]

@@ -1,4 +1,4 @@
-//! `host-sim probe configure | status | align | station | reboot`: commands
+//! `host-sim probe configure | status | align | station | index | reboot`: commands
 //! to a live probe over its serial port (`docs/protocol.md`, "Uplink").
 //! Each command is sent and its reply awaited among the probe's telemetry
 //! (`Decoder::unknown_body`, `decode_reply_body`), matched by sequence
@@ -8,9 +8,11 @@
 
 use anyhow::{bail, Context, Result};
 use host_sim::job::Job;
+use mwd_core::protocol::uplink::fields::{INDEX_DWELL_S, INDEX_POSITIONS};
 use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::{
-    encode_command, Command, Field, NakReason, Reply, ReplyStatus, MAX_COMMAND_WIRE_LEN,
+    encode_command, Command, Field, IndexingProcedure, NakReason, Reply, ReplyStatus,
+    MAX_COMMAND_WIRE_LEN,
 };
 use mwd_core::protocol::Decoder;
 use std::io::{ErrorKind, Read, Write};
@@ -40,6 +42,20 @@ enum Action {
     Align(LinkArgs),
     /// Take a station survey now (the probe must be still).
     Station(LinkArgs),
+    /// Start the guided toolface-indexing procedure: the probe reports
+    /// each dwell it detects.
+    Index {
+        /// Toolface positions to visit (2 to 36).
+        #[arg(long, value_parser = clap::value_parser!(u8)
+            .range(INDEX_POSITIONS.0 as i64..=INDEX_POSITIONS.1 as i64))]
+        positions: u8,
+        /// Seconds to hold each position (3 to 600).
+        #[arg(long, value_parser = clap::value_parser!(u16)
+            .range(INDEX_DWELL_S.0 as i64..=INDEX_DWELL_S.1 as i64))]
+        dwell_s: u16,
+        #[command(flatten)]
+        link: LinkArgs,
+    },
     /// Reboot the probe.
     Reboot(LinkArgs),
 }
@@ -73,6 +89,17 @@ pub fn run(args: Args) -> Result<()> {
         ),
         Action::Align(link) => (link, vec![("re-align".into(), Command::Realign)]),
         Action::Station(link) => (link, vec![("take a station".into(), Command::TakeStation)]),
+        Action::Index {
+            positions,
+            dwell_s,
+            link,
+        } => (
+            link,
+            vec![(
+                format!("toolface indexing, {positions} positions of {dwell_s} s"),
+                Command::IndexToolface(IndexingProcedure { positions, dwell_s }),
+            )],
+        ),
         Action::Reboot(link) => (link, vec![("reboot".into(), Command::Reboot)]),
     };
     let port = serialport::new(&link.port, link.baud)
