@@ -24,8 +24,8 @@ fn wire(seq: u16, command: &Command) -> Vec<u8> {
 }
 
 /// Non-empty runs between zeros: the chunks a receiver must count.
-fn chunks_in(bytes: &[u8]) -> u32 {
-    bytes.split(|b| *b == 0).filter(|c| !c.is_empty()).count() as u32
+fn chunks_in(bytes: &[u8]) -> u64 {
+    bytes.split(|b| *b == 0).filter(|c| !c.is_empty()).count() as u64
 }
 
 /// A random string: garbage with some zeros, or a body with a good CRC
@@ -77,7 +77,7 @@ fn a_hundred_thousand_random_strings_neither_crash_nor_wedge_it() {
     let (mut isr, mut main_loop) = inbox.split();
     let mut rx = UplinkReceiver::new();
     let mut config = ProbeConfig::default();
-    let mut expected_chunks = 0u32;
+    let mut expected_chunks = 0u64;
     let (mut answered, mut oversized_strings) = (0u32, 0u32);
     for i in 0..100_000u32 {
         let garbage = random_string(&mut rng);

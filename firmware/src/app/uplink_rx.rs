@@ -108,7 +108,8 @@ impl InboxReader<'_> {
 }
 
 /// What the receiver has seen. Every non-empty chunk between delimiters is
-/// counted once, in one of `frames_ok` .. `out_of_range` ([`Self::chunks`]).
+/// counted once, in one of `frames_ok` .. `out_of_range` ([`Self::chunks`]);
+/// the counters saturate (4e9 chunks) rather than wrap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct UplinkStats {
     /// Bytes taken from the inbox.
@@ -130,13 +131,18 @@ pub struct UplinkStats {
 
 impl UplinkStats {
     /// Chunks seen: the sum of the per-outcome counters.
-    pub fn chunks(&self) -> u32 {
-        self.frames_ok
-            + self.crc_failures
-            + self.malformed
-            + self.oversized
-            + self.unknown
-            + self.out_of_range
+    pub fn chunks(&self) -> u64 {
+        [
+            self.frames_ok,
+            self.crc_failures,
+            self.malformed,
+            self.oversized,
+            self.unknown,
+            self.out_of_range,
+        ]
+        .iter()
+        .map(|n| u64::from(*n))
+        .sum()
     }
 }
 
@@ -220,7 +226,7 @@ impl UplinkReceiver {
             return None; // Between two delimiters.
         }
         if self.oversized {
-            s.oversized += 1;
+            s.oversized = s.oversized.saturating_add(1);
             return None;
         }
         let decoded = self
@@ -243,7 +249,8 @@ impl UplinkReceiver {
             ))
             | None => &mut s.malformed,
         };
-        *counter += 1;
+        // Saturating: a counter stuck at its limit, never a panic.
+        *counter = counter.saturating_add(1);
         decoded.filter(|d| {
             d.as_ref()
                 .map_or_else(|e| e.addressed().is_some(), |_| true)
