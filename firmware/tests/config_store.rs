@@ -207,3 +207,48 @@ fn a_region_that_does_not_fit_is_refused() {
         Err(StoreError::Geometry)
     ));
 }
+
+/// The whole probe side without the board: command bytes through the
+/// receive queue and the receiver, applied and stored before their ACK;
+/// after a reboot (a new store on the same flash) the configuration is
+/// back, and the loader says it came from a slot.
+#[test]
+fn configured_over_the_uplink_then_rebooted_the_configuration_persists() {
+    use firmware::app::uplink_rx::{apply, UplinkInbox, UplinkReceiver};
+    use mwd_core::protocol::uplink::{encode_command, ReplyStatus, MAX_COMMAND_WIRE_LEN};
+    let mut store = ConfigStore::new(MemFlash::new(2 * ERASE), 0).unwrap();
+    let mut config = store.load().config;
+    let mut inbox = UplinkInbox::new();
+    let (mut isr, mut main_loop) = inbox.split();
+    let mut rx = UplinkReceiver::new();
+    let site = Position::from_degrees(-33.9, 18.4, 40.0);
+    let commands = [Command::SetSite(site), Command::ClearTieIn, Command::Reboot];
+    let mut replies = Vec::new();
+    for (seq, command) in commands.iter().enumerate() {
+        let mut wire = [0u8; MAX_COMMAND_WIRE_LEN];
+        let n = encode_command(seq as u16, command, &mut wire).unwrap();
+        wire[..n].iter().for_each(|b| isr.push(*b));
+        let decoded = rx.poll(&mut main_loop, 512).expect("a command");
+        let outcome = apply(&decoded, &mut config, 0, true, |c| {
+            store.save(c).map(|_| ())
+        });
+        replies.push(outcome.expect("answered"));
+    }
+    assert!(replies.iter().all(|o| o.reply.status == ReplyStatus::Ack));
+    assert_eq!(replies[0].reply.config_version, 1);
+    assert_eq!(
+        replies[2].action,
+        Some(firmware::app::uplink_rx::Action::Reboot)
+    );
+    let flash = store.into_inner();
+    let loaded = ConfigStore::new(flash, 0).unwrap().load();
+    assert_eq!(
+        loaded.source,
+        LoadSource::Slot {
+            index: 0,
+            version: 1
+        }
+    );
+    assert_eq!(loaded.config.site, site);
+    assert_eq!(loaded.config, config);
+}

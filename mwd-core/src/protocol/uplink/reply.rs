@@ -13,7 +13,7 @@
 use super::super::bytes::{OutOfRoom, Reader, Writer};
 use super::super::codec::{open_body, seal_body, FrameError};
 use super::super::frame::{CRC_LEN, HEADER_LEN, PROTOCOL_VERSION};
-use super::super::wire::delimit_body;
+use super::super::wire::{delimit_body, FrameEncoder};
 use super::UplinkError;
 
 /// The downlink kind byte of a reply.
@@ -159,6 +159,18 @@ pub fn encode_reply(seq: u16, reply: &Reply, out: &mut [u8]) -> Result<usize, Ou
     let mut body = [0u8; REPLY_BODY_LEN];
     let len = encode_reply_body(seq, reply, &mut body)?;
     delimit_body(body.get(..len).ok_or(OutOfRoom)?, out)
+}
+
+impl FrameEncoder {
+    /// Encodes a reply with the next downlink sequence number (the one
+    /// counter across all kinds, so the host counts every loss) and uses
+    /// it up; on error (buffer too small) the number is not used up.
+    pub fn encode_reply(&mut self, reply: &Reply, out: &mut [u8]) -> Result<usize, OutOfRoom> {
+        let seq = self.next_seq();
+        let n = encode_reply(seq, reply, out)?;
+        *self = FrameEncoder::starting_at(seq.wrapping_add(1));
+        Ok(n)
+    }
 }
 
 /// Checks and parses a reply body: its downlink sequence number and the

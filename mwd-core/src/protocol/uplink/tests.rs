@@ -323,8 +323,11 @@ fn replies_round_trip_and_old_decoders_skip_them() {
             Ok((enc.next_seq(), reply))
         );
         let mut wire = [0u8; 32];
-        let w = reply::encode_reply(enc.next_seq(), &reply, &mut wire).unwrap();
-        assert_eq!(w, 28);
+        let seq = enc.next_seq();
+        assert!(enc.encode_reply(&reply, &mut wire[..20]).is_err());
+        assert_eq!(enc.next_seq(), seq, "not used up on error");
+        let w = enc.encode_reply(&reply, &mut wire).unwrap();
+        assert_eq!((w, enc.next_seq()), (28, seq.wrapping_add(1)));
         let mut read_back = None;
         for b in &wire[..w] {
             assert_eq!(dec.push(*b), None, "not a telemetry frame");
@@ -332,11 +335,15 @@ fn replies_round_trip_and_old_decoders_skip_them() {
                 read_back = Some(reply::decode_reply_body(body));
             }
         }
-        assert_eq!(read_back, Some(Ok((enc.next_seq(), reply))));
-        // Numbered in the downlink's one sequence: the next telemetry
-        // frame after it is not counted as a loss.
-        let _ = enc.encode(&super::super::example::boot_event(), &mut [0u8; 64]);
+        assert_eq!(read_back, Some(Ok((seq, reply))));
     }
+    // Numbered in the downlink's one sequence: a telemetry frame after
+    // the replies is not counted as a loss.
+    let mut wire = [0u8; 64];
+    let w = enc
+        .encode(&super::super::example::boot_event(), &mut wire)
+        .unwrap();
+    dec.feed(&wire[..w], |_| {});
     let s = dec.stats();
     assert_eq!((s.unknown_kind, s.corrupt(), s.lost), (2, 0, 0));
     // Every status byte survives (unknown NAK reasons are kept).
