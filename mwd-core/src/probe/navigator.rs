@@ -39,10 +39,10 @@
 //! bit for bit.
 
 use super::raw::{reading, Reading};
-use super::station::{angle_uncertainty, angles_and_jacobian};
-use super::still::StillDetector;
 use super::tie_in::TieIn;
 use crate::aid_sources::{NonHolonomic, DRILLING_VARIANCE};
+use super::station::{angle_uncertainty, angles_and_jacobian};
+use super::still::StillDetector;
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
 use crate::calibration::ProbeCalibration;

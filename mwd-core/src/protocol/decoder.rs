@@ -25,7 +25,8 @@ pub struct DecoderStats {
     /// Good frames by kind, indexed by `FrameKind::index`: raw sample,
     /// navigation, event, station survey.
     pub frames: [u64; FrameKind::COUNT],
-    /// Good frames with a kind this decoder does not know (newer probe).
+    /// Good frames with a kind this decoder does not know (newer probe),
+    /// and the uplink's replies (kind 5: [`Decoder::unknown_body`]).
     pub unknown_kind: u64,
     /// Chunks whose CRC failed.
     pub crc_errors: u64,
