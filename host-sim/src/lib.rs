@@ -5,6 +5,7 @@ pub mod analysis;
 pub mod capture;
 pub mod coarse;
 pub mod display;
+pub mod job;
 pub mod live;
 pub mod observability;
 pub mod paper_mgwd;

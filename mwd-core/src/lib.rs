@@ -13,7 +13,8 @@
 //! * The probe's navigation, raw sample to solution: [`probe`].
 //! * Wellbore surveys (stations, north references, minimum curvature
 //!   positions from a tie-on): [`survey`].
-//! * The wire protocol: [`protocol`].
+//! * The wire protocol: [`protocol`]; what the host configures and its
+//!   record in flash: [`config`].
 #![no_std]
 #![forbid(unsafe_code)]
 
@@ -22,6 +23,7 @@ pub mod alignment;
 pub mod ar;
 pub mod attitude;
 pub mod calibration;
+pub mod config;
 pub mod conventions;
 pub mod earth;
 pub mod error_model;

@@ -3,12 +3,15 @@
 //! and faults become frames, and the glue between the board's contexts;
 //! [`budget`] derives the worst recovery, the inbox's size and the
 //! watchdog's worst unfed stretch from the driver's waits, [`watchdog`]
-//! the watchdog's timeout from them.
+//! the watchdog's timeout from them; [`config_store`] keeps the
+//! configuration in two flash slots, [`uplink_rx`] receives the host's
+//! commands.
 //! Pure code (no registers, no heap), so the host tests it and every board
 //! binary runs the same logic; a board only supplies the timer interrupt,
 //! its UART ([`Transmitter`]), the sensors' SPI and the watchdog.
 
 pub mod budget;
+pub mod config_store;
 pub mod cycle;
 pub mod frame_queue;
 pub mod probe;
@@ -17,6 +20,7 @@ pub mod sensor_wire;
 pub mod shared;
 pub mod start_up;
 pub mod transmitter;
+pub mod uplink_rx;
 pub mod watchdog;
 
 pub use cycle::{AcquisitionCycle, CycleReport};

@@ -24,6 +24,7 @@ mod limits;
 mod observability;
 mod paper;
 mod paper_mgwd;
+mod probe;
 mod replay;
 mod simulate;
 mod site;
@@ -66,6 +67,9 @@ pub enum Command {
     /// Monte Carlo studies over simulated runs.
     #[command(subcommand)]
     Study(study::StudyCommand),
+    /// Commands to a live probe over its serial port: configure (a job
+    /// file), status, align, station, index, reboot.
+    Probe(probe::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
@@ -116,6 +120,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Observability(args) => done(observability::run(args)),
         Command::Survey(args) => done(survey::run(args)),
         Command::Study(cmd) => done(study::run(cmd)),
+        Command::Probe(args) => done(probe::run(args)),
         Command::Paper(cmd) => done(paper::run(cmd)),
     }
 }

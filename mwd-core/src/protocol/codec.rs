@@ -164,6 +164,12 @@ pub fn encode_body(seq: u16, payload: &Payload, buf: &mut [u8]) -> Result<usize,
         write_payload(&mut w, payload)?;
         w.len()
     };
+    seal_body(buf, len)
+}
+
+/// Appends the CRC-32C of `buf[..len]` after it; returns the body's length.
+/// The one sealing step of every body, downlink and uplink.
+pub fn seal_body(buf: &mut [u8], len: usize) -> Result<usize, OutOfRoom> {
     let crc = crc32c(buf.get(..len).ok_or(OutOfRoom)?);
     let end = len.checked_add(CRC_LEN).ok_or(OutOfRoom)?;
     let tail = buf.get_mut(len..end).ok_or(OutOfRoom)?;
@@ -171,8 +177,9 @@ pub fn encode_body(seq: u16, payload: &Payload, buf: &mut [u8]) -> Result<usize,
     Ok(end)
 }
 
-/// Checks and parses a frame body (COBS already removed).
-pub fn decode_body(body: &[u8]) -> Result<Frame, FrameError> {
+/// Checks a body's length and CRC; returns the bytes the CRC covers
+/// (header and payload). The one opening step of every body.
+pub fn open_body(body: &[u8]) -> Result<&[u8], FrameError> {
     let split = body
         .len()
         .checked_sub(CRC_LEN)
@@ -184,7 +191,12 @@ pub fn decode_body(body: &[u8]) -> Result<Frame, FrameError> {
     if crc32c(covered) != u32::from_le_bytes(crc_bytes) {
         return Err(FrameError::BadCrc);
     }
-    let mut r = Reader::new(covered);
+    Ok(covered)
+}
+
+/// Checks and parses a frame body (COBS already removed).
+pub fn decode_body(body: &[u8]) -> Result<Frame, FrameError> {
+    let mut r = Reader::new(open_body(body)?);
     let version = r.u8()?;
     if version != PROTOCOL_VERSION {
         return Err(FrameError::UnsupportedVersion(version));

@@ -25,7 +25,8 @@ pub struct DecoderStats {
     /// Good frames by kind, indexed by `FrameKind::index`: raw sample,
     /// navigation, event, station survey.
     pub frames: [u64; FrameKind::COUNT],
-    /// Good frames with a kind this decoder does not know (newer probe).
+    /// Good frames with a kind this decoder does not know (newer probe),
+    /// and the uplink's replies (kind 5: [`Decoder::unknown_body`]).
     pub unknown_kind: u64,
     /// Chunks whose CRC failed.
     pub crc_errors: u64,
@@ -64,6 +65,9 @@ pub struct Decoder {
     len: usize,
     /// The current chunk outgrew `chunk`: discard it at the next delimiter.
     overflowed: bool,
+    /// Length of the body in `chunk` of a good frame of a kind this
+    /// decoder does not know, until the next byte: [`Decoder::unknown_body`].
+    unknown_body_len: Option<usize>,
     expected_seq: Option<u16>,
     /// Sequence number and sample counter of the last raw frame of the
     /// current run, and what was counted since: the cross-check's anchor.
@@ -107,6 +111,7 @@ impl Decoder {
             chunk: [0; MAX_CHUNK_LEN],
             len: 0,
             overflowed: false,
+            unknown_body_len: None,
             expected_seq: None,
             last_raw: None,
             since_raw: SinceRaw {
@@ -135,6 +140,7 @@ impl Decoder {
     /// Feeds one byte; returns a frame when this byte completed a good one.
     pub fn push(&mut self, byte: u8) -> Option<Frame> {
         self.stats.bytes += 1;
+        self.unknown_body_len = None;
         if byte != DELIMITER {
             match self.chunk.get_mut(self.len) {
                 Some(slot) if !self.overflowed => {
@@ -152,6 +158,13 @@ impl Decoder {
         self.len = 0;
         self.overflowed = false;
         frame
+    }
+
+    /// The body (CRC checked) of a good frame of a kind this decoder does
+    /// not know, when the last byte pushed completed one: the uplink's
+    /// replies (`uplink::reply::decode_reply_body`) are read from here.
+    pub fn unknown_body(&self) -> Option<&[u8]> {
+        self.chunk.get(..self.unknown_body_len?)
     }
 
     /// Feeds a slice, handing every good frame to `on_frame`.
@@ -208,6 +221,7 @@ impl Decoder {
                 Some(frame)
             }
             Some(Err(FrameError::UnknownKind { seq, .. })) => {
+                self.unknown_body_len = Some(body_len);
                 self.note_sequence(seq, None);
                 self.stats.unknown_kind += 1;
                 None

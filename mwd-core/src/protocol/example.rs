@@ -91,3 +91,32 @@ pub fn station_survey() -> Payload {
         still_quality: 1.02,
     })
 }
+
+/// The uplink's worked example: set the site to the paper's (45.77755 N,
+/// 126.687898 E, 124 m), command number 7.
+pub fn set_site_command() -> super::uplink::Command {
+    super::uplink::Command::SetSite(Position::paper_site())
+}
+
+/// Command number of the uplink's worked examples.
+pub const EXAMPLE_COMMAND_SEQ: u16 = 7;
+
+/// The probe's ACK of command 7 at t = 2.5 s, the configuration now at
+/// version 3.
+pub fn ack_reply() -> super::uplink::Reply {
+    super::uplink::Reply::ack(2_500_000, EXAMPLE_COMMAND_SEQ, 0x40, 3)
+}
+
+/// The NAK of a still-settings command 8 whose staying quantile is below
+/// its entering one (field 16), configuration still at version 3.
+pub fn nak_reply() -> super::uplink::Reply {
+    use super::uplink::{Field, NakReason, Reply, ReplyStatus};
+    Reply {
+        time_us: 2_550_000,
+        command_seq: 8,
+        command_kind: 0x44,
+        status: ReplyStatus::Nak(NakReason::OutOfRange),
+        detail: Field::ZStay as u8,
+        config_version: 3,
+    }
+}

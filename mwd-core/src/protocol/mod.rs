@@ -6,6 +6,7 @@
 //!   little-endian layouts, version byte, sequence number, CRC-32C ([`crc`]).
 //! - [`wire`]: COBS framing between 0x00 delimiters and the probe's
 //!   [`FrameEncoder`].
+//! - [`uplink`]: the host's commands to the probe and the probe's replies.
 //! - [`decoder`]: the host's (or anyone's) streaming [`Decoder`], which
 //!   resynchronises after garbage and counts lost and corrupt frames.
 //!
@@ -17,6 +18,7 @@ pub mod crc;
 pub mod decoder;
 pub mod example;
 pub mod frame;
+pub mod uplink;
 pub mod wire;
 
 pub use decoder::{Decoder, DecoderStats};

@@ -26,7 +26,12 @@ pub const MAX_WIRE_LEN: usize = wire_len(MAX_BODY_LEN);
 pub fn encode_frame(seq: u16, payload: &Payload, out: &mut [u8]) -> Result<usize, OutOfRoom> {
     let mut body = [0u8; MAX_BODY_LEN];
     let body_len = encode_body(seq, payload, &mut body)?;
-    let body = body.get(..body_len).ok_or(OutOfRoom)?;
+    delimit_body(body.get(..body_len).ok_or(OutOfRoom)?, out)
+}
+
+/// COBS-encodes a sealed body between two delimiters into `out`; returns
+/// the bytes written. The one framing step of both directions.
+pub fn delimit_body(body: &[u8], out: &mut [u8]) -> Result<usize, OutOfRoom> {
     let (first, rest) = out.split_first_mut().ok_or(OutOfRoom)?;
     *first = DELIMITER;
     let encoded = cobs::try_encode(body, rest).map_err(|_| OutOfRoom)?;
