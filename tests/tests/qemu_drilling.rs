@@ -24,7 +24,7 @@ use std::time::Duration;
 use hil_mock::{StreamPlayer, StreamRecord};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
-use mwd_core::protocol::frame::{nav_mode, raw_flags, FrameKind, MAX_BODY_LEN};
+use mwd_core::protocol::frame::{nav_mode, raw_flags, MAX_BODY_LEN};
 use mwd_core::protocol::{encode_body, Decoder, Frame, NavSolution, Payload, RawPart, RawSample};
 use mwd_core::sensor_units::{
     m_s2_to_accel_count, rad_s_to_gyro_count, ACCEL_TEMPERATURE, GYRO_TEMPERATURE,
