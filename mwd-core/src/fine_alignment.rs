@@ -431,6 +431,20 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
     }
 
+    /// Adds `q` (rad^2, nav frame, symmetric positive semi-definite) to the
+    /// attitude-error covariance: process noise that is not isotropic, such
+    /// as the drilling environment's (the vibration turns the tool about
+    /// its cross axes, the orienter about its own axis; derivation section
+    /// 4d), added after the step's own time update.
+    pub fn add_attitude_noise(&mut self, q: &Matrix3<f64>) {
+        let p = &mut self.filter.p;
+        for i in 0..3 {
+            for j in 0..3 {
+                p[(ATT + i, ATT + j)] += T::of(q[(i, j)]);
+            }
+        }
+    }
+
     /// Ends the alignment: no more zero-velocity or zero-position updates,
     /// and F21 takes the measured specific force (the tool may now move).
     /// The filter goes on propagating, so the estimated biases keep being
