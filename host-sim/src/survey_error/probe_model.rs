@@ -229,12 +229,22 @@ mod tests {
                 tvd: 50.0,
                 toolface: tf.map(f64::to_radians),
             };
-            weighting(name, &s, &StationTrig::of(&s, &site), 30.0, &SiteTerms::of(&site))
-                .unwrap()
-                .w[2]
+            weighting(
+                name,
+                &s,
+                &StationTrig::of(&s, &site),
+                30.0,
+                &SiteTerms::of(&site),
+            )
+            .unwrap()
+            .w[2]
         };
         for azi in [0.0, 30.0, 135.0, 250.0] {
-            let tol = |x: f64| 1e-9 * x.abs().max(1.0 / horizontal_earth_rate(&SiteTerms::of(&site)));
+            let tol = |x: f64| {
+                1e-9 * x
+                    .abs()
+                    .max(1.0 / horizontal_earth_rate(&SiteTerms::of(&site)))
+            };
             // vertical, toolface 0: body x is the right side, z the high side
             let (b1, b2) = (wt("GXY-B1", 0.0, azi, None), wt("GXY-B2", 0.0, azi, None));
             assert!((wt("PRB-GXB", 0.0, azi, Some(0.0)) + b2).abs() < tol(b2));

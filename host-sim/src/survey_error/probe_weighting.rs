@@ -242,9 +242,15 @@ mod tests {
             tvd: 0.0,
             toolface: tf,
         };
-        engine_weighting(name, &s, &StationTrig::of(&s, site), 30.0, &SiteTerms::of(site))
-            .expect("registered")
-            .w[2]
+        engine_weighting(
+            name,
+            &s,
+            &StationTrig::of(&s, site),
+            30.0,
+            &SiteTerms::of(site),
+        )
+        .expect("registered")
+        .w[2]
     }
 
     /// Which sensor error a run draws.

@@ -549,9 +549,19 @@ impl Navigator {
                 if report.sample_used && !still && !self.covariance_invalid {
                     // Drilling or moving in the hole: the tool moves along
                     // its axis (derivation sections 4b, 4d).
+                    // The rows' attitude terms (v_n x r_a) are dropped:
+                    // linearised at the computed velocity, which while
+                    // drilling is mostly vibration noise (the true speed,
+                    // the rate of penetration, is < 0.01 m/s), they would
+                    // read that noise as azimuth and tilt errors; the true
+                    // speed's leak through an attitude error is in the
+                    // constraint's noise (the misalignment part, 0.5 m/s x
+                    // 1 deg; derivation section 4d).
                     let state = filter.state();
-                    let cross = NonHolonomic::at(state, DRILLING_VARIANCE as f32);
-                    let axial = AxialSpeed::at(state, AXIAL_SPEED_VARIANCE as f32);
+                    let mut cross = NonHolonomic::at(state, DRILLING_VARIANCE as f32);
+                    cross.attitude_row = [[0.0; 3]; 2];
+                    let mut axial = AxialSpeed::at(state, AXIAL_SPEED_VARIANCE as f32);
+                    axial.attitude_row = [0.0; 3];
                     filter.aid(&cross);
                     filter.aid(&axial);
                 }
