@@ -455,6 +455,20 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.config.specific_force = SpecificForceInModel::MeasuredSample;
     }
 
+    /// Linearises F21 (the velocity error's f^n x phi) at the gravity
+    /// reaction instead of the measured specific force (`true`), or back
+    /// at the measured one: while drilling the measured force is mostly
+    /// vibration (~0.74 g per sample), which the mechanization integrates
+    /// as noise; linearised at it the filter would read that noise, through
+    /// the constraints, as azimuth information (derivation section 4d).
+    pub fn linearize_at_gravity(&mut self, at_gravity: bool) {
+        self.config.specific_force = if at_gravity {
+            SpecificForceInModel::GravityAtRest
+        } else {
+            SpecificForceInModel::MeasuredSample
+        };
+    }
+
     /// Turns the zero-velocity update on (noise variance `variance`,
     /// (m/s)^2) or off for the following steps: the navigator's station
     /// surveys while the probe is still (`probe::navigator`).

@@ -149,6 +149,10 @@ pub const DRILLING_ANGULAR_SIGMA_RAD_S: f64 = 0.372 * DEG;
 /// as a random walk of 100 deg^2/h about the tool axis.
 pub const DRILLING_TOOLFACE_VARIANCE_PER_S: f64 = 100.0 * DEG * DEG / 3600.0;
 
+/// One still sample's accelerometer roll noise (rad): the SCC1300's x
+/// accelerometer noise, 0.058 m/s^2 per sample (paper Table 4), over g.
+pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
+
 /// The fewest still cycles whose mean makes a vertical-earth-rate bias
 /// update (`aid_sources::VerticalEarthRate`): 30 s.
 pub const MIN_BIAS_UPDATE_SAMPLES: u32 = 600;
@@ -231,6 +235,8 @@ pub struct Navigator {
     finished_station: Option<StationSurvey>,
     /// This still cycle's vertical-earth-rate residual and d_x, d_z.
     vertical_residual: Option<(f64, [f64; 2])>,
+    /// The roll was held for drilling since the last still cycle.
+    drilled_since_station: bool,
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
@@ -264,6 +270,7 @@ impl Navigator {
             station_capped: false,
             finished_station: None,
             vertical_residual: None,
+            drilled_since_station: false,
             time_us: 0,
             sample_counter: 0,
         }
@@ -516,9 +523,16 @@ impl Navigator {
                 let jitter = f64::from(self.still.statistics().lateral_jitter);
                 let drilling = !still && jitter > DRILLING_JITTER_LIMIT_M_S2;
                 // Drilling: the roll is held (the accelerometer roll is
-                // vibration); the estimator keeps its last clean roll, so
-                // the first clean sample after it re-syncs the toolface.
-                let source = if drilling {
+                // vibration), and the roll estimator starts again after it:
+                // a difference across the drilling would add the roll
+                // change a second time on top of what the filter already
+                // corrected through the constraints. Still: held too, as in
+                // the fine alignment (`ToolAxisSource::AtRest`: a single
+                // sample's roll carries its 0.3 deg of noise).
+                if drilling {
+                    self.input = ProbeInput::new();
+                }
+                let source = if drilling || still {
                     ToolAxisSource::AtRest
                 } else {
                     ToolAxisSource::AccelerometerRoll
@@ -542,6 +556,7 @@ impl Navigator {
                     // noise per sample: white, a velocity random walk.
                     extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
                 }
+                filter.linearize_at_gravity(drilling);
                 let report = filter.step_with(&imu, &extra);
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
@@ -565,6 +580,21 @@ impl Navigator {
                     filter.aid(&cross);
                     filter.aid(&axial);
                 }
+                if still && self.drilled_since_station {
+                    // The first still cycle after drilling: the roll was
+                    // held through it, so the orienter's steps were not
+                    // sensed. The accelerometer roll shows how far off the
+                    // held roll is; that, with the sample's own roll noise,
+                    // goes into the variance about the tool axis, and the
+                    // station's zero-velocity updates re-level it.
+                    let offset = roll_offset(filter.state(), &sample);
+                    let c_bn = dcm_from_quat(&filter.state().attitude);
+                    let t: Vector3<f64> = c_bn.column(1).into_owned();
+                    let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+                    filter.add_attitude_noise(&(t * t.transpose() * variance));
+                    self.drilled_since_station = false;
+                }
+                self.drilled_since_station |= drilling;
                 self.vertical_residual = (update && missing_gyro.is_none())
                     .then(|| vertical_residual(filter.state(), &sample));
                 self.held = Some(imu);
@@ -800,6 +830,17 @@ fn vertical_residual(state: &NavState, sample: &ProbeSample) -> (f64, [f64; 2]) 
         .map(|k| d[k] * (sample.gyro[k] - w[GYRO_AXES[k]]))
         .sum();
     (m, d)
+}
+
+/// The accelerometer roll of `sample` less the solution's roll (rad,
+/// wrapped; 0 where the roll is not defined: tool near vertical).
+fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
+    let levelling = crate::attitude::level(&sample.specific_force);
+    if !levelling.roll_valid {
+        return 0.0;
+    }
+    let roll = euler_from_quat(&state.attitude).roll;
+    crate::conventions::wrap_pi(levelling.roll - roll)
 }
 
 /// A gyro's long-run variance per sample, (rad/s)^2: white density^2 /
