@@ -110,13 +110,14 @@ fn run(plan_json: &str, seed: u64) -> Run {
         if std::env::var("DIAG").is_ok() && tied && index % 600 == 0 {
             let e = s.truth.euler();
             eprintln!(
-                "t {:7.0} {:?} md {:7.2} roll err {:7.2} pitch err {:6.2} head err {:7.2} tf {:6.1} flags {:#x}",
+                "t {:7.0} {:?} md {:7.2} roll err {:7.2} pitch err {:6.2} head err {:7.2} sd {:6.2} tf {:6.1} flags {:#x}",
                 s.truth.time,
                 s.truth.state,
                 s.truth.md,
                 wrap_pi(f64::from(frame.attitude[0]) - e.roll) / DEG,
                 (f64::from(frame.attitude[1]) - e.pitch) / DEG,
                 wrap_pi(f64::from(frame.attitude[2]) - e.heading) / DEG,
+                f64::from(frame.attitude_std[2]) / DEG,
                 truth.toolface / DEG,
                 frame.flags
             );

@@ -251,6 +251,15 @@ pub struct Navigator {
     vertical_residual: Option<(f64, [f64; 2])>,
     /// The roll was held for drilling since the last still cycle.
     drilled_since_station: bool,
+    /// Drilled since the heading was last set (alignment or tie-in): the
+    /// azimuth is reported undetermined from then on. Measured in the
+    /// simulated lateral (host-sim/tests/drilling_navigation.rs): the
+    /// filter's heading sigma, honest while drilling, collapses during the
+    /// next station's zero-velocity updates (10 deg to 1.7 deg) with no
+    /// heading information behind it, and station azimuth errors of 8-16
+    /// deg came with 1.7-3.5 deg sigmas. Until that is understood no
+    /// azimuth after drilling is given a finite sigma.
+    heading_after_drilling: bool,
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
@@ -285,6 +294,7 @@ impl Navigator {
             finished_station: None,
             vertical_residual: None,
             drilled_since_station: false,
+            heading_after_drilling: false,
             time_us: 0,
             sample_counter: 0,
         }
@@ -456,6 +466,7 @@ impl Navigator {
         survey.correlations = u.correlation.map(|r| r as f32);
         // The navigation frames' rule for the azimuth (see `solution`).
         let determined = self.coarse_std[2].is_finite()
+            && !self.heading_after_drilling
             && self.flags & nav_flags::SINGLE_PART == 0
             && flags & station_flags::NEAR_VERTICAL == 0
             && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
@@ -614,6 +625,7 @@ impl Navigator {
                     self.drilled_since_station = false;
                 }
                 self.drilled_since_station |= drilling;
+                self.heading_after_drilling |= drilling;
                 self.vertical_residual = (update && missing_gyro.is_none())
                     .then(|| vertical_residual(filter.state(), &sample));
                 self.held = Some(imu);
@@ -698,6 +710,8 @@ impl Navigator {
         );
         self.covariance_invalid = false;
         self.coasting = false;
+        self.heading_after_drilling = false;
+        self.drilled_since_station = false;
         self.phase = Phase::Fine { samples: 0 };
     }
 
@@ -745,6 +759,7 @@ impl Navigator {
         // The azimuth's sigma: infinite while the heading is undetermined
         // (coarse alignment) or rests on one gyro (single part).
         let heading_std = if self.coarse_std[2].is_finite()
+            && !self.heading_after_drilling
             && solution.flags & nav_flags::SINGLE_PART == 0
             && std.z <= AZIMUTH_SIGMA_LIMIT_RAD
         {
@@ -771,6 +786,13 @@ impl Navigator {
     /// covariance as the attitude-error covariance (independent of the
     /// sensor states: not levelled with these accelerometers), the other
     /// states as after a coarse alignment, no zero updates.
+    ///
+    /// When: at any step boundary. An in-process caller tying in a probe
+    /// that levelled itself calls it between steps as soon as
+    /// [`is_navigating`](Self::is_navigating) first returns true (the end
+    /// of the fine alignment); the probe's own levelled tilt is then
+    /// replaced by the tie-in's (not combined). Drilling mode, stations and
+    /// the azimuth rule (`heading_after_drilling`) start afresh.
     pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
         let sigma = tie_in.euler_sigma();
         let mut config = filter_config(&self.position, &sigma);
@@ -787,6 +809,8 @@ impl Navigator {
         self.coasting = false;
         self.covariance_invalid = false;
         self.coarse_single_part = false;
+        self.heading_after_drilling = false;
+        self.drilled_since_station = false;
         self.phase = Phase::Navigating;
     }
 
