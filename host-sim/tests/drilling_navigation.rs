@@ -138,6 +138,11 @@ fn run(plan_json: &str, seed: u64) -> Run {
             }
             out.stations.push((st, t));
             out.bias_std.push(bias_std(&navigator));
+            eprintln!(
+                "station {}: filter heading sigma {:.2} deg (the frames' azimuth rule aside)",
+                st.station,
+                navigator.filter().euler_std().z / DEG
+            );
         }
     }
     out
