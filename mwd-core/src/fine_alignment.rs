@@ -233,9 +233,6 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     reference: LocalEarth,
     steps: u32,
     rejected_samples: u32,
-    /// The mechanization's tool-axis rate is the frame's at the computed
-    /// attitude ([`hold_tool_axis`](Self::hold_tool_axis)).
-    tool_axis_held: bool,
 }
 
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
@@ -251,7 +248,6 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             reference: LocalEarth::at(&reference),
             steps: 0,
             rejected_samples: 0,
-            tool_axis_held: false,
         };
         alignment.restart(initial, reference, config);
         alignment
@@ -295,7 +291,6 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.reference = LocalEarth::at(&reference);
         self.steps = 0;
         self.rejected_samples = 0;
-        self.tool_axis_held = false;
     }
 
     /// One sample: mechanization, time update, measurement updates,
@@ -346,22 +341,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         if !self.earth.is_near(&state.position) {
             self.earth = LocalEarth::at(&state.position);
         }
-        let mut phi: AugmentedTransition<T, N> =
-            self.config.model.transition_with(&self.earth, &lp);
-        if self.tool_axis_held {
-            // The held tool-axis rate is t~ . omega_in: its error,
-            // -t . (omega_in x phi), cancels the tool-axis part of the
-            // attitude drift, phi' = -(I - t t^T)(omega_in x phi) (derivation
-            // section 4d): Phi_phiphi = A + t t^T (I - A), A = I - [w x] dt.
-            let t: Vector3<f64> = c_bn.column(1).into_owned();
-            let a = phi.nav.fixed_view::<3, 3>(ATT, ATT).map(|v| v.as_f64());
-            let held = a + t * t.transpose() * (Matrix3::identity() - a);
-            for i in 0..3 {
-                for j in 0..3 {
-                    phi.nav[(ATT + i, ATT + j)] = T::of(held[(i, j)]);
-                }
-            }
-        }
+        let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
         if extra.is_none() {
             self.filter.predict(&phi, &self.q);
         } else {
@@ -487,14 +467,6 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         } else {
             SpecificForceInModel::MeasuredSample
         };
-    }
-
-    /// Tells the filter whether the mechanization's tool-axis rate is held
-    /// at the frame's rate at the computed attitude
-    /// (`ToolAxisSource::AtRest` while navigating): the attitude block of
-    /// Phi then loses its tool-axis drift (derivation section 4d).
-    pub fn hold_tool_axis(&mut self, held: bool) {
-        self.tool_axis_held = held;
     }
 
     /// Turns the zero-velocity update on (noise variance `variance`,

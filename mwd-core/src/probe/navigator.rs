@@ -587,7 +587,6 @@ impl Navigator {
                     extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
                 }
                 filter.linearize_at_gravity(drilling);
-                filter.hold_tool_axis(drilling || still);
                 let report = filter.step_with(&imu, &extra);
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
