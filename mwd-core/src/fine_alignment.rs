@@ -431,6 +431,20 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
     }
 
+    /// Adds `q` (rad^2, nav frame, symmetric positive semi-definite) to the
+    /// attitude-error covariance: process noise that is not isotropic, such
+    /// as the drilling environment's (the vibration turns the tool about
+    /// its cross axes, the orienter about its own axis; derivation section
+    /// 4d), added after the step's own time update.
+    pub fn add_attitude_noise(&mut self, q: &Matrix3<f64>) {
+        let p = &mut self.filter.p;
+        for i in 0..3 {
+            for j in 0..3 {
+                p[(ATT + i, ATT + j)] += T::of(q[(i, j)]);
+            }
+        }
+    }
+
     /// Ends the alignment: no more zero-velocity or zero-position updates,
     /// and F21 takes the measured specific force (the tool may now move).
     /// The filter goes on propagating, so the estimated biases keep being
@@ -439,6 +453,20 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.config.zero_velocity_variance = None;
         self.config.zero_position_variance = None;
         self.config.specific_force = SpecificForceInModel::MeasuredSample;
+    }
+
+    /// Linearises F21 (the velocity error's f^n x phi) at the gravity
+    /// reaction instead of the measured specific force (`true`), or back
+    /// at the measured one: while drilling the measured force is mostly
+    /// vibration (~0.74 g per sample), which the mechanization integrates
+    /// as noise; linearised at it the filter would read that noise, through
+    /// the constraints, as azimuth information (derivation section 4d).
+    pub fn linearize_at_gravity(&mut self, at_gravity: bool) {
+        self.config.specific_force = if at_gravity {
+            SpecificForceInModel::GravityAtRest
+        } else {
+            SpecificForceInModel::MeasuredSample
+        };
     }
 
     /// Turns the zero-velocity update on (noise variance `variance`,

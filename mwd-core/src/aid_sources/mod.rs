@@ -12,10 +12,14 @@
 //! The non-holonomic constraint (no velocity across the tool axis while
 //! drilling) is not in the paper: derivation section 4b.
 
+mod axial_speed;
 mod non_holonomic;
+mod vertical_earth_rate;
 mod zero_position;
 mod zero_velocity;
 
+pub use axial_speed::{AxialSpeed, AXIAL_SPEED_VARIANCE};
 pub use non_holonomic::{BhaCrossMotion, NonHolonomic, CROSS_AXES, DRILLING_VARIANCE};
+pub use vertical_earth_rate::VerticalEarthRate;
 pub use zero_position::ZeroPosition;
 pub use zero_velocity::ZeroVelocity;

@@ -39,14 +39,17 @@
 //! bit for bit.
 
 use super::raw::{reading, Reading};
-use super::tie_in::TieIn;
-use crate::aid_sources::{NonHolonomic, DRILLING_VARIANCE};
 use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::StillDetector;
+use super::tie_in::TieIn;
+use crate::aid_sources::{
+    AxialSpeed, NonHolonomic, VerticalEarthRate, AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE,
+};
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
 use crate::calibration::ProbeCalibration;
 use crate::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, Euler, DEG};
+use crate::earth::earth_rate_n;
 use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
 use crate::fine_alignment::{FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior};
@@ -60,6 +63,7 @@ use crate::protocol::{NavSolution, RawSample, StationSurvey};
 use crate::sensor_noise::ImuNoise;
 use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
 use nalgebra::UnitQuaternion;
+use nalgebra::{Matrix3, Vector3};
 
 /// The probe's filter: f32 (the M4F's FPU), 39 states.
 type Filter = FineAlignment<f32, STATES_WITH_BIASES>;
@@ -112,6 +116,57 @@ pub const STATION_ZUPT_VARIANCE: f64 = 1e-4;
 /// lengths, where the drift (~3 cm in 5 min) stays within the sigma.
 pub const MAX_STATION_SAMPLES: u32 = 6000;
 
+/// The largest azimuth 1-sigma (rad) a station or frame reports as
+/// determined: 10 deg, the first-order limit measured for the probe's tool
+/// model (docs/probe-tool-model.md): beyond it the small-angle azimuth
+/// sigma no longer covers the error, so the azimuth is flagged
+/// undetermined and its sigma sent as infinite.
+pub const AZIMUTH_SIGMA_LIMIT_RAD: f64 = 10.0 * DEG;
+
+/// The lateral force jitter (m/s^2, `StillStatistics::lateral_jitter`)
+/// above which the probe is taken as drilling (on bottom, vibrating):
+/// g sin(1 deg). Above it a single sample's accelerometer roll is off by
+/// more than 1 deg, and the roll-derived tool-axis rate (paper eq. 1-2)
+/// would put that noise into the attitude every sample (and rectify it into
+/// a vertical force: the force is rolled onto the vertical); the roll is
+/// then held (`ToolAxisSource::AtRest`) and its possible change is process
+/// noise ([`DRILLING_TOOLFACE_VARIANCE_PER_S`]). The SCC1300's own noise
+/// is ~0.06 m/s^2 per sample; a 10 deg/s toolface turn adds 0.085 m/s^2
+/// per sample to the differences; the moderate simulated vibration is
+/// ~7 m/s^2 (docs/filter-derivation.md section 4d).
+pub const DRILLING_JITTER_LIMIT_M_S2: f64 = 9.80665 * 0.017_452_406;
+
+/// Angular vibration reaching a gyro sample while drilling (rad/s, 1-sigma
+/// per sample, white): the drilling simulator's moderate level, 1 deg/s RMS
+/// over 5-500 Hz through the part's assumed 50 Hz first-order low-pass,
+/// which passes 0.1385 of the power (docs/drilling-simulation.md): 0.372
+/// deg/s, an attitude random walk of 5.0 deg/sqrt(h) about the gyro axes.
+pub const DRILLING_ANGULAR_SIGMA_RAD_S: f64 = 0.372 * DEG;
+
+/// Variance rate (rad^2/s) of the toolface while the roll is held: the
+/// orienter's steps while sliding, 10 deg once an hour (the simulator's
+/// `sliding_toolface_step_deg`, `sliding_toolface_steps_per_hour`), taken
+/// as a random walk of 100 deg^2/h about the tool axis.
+pub const DRILLING_TOOLFACE_VARIANCE_PER_S: f64 = 100.0 * DEG * DEG / 3600.0;
+
+/// Still cycles per block of the station's survey checkpoints: a station
+/// sends the survey of the older of its last two checkpoints, 40 to 80
+/// cycles (2-4 s) before its last still cycle (or its last still cycle
+/// when it was shorter than 80). The still detector ends a station only
+/// when the motion exceeds its stay threshold, and the orienter's turn
+/// begins slowly: in the drilling simulator the toolface had moved by up
+/// to 1.5 deg between 40 samples before the last still cycle and it,
+/// twenty times the station's toolface sigma.
+pub const SURVEY_SETTLE_EPOCHS: u32 = 40;
+
+/// One still sample's accelerometer roll noise (rad): the SCC1300's x
+/// accelerometer noise, 0.058 m/s^2 per sample (paper Table 4), over g.
+pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
+
+/// The fewest still cycles whose mean makes a vertical-earth-rate bias
+/// update (`aid_sources::VerticalEarthRate`): 30 s.
+pub const MIN_BIAS_UPDATE_SAMPLES: u32 = 600;
+
 /// The filter's settings for a still probe at `position` whose coarse
 /// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
 fn filter_config(
@@ -143,6 +198,14 @@ struct Station {
     quality_sum: f32,
     /// The survey as of the last still cycle.
     survey: StationSurvey,
+    /// The survey at the last multiple of [`SURVEY_SETTLE_EPOCHS`] still
+    /// cycles, and the one before it: what the station sends.
+    checkpoint: Option<StationSurvey>,
+    settled: Option<StationSurvey>,
+    /// Sums over the still cycles for the vertical-earth-rate update: the
+    /// residual m and d_x, d_z (`aid_sources::VerticalEarthRate`).
+    vertical_sum: f64,
+    down_sum: [f64; 2],
 }
 
 /// The probe's navigation, one raw sample at a time.
@@ -184,6 +247,19 @@ pub struct Navigator {
     station_capped: bool,
     /// A finished station, until taken.
     finished_station: Option<StationSurvey>,
+    /// This still cycle's vertical-earth-rate residual and d_x, d_z.
+    vertical_residual: Option<(f64, [f64; 2])>,
+    /// The roll was held for drilling since the last still cycle.
+    drilled_since_station: bool,
+    /// Drilled since the heading was last set (alignment or tie-in): the
+    /// azimuth is reported undetermined from then on. Measured in the
+    /// simulated lateral (host-sim/tests/drilling_navigation.rs): the
+    /// filter's heading sigma, honest while drilling, collapses during the
+    /// next station's zero-velocity updates (10 deg to 1.7 deg) with no
+    /// heading information behind it, and station azimuth errors of 8-16
+    /// deg came with 1.7-3.5 deg sigmas. Until that is understood no
+    /// azimuth after drilling is given a finite sigma.
+    heading_after_drilling: bool,
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
@@ -216,6 +292,9 @@ impl Navigator {
             stations: 0,
             station_capped: false,
             finished_station: None,
+            vertical_residual: None,
+            drilled_since_station: false,
+            heading_after_drilling: false,
             time_us: 0,
             sample_counter: 0,
         }
@@ -285,6 +364,10 @@ impl Navigator {
                 epochs: 0,
                 quality_sum: 0.0,
                 survey: StationSurvey::default(),
+                vertical_sum: 0.0,
+                down_sum: [0.0; 2],
+                checkpoint: None,
+                settled: None,
             });
         }
         let survey = self.station_survey();
@@ -294,6 +377,11 @@ impl Navigator {
         };
         station.epochs += 1;
         station.quality_sum += quality;
+        if let Some((m, d)) = self.vertical_residual {
+            station.vertical_sum += m;
+            station.down_sum[0] += d[0];
+            station.down_sum[1] += d[1];
+        }
         let start_sample = if station.epochs == 1 {
             start
         } else {
@@ -305,6 +393,9 @@ impl Navigator {
             still_quality: station.quality_sum / station.epochs as f32,
             ..survey
         };
+        if station.epochs % SURVEY_SETTLE_EPOCHS == 0 {
+            station.settled = station.checkpoint.replace(station.survey);
+        }
         if station.epochs >= MAX_STATION_SAMPLES {
             self.finish_station(station_flags::MAX_DURATION);
             self.station_capped = true;
@@ -313,10 +404,38 @@ impl Navigator {
 
     fn finish_station(&mut self, flags: u16) {
         if let Some(station) = self.station.take() {
-            let mut survey = station.survey;
+            self.update_rate_biases(&station);
+            let mut survey = station.settled.unwrap_or(station.survey);
             survey.flags |= flags;
             self.finished_station = Some(survey);
         }
+    }
+
+    /// The vertical-earth-rate update of the x and z rate biases from a
+    /// station's still cycles (`aid_sources::VerticalEarthRate`), when it
+    /// had at least [`MIN_BIAS_UPDATE_SAMPLES`] of them.
+    fn update_rate_biases(&mut self, station: &Station) {
+        if station.epochs < MIN_BIAS_UPDATE_SAMPLES || self.covariance_invalid {
+            return;
+        }
+        let n = f64::from(station.epochs);
+        let d = station.down_sum.map(|v| v / n);
+        let tilt = self.filter.euler_std();
+        let cos_inclination = dcm_from_quat(&self.filter.state().attitude)[(2, 1)];
+        let variance = VerticalEarthRate::<f32>::variance(
+            d,
+            GYRO_AXES.map(gyro_long_run_variance),
+            station.epochs,
+            tilt.x.max(tilt.y),
+            cos_inclination,
+            tilt.z.min(core::f64::consts::PI),
+        );
+        let measurement = VerticalEarthRate {
+            vertical_residual: (station.vertical_sum / n) as f32,
+            down_in_gyro_plane: d.map(|v| v as f32),
+            variance: variance as f32,
+        };
+        self.filter.aid(&measurement);
     }
 
     /// The station survey at this cycle: the filter's attitude as drilling
@@ -346,7 +465,11 @@ impl Navigator {
         survey.angles_std = u.sigma.map(|s| s as f32);
         survey.correlations = u.correlation.map(|r| r as f32);
         // The navigation frames' rule for the azimuth (see `solution`).
-        let determined = self.coarse_std[2].is_finite() && self.flags & nav_flags::SINGLE_PART == 0;
+        let determined = self.coarse_std[2].is_finite()
+            && !self.heading_after_drilling
+            && self.flags & nav_flags::SINGLE_PART == 0
+            && flags & station_flags::NEAR_VERTICAL == 0
+            && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
         if !determined {
             flags |= station_flags::AZIMUTH_UNDETERMINED;
             survey.angles_std[1] = f32::INFINITY;
@@ -427,20 +550,84 @@ impl Navigator {
                 fine_done = *samples >= FINE_ALIGNMENT_SAMPLES;
             }
             Phase::Navigating => {
+                let jitter = f64::from(self.still.statistics().lateral_jitter);
+                let drilling = !still && jitter > DRILLING_JITTER_LIMIT_M_S2;
+                // Drilling: the roll is held (the accelerometer roll is
+                // vibration), and the roll estimator starts again after it:
+                // a difference across the drilling would add the roll
+                // change a second time on top of what the filter already
+                // corrected through the constraints. Still: held too, as in
+                // the fine alignment (`ToolAxisSource::AtRest`: a single
+                // sample's roll carries its 0.3 deg of noise).
+                if drilling {
+                    self.input = ProbeInput::new();
+                }
+                let source = if drilling || still {
+                    ToolAxisSource::AtRest
+                } else {
+                    ToolAxisSource::AccelerometerRoll
+                };
                 let (imu, tool_axis) = self.input.imu_sample(
                     &filter.frame_rate_in_body(),
                     &sample,
-                    ToolAxisSource::AccelerometerRoll,
+                    source,
                     SAMPLE_INTERVAL_S,
                 );
-                if tool_axis == ToolAxisRate::Unavailable {
+                if tool_axis == ToolAxisRate::Unavailable || drilling {
                     self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
                 }
                 // No updates past the longest station (see
                 // `MAX_STATION_SAMPLES`): free navigation until it moves.
                 let update = still && !self.station_capped;
                 filter.set_zero_velocity(update.then_some(STATION_ZUPT_VARIANCE));
+                let mut extra = extra;
+                if drilling {
+                    // The measured lateral jitter is the vibration's force
+                    // noise per sample: white, a velocity random walk.
+                    extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
+                }
+                filter.linearize_at_gravity(drilling);
                 let report = filter.step_with(&imu, &extra);
+                if drilling {
+                    filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
+                }
+                if report.sample_used && !still && !self.covariance_invalid {
+                    // Drilling or moving in the hole: the tool moves along
+                    // its axis (derivation sections 4b, 4d).
+                    // The rows' attitude terms (v_n x r_a) are dropped:
+                    // linearised at the computed velocity, which while
+                    // drilling is mostly vibration noise (the true speed,
+                    // the rate of penetration, is < 0.01 m/s), they would
+                    // read that noise as azimuth and tilt errors; the true
+                    // speed's leak through an attitude error is in the
+                    // constraint's noise (the misalignment part, 0.5 m/s x
+                    // 1 deg; derivation section 4d).
+                    let state = filter.state();
+                    let mut cross = NonHolonomic::at(state, DRILLING_VARIANCE as f32);
+                    cross.attitude_row = [[0.0; 3]; 2];
+                    let mut axial = AxialSpeed::at(state, AXIAL_SPEED_VARIANCE as f32);
+                    axial.attitude_row = [0.0; 3];
+                    filter.aid(&cross);
+                    filter.aid(&axial);
+                }
+                if still && self.drilled_since_station {
+                    // The first still cycle after drilling: the roll was
+                    // held through it, so the orienter's steps were not
+                    // sensed. The accelerometer roll shows how far off the
+                    // held roll is; that, with the sample's own roll noise,
+                    // goes into the variance about the tool axis, and the
+                    // station's zero-velocity updates re-level it.
+                    let offset = roll_offset(filter.state(), &sample);
+                    let c_bn = dcm_from_quat(&filter.state().attitude);
+                    let t: Vector3<f64> = c_bn.column(1).into_owned();
+                    let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+                    filter.add_attitude_noise(&(t * t.transpose() * variance));
+                    self.drilled_since_station = false;
+                }
+                self.drilled_since_station |= drilling;
+                self.heading_after_drilling |= drilling;
+                self.vertical_residual = (update && missing_gyro.is_none())
+                    .then(|| vertical_residual(filter.state(), &sample));
                 self.held = Some(imu);
                 if still {
                     self.flags |= nav_flags::STILL;
@@ -523,6 +710,8 @@ impl Navigator {
         );
         self.covariance_invalid = false;
         self.coasting = false;
+        self.heading_after_drilling = false;
+        self.drilled_since_station = false;
         self.phase = Phase::Fine { samples: 0 };
     }
 
@@ -569,12 +758,15 @@ impl Navigator {
         let std = filter.euler_std();
         // The azimuth's sigma: infinite while the heading is undetermined
         // (coarse alignment) or rests on one gyro (single part).
-        let heading_std =
-            if self.coarse_std[2].is_finite() && solution.flags & nav_flags::SINGLE_PART == 0 {
-                std.z as f32
-            } else {
-                f32::INFINITY
-            };
+        let heading_std = if self.coarse_std[2].is_finite()
+            && !self.heading_after_drilling
+            && solution.flags & nav_flags::SINGLE_PART == 0
+            && std.z <= AZIMUTH_SIGMA_LIMIT_RAD
+        {
+            std.z as f32
+        } else {
+            f32::INFINITY
+        };
         solution.attitude_std = [std.x as f32, std.y as f32, heading_std];
         // Beyond the tilt limit (or with a tilt sigma that is not even a
         // number) the small-angle error model no longer holds.
@@ -594,6 +786,13 @@ impl Navigator {
     /// covariance as the attitude-error covariance (independent of the
     /// sensor states: not levelled with these accelerometers), the other
     /// states as after a coarse alignment, no zero updates.
+    ///
+    /// When: at any step boundary. An in-process caller tying in a probe
+    /// that levelled itself calls it between steps as soon as
+    /// [`is_navigating`](Self::is_navigating) first returns true (the end
+    /// of the fine alignment); the probe's own levelled tilt is then
+    /// replaced by the tie-in's (not combined). Drilling mode, stations and
+    /// the azimuth rule (`heading_after_drilling`) start afresh.
     pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
         let sigma = tie_in.euler_sigma();
         let mut config = filter_config(&self.position, &sigma);
@@ -610,6 +809,8 @@ impl Navigator {
         self.coasting = false;
         self.covariance_invalid = false;
         self.coarse_single_part = false;
+        self.heading_after_drilling = false;
+        self.drilled_since_station = false;
         self.phase = Phase::Navigating;
     }
 
@@ -645,6 +846,57 @@ impl Navigator {
 
 fn square(v: f64) -> f64 {
     v * v
+}
+
+/// The drilling environment's attitude noise for one step, nav frame
+/// (derivation section 4d): the angular vibration about the gyro axes
+/// (body x and z: (I - t t^T) sigma^2 dt^2, t the tool axis) and the
+/// orienter's unsensed toolface steps about the tool axis (t t^T q dt).
+fn drilling_attitude_noise(state: &NavState) -> Matrix3<f64> {
+    let c_bn = dcm_from_quat(&state.attitude);
+    let t: Vector3<f64> = c_bn.column(1).into_owned();
+    let tt = t * t.transpose();
+    let vibration = square(DRILLING_ANGULAR_SIGMA_RAD_S * SAMPLE_INTERVAL_S);
+    (Matrix3::identity() - tt) * vibration
+        + tt * (DRILLING_TOOLFACE_VARIANCE_PER_S * SAMPLE_INTERVAL_S)
+}
+
+/// One still cycle's vertical-earth-rate residual m = d_x (g_x - w_x) +
+/// d_z (g_z - w_z) and (d_x, d_z), d = C_n^b e_D, w = C_n^b omega_ie^n
+/// (`aid_sources::VerticalEarthRate`).
+fn vertical_residual(state: &NavState, sample: &ProbeSample) -> (f64, [f64; 2]) {
+    let c_nb = dcm_from_quat(&state.attitude).transpose();
+    let down = c_nb.column(2).into_owned();
+    let w = c_nb * earth_rate_n(state.position.lat);
+    let d = GYRO_AXES.map(|a| down[a]);
+    let m = (0..2)
+        .map(|k| d[k] * (sample.gyro[k] - w[GYRO_AXES[k]]))
+        .sum();
+    (m, d)
+}
+
+/// The accelerometer roll of `sample` less the solution's roll (rad,
+/// wrapped; 0 where the roll is not defined: tool near vertical).
+fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
+    let levelling = crate::attitude::level(&sample.specific_force);
+    if !levelling.roll_valid {
+        return 0.0;
+    }
+    let roll = euler_from_quat(&state.attitude).roll;
+    crate::conventions::wrap_pi(levelling.roll - roll)
+}
+
+/// A gyro's long-run variance per sample, (rad/s)^2: white density^2 /
+/// dt plus its AR model's zero-frequency share sigma_e^2 / (1 + sum
+/// a_i)^2 (the variance of an n-sample mean is this over n for large n).
+fn gyro_long_run_variance(axis: usize) -> f64 {
+    let noise = ImuNoise::scc1300().gyro[axis];
+    let white = square(noise.white_density) / SAMPLE_INTERVAL_S;
+    let coloured = noise.coloured.map_or(0.0, |ar| {
+        let gain = 1.0 + ar.coefficients.iter().sum::<f64>();
+        ar.noise_variance / square(gain)
+    });
+    white + coloured
 }
 
 #[cfg(test)]
@@ -933,6 +1185,7 @@ mod tests {
         let still_to = still_from + 1200; // 60 s
         let mut moving_end = NavSolution::default();
         let mut last_still = NavSolution::default();
+        let mut frames = std::vec::Vec::new();
         let mut stations = std::vec::Vec::new();
         for n in start..still_to + 50 {
             let still = (still_from..still_to).contains(&n);
@@ -942,6 +1195,7 @@ mod tests {
                 turning_sample(n, 3.0)
             };
             let s = navigator.step(&raw);
+            frames.push(s);
             stations.extend(navigator.take_station().map(|st| (n, st)));
             let expect_zupt = still && n >= still_from + DETECTION_DELAY_SAMPLES - 1;
             assert_eq!(
@@ -966,9 +1220,11 @@ mod tests {
                 "{moving_end:?} -> {last_still:?}"
             );
         }
+        // (The non-holonomic updates while it turned had already levelled
+        // it part of the way.)
         for i in 0..2 {
             assert!(
-                last_still.attitude_std[i] < 0.9 * moving_end.attitude_std[i],
+                last_still.attitude_std[i] < moving_end.attitude_std[i],
                 "{moving_end:?} -> {last_still:?}"
             );
         }
@@ -976,9 +1232,14 @@ mod tests {
         let (sent_at, st) = stations[0];
         assert_eq!(sent_at, still_to, "sent with the first moving sample");
         assert_eq!(st.station, 1);
-        assert_eq!(st.start_sample, still_from + DETECTION_DELAY_SAMPLES - 1);
-        assert_eq!(st.end_sample, still_to - 1);
-        assert_eq!(st.time_us, u64::from(still_to - 1) * 50_000);
+        let first_zupt = still_from + DETECTION_DELAY_SAMPLES - 1;
+        assert_eq!(st.start_sample, first_zupt);
+        // The older of the last two checkpoints (`SURVEY_SETTLE_EPOCHS`).
+        let epochs = still_to - first_zupt;
+        let settled = (epochs / SURVEY_SETTLE_EPOCHS - 1) * SURVEY_SETTLE_EPOCHS;
+        assert_eq!(st.end_sample, first_zupt + settled - 1);
+        assert_eq!(st.time_us, u64::from(st.end_sample) * 50_000);
+        let last_still = frames[(st.end_sample - start) as usize];
         // The level probe: inclination 90 deg; toolface = roll.
         let [roll, pitch, heading] = last_still.attitude.map(f64::from);
         let [inc, azi, tf] = st.angles.map(f64::from);
@@ -1046,7 +1307,7 @@ mod tests {
         assert_eq!(at, first_zupt + MAX_STATION_SAMPLES - 1);
         assert_eq!(
             (first.station, first.start_sample, first.end_sample),
-            (1, first_zupt, at)
+            (1, first_zupt, at - SURVEY_SETTLE_EPOCHS)
         );
         assert_ne!(first.flags & station_flags::MAX_DURATION, 0);
         // The stop after the move started station 2, not ended yet.

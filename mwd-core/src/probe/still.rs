@@ -248,6 +248,12 @@ pub struct StillStatistics {
     pub force: f32,
     /// | |mean f| - g | over its 1-sigma.
     pub gravity: f32,
+    /// The per-sample jitter of the force across the tool axis (body x
+    /// and z), m/s^2: the von Neumann estimate sqrt(mean (f_k - f_k-1)^2
+    /// / 2) per axis, root-mean-squared over the two. Successive
+    /// differences leave out a smooth change (a toolface turn at 10 deg/s
+    /// moves f by 0.085 m/s^2 a sample) and keep white vibration whole.
+    pub lateral_jitter: f32,
 }
 
 /// The still detector: one sample at a time.
@@ -341,12 +347,23 @@ impl StillDetector {
                 force += square(f64::from(*v) - m) / var;
             }
         }
+        // Oldest to newest: the slot after the newest comes first.
+        let mut jitter = 0.0f64;
+        for k in 1..WINDOW {
+            let (a, b) = (
+                &self.window[(self.next + k - 1) % WINDOW],
+                &self.window[(self.next + k) % WINDOW],
+            );
+            jitter += square(f64::from(b[2] - a[2])) + square(f64::from(b[4] - a[4]));
+        }
+        let lateral_jitter = libm::sqrt(jitter / (4.0 * (WINDOW - 1) as f64));
         let magnitude = libm::sqrt(mean.iter().map(|m| m * m).sum::<f64>());
         let gravity = libm::fabs(magnitude - t.gravity_m_s2);
         self.statistics = StillStatistics {
             rate: (rate / t.rate.expected) as f32,
             force: (force / t.force.expected) as f32,
             gravity: (gravity / t.gravity.expected) as f32,
+            lateral_jitter: lateral_jitter as f32,
         };
         if self.still {
             self.still = rate <= t.rate.stay && force <= t.force.stay && gravity <= t.gravity.stay;

@@ -351,10 +351,12 @@ mod tests {
             let error = wrap_pi(f64::from(*got) - want);
             assert!(error.abs() < 1e-5, "{want}: {frame:?}");
         }
-        // One step of process noise on top of the tie-in's sigmas.
+        // One step of process noise on top of the tie-in's sigmas, and the
+        // step's non-holonomic update (not yet still: the detector needs
+        // its window), which levels a little.
         for (i, s) in t.euler_sigma().iter().enumerate() {
             let ratio = f64::from(frame.attitude_std[i]) / s;
-            assert!((1.0..1.01).contains(&ratio), "{i}: {frame:?}");
+            assert!((0.99..1.01).contains(&ratio), "{i}: {frame:?}");
         }
         assert!(frame.velocity_std.iter().all(|s| s.is_finite() && *s > 0.0));
     }
