@@ -278,7 +278,10 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
         (st.probe, st.probe, 0, 0),
         "station replay: {st:?}"
     );
-    eprintln!("station frames: {} in the capture, all replayed bit for bit", st.probe);
+    eprintln!(
+        "station frames: {} in the capture, all replayed bit for bit",
+        st.probe
+    );
     let (_, summary) = replayer.finish();
     assert_eq!(
         (summary.matched, summary.mismatched, summary.unchecked),
