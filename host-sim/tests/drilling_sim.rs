@@ -313,6 +313,51 @@ fn the_same_seed_gives_the_same_capture_and_another_seed_another() {
     assert!(a != c, "different seeds, same bytes");
 }
 
+/// The capture's navigation and station frames are the probe's own
+/// (`Navigator` at the configured site, the plan's): `replay` of the
+/// capture, which knows only that site, gets every one bit for bit (exit 0).
+/// It did not when the simulator's navigator ran at the probe's position
+/// down hole: every solution differed.
+#[test]
+fn a_drilling_capture_replays_bit_for_bit() {
+    let dir = scratch("drillsim", "replay");
+    let plan = short_plan(&dir);
+    let bin = dir.join("run.bin");
+    let r = run(&[
+        "simulate",
+        "--motion",
+        "lateral",
+        "--plan",
+        s(&plan),
+        "-o",
+        s(&bin),
+        "--seed",
+        "3",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let r = run(&["replay", s(&bin)]);
+    assert_eq!(r.code, Some(0), "replay: {}\n{}", r.stdout, r.stderr);
+    let parity = r
+        .stdout
+        .lines()
+        .find(|l| l.starts_with("replay parity"))
+        .unwrap_or_else(|| panic!("no parity line: {}", r.stdout));
+    assert!(parity.contains(" 0 different, 0 not compared"), "{parity}");
+    let stations = r
+        .stdout
+        .lines()
+        .find(|l| l.starts_with("station parity"))
+        .unwrap_or_else(|| panic!("no station line: {}", r.stdout));
+    assert!(
+        stations.contains("0 different, 0 not compared"),
+        "{stations}"
+    );
+    assert!(
+        !stations.starts_with("station parity   0 replayed"),
+        "{stations}"
+    );
+}
+
 #[test]
 fn vibration_reaches_the_samples_as_stated_and_harsh_levels_clip() {
     // Moderate: 2 g RMS lateral over 5-500 Hz through a first-order 50 Hz

@@ -329,7 +329,11 @@ fn run_lateral(args: &Args) -> Result<()> {
         MAX_LATERAL_S / 3600.0
     );
     let n = drilling.sample_count(SAMPLE_INTERVAL_S);
-    let site = drilling.truth(0.0).position;
+    // The site the probe's navigator is configured with: the plan's (the
+    // wellhead; the QEMU probe's default is the same paper site), not the
+    // probe's position down hole, so `replay` of the capture (which knows
+    // only the configured site) is bit for bit the probe's.
+    let site = drilling.plan().site;
     let output = &args.output;
     let to_stdout = output.as_os_str() == "-";
     let mut truth_out = match &args.truth {
