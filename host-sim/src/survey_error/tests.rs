@@ -228,122 +228,29 @@ fn bad_surveys_are_rejected_with_the_station_named() {
 /// against ("fast code checked against the slow one"): every source's
 /// error vector built on its own, each station's trigonometry and the site
 /// constants recomputed wherever they are used, the vectors stored, then
-/// summed. This is the engine as it was before the optimisation (SPE 67616
-/// eqs. for the balanced-tangential derivatives, as described in the
-/// module documentation), kept only as a test oracle.
+/// summed. This is the engine's propagation as it was before the
+/// optimisation (SPE 67616 eqs. for the balanced-tangential derivatives,
+/// as described in the module documentation), kept only as a test oracle;
+/// it shares the engine's weighting table.
 mod slow {
     use super::super::{
-        enhanced, outer, Cov6, ErrorTerm, ModelResult, Options, Propagation, Site, Station, TieOn,
-        XclAzimuth, EARTH_RATE, XCL_TORTUOSITY,
+        outer, Cov6, ErrorTerm, ModelResult, Options, Propagation, Site, SiteTerms, Station,
+        StationTrig, TieOn, Weight, XclAzimuth, XCL_TORTUOSITY,
     };
     use std::collections::BTreeMap;
 
-    struct Weight {
-        w: [f64; 3],
-        singular: Option<[f64; 3]>,
-    }
-
-    fn her(site: &Site) -> f64 {
-        EARTH_RATE * site.latitude.cos()
-    }
-
+    /// The engine's own weighting table: the formulas are checked against
+    /// the published ISCWSA covariances (`tests/iscwsa_error_model.rs`);
+    /// what this oracle checks is the propagation around them, so it only
+    /// recomputes the station's trigonometry and the site terms per call.
     fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight> {
-        let (si, ci) = s.inc.sin_cos();
-        let (sam, cam) = (s.azi - site.declination).sin_cos();
-        let (sat, cat) = s.azi.sin_cos();
-        let g = site.gravity;
-        let td = site.dip.tan();
-        let bh = site.b_total * site.dip.cos();
-        let r2 = std::f64::consts::SQRT_2;
-        let w = |d: f64, i: f64, a: f64| Weight {
-            w: [d, i, a],
-            singular: None,
-        };
-        let vertical = s.inc < site.vertical_limit;
-        Some(match name {
-            "DREF" => w(1.0, 0.0, 0.0),
-            "DSF" => w(s.md, 0.0, 0.0),
-            "DST" => w(s.md * s.tvd, 0.0, 0.0),
-            "ABXY-TI1" => w(0.0, -ci / g, td * ci * sam / g),
-            "ABXY-TI2" => Weight {
-                w: [
-                    0.0,
-                    0.0,
-                    if vertical {
-                        0.0
-                    } else {
-                        ((std::f64::consts::FRAC_PI_2 - s.inc).tan() - td * cam) / g
-                    },
-                ],
-                singular: Some([-sat / g, cat / g, 0.0]),
-            },
-            "ABZ" => w(0.0, -si / g, td * si * sam / g),
-            "ASXY-TI1" => w(0.0, si * ci / r2, -td * si * ci * sam / r2),
-            "ASXY-TI2" => w(0.0, si * ci / 2.0, -td * si * ci * sam / 2.0),
-            "ASXY-TI3" => w(0.0, 0.0, (td * si * cam - ci) / 2.0),
-            "ASZ" => w(0.0, -si * ci, td * si * ci * sam),
-            "MBXY-TI1" => w(0.0, 0.0, -ci * sam / bh),
-            "MBXY-TI2" => w(0.0, 0.0, cam / bh),
-            "MBZ" => w(0.0, 0.0, -si * sam / bh),
-            "MSXY-TI1" => w(0.0, 0.0, si * sam * (td * ci + si * cam) / r2),
-            "MSXY-TI2" => w(0.0, 0.0, sam * (td * si * ci - ci * ci * cam - cam) / 2.0),
-            "MSXY-TI3" => w(
-                0.0,
-                0.0,
-                (ci * cam * cam - ci * sam * sam - td * si * cam) / 2.0,
-            ),
-            "MSZ" => w(0.0, 0.0, -(si * cam + td * ci) * si * sam),
-            "AZ" => w(0.0, 0.0, 1.0),
-            "DBH" => w(0.0, 0.0, 1.0 / bh),
-            "AMIL" => w(0.0, 0.0, si * sam / bh),
-            "SAGE" => w(0.0, si.powf(0.25), 0.0),
-            "SAG" => w(0.0, si, 0.0),
-            "AXYZ-MIS" => w(0.0, 1.0, 0.0),
-            "AXYZ-SF" => w(0.0, 1.3 * si * ci, 0.0),
-            "AXYZ-ZB" => w(0.0, si / g, 0.0),
-            "GXY-B1" => w(0.0, 0.0, sat / (her(site) * ci)),
-            "GXY-B2" => w(0.0, 0.0, cat / her(site)),
-            "GXY-G1" => w(0.0, 0.0, cat * si / her(site)),
-            "GXY-G4" => w(0.0, 0.0, sat * si / ci / her(site)),
-            "GXY-RN" => w(
-                0.0,
-                0.0,
-                site.gyro_noise_reduction * (1.0 - (cat * si).powi(2)).sqrt() / (her(site) * ci),
-            ),
-            "XYM1" => w(0.0, si.abs(), 0.0),
-            "XYM2" => w(0.0, 0.0, -1.0),
-            "XYM3" | "XYM3L" | "XYM3E" => {
-                let f = enhanced(name, course);
-                Weight {
-                    w: [
-                        0.0,
-                        f * ci.abs() * cat,
-                        if vertical {
-                            0.0
-                        } else {
-                            -f * ci.abs() * sat / si
-                        },
-                    ],
-                    singular: Some([f, 0.0, 0.0]),
-                }
-            }
-            "XYM4" | "XYM4L" | "XYM4E" => {
-                let f = enhanced(name, course);
-                Weight {
-                    w: [
-                        0.0,
-                        f * ci.abs() * sat,
-                        if vertical {
-                            0.0
-                        } else {
-                            f * ci.abs() * cat / si
-                        },
-                    ],
-                    singular: Some([0.0, f, 0.0]),
-                }
-            }
-            _ => return None,
-        })
+        super::super::weighting(
+            name,
+            s,
+            &StationTrig::of(s, site),
+            course,
+            &SiteTerms::of(site),
+        )
     }
 
     fn xcl_vector(
