@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{s, Run};
+use common::{refused, s, Run};
 use std::path::{Path, PathBuf};
 
 fn host_sim(args: &[&str]) -> Run {
@@ -30,21 +30,6 @@ const WELL1_SITE: [&str; 8] = [
     "--declination-deg",
     "-4",
 ];
-
-fn refused(run: &Run, needle: &str) {
-    assert!(
-        matches!(run.code, Some(1 | 2)),
-        "exit {:?}, stderr {}",
-        run.code,
-        run.stderr
-    );
-    assert!(
-        run.stderr.contains(needle),
-        "`{needle}` not in stderr: {}",
-        run.stderr
-    );
-    assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
-}
 
 fn refused_file(name: &str, text: &str, extra: &[&str], needle: &str) {
     let path = scratch(name).join("stations.csv");

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{s, Run};
+use common::{refused, s, Run};
 use std::path::PathBuf;
 
 fn host_sim(args: &[&str]) -> Run {
@@ -39,21 +39,6 @@ const SITE: [&str; 10] = [
     "--error-model",
     "ISCWSA MWD Rev5",
 ];
-
-fn refused(run: &Run, needle: &str) {
-    assert!(
-        matches!(run.code, Some(1 | 2)),
-        "exit {:?}, stderr {}",
-        run.code,
-        run.stderr
-    );
-    assert!(
-        run.stderr.contains(needle),
-        "`{needle}` not in stderr: {}",
-        run.stderr
-    );
-    assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
-}
 
 /// Runs two vertical wells `north` m apart; returns the run and the JSON.
 fn parallel(name: &str, north: &str, model: bool) -> (Run, serde_json::Value) {

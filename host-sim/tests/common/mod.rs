@@ -36,3 +36,20 @@ pub fn scratch(tag: &str, name: &str) -> PathBuf {
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// The run was refused: exit 1 or 2 (argument error), `needle` in its
+/// stderr, and no panic.
+pub fn refused(run: &Run, needle: &str) {
+    assert!(
+        matches!(run.code, Some(1 | 2)),
+        "exit {:?}, stderr {}",
+        run.code,
+        run.stderr
+    );
+    assert!(
+        run.stderr.contains(needle),
+        "`{needle}` not in stderr: {}",
+        run.stderr
+    );
+    assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
+}
