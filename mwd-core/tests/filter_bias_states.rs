@@ -11,8 +11,8 @@
 //! 61 of 100 inside 3 sigma).
 
 mod common;
-use common::Normal;
-use mwd_core::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
+use common::{Channel, Normal};
+use mwd_core::ar::{ACCEL_DEFAULTS, GYRO_DEFAULTS};
 use mwd_core::attitude::level;
 use mwd_core::conventions::DEG;
 use mwd_core::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, Euler};
@@ -22,7 +22,7 @@ use mwd_core::fine_alignment::{
     ArInitialCovariance, FineAlignment, FineAlignmentConfig, SpecificForceInModel, TiltPrior,
 };
 use mwd_core::mechanization::{ImuSample, NavState};
-use mwd_core::sensor_noise::{AxisNoise, ImuNoise};
+use mwd_core::sensor_noise::ImuNoise;
 use mwd_core::sensor_units::STANDARD_GRAVITY;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
@@ -31,40 +31,6 @@ const DT: f64 = SAMPLE_INTERVAL_S;
 const SAMPLES: usize = 1200; // the paper's 60 s
 const COARSE_SAMPLES: usize = 100; // its 5 s of coarse alignment
 const AZIMUTH_SIGMA: f64 = 2.0 * DEG;
-
-/// One sensor channel: AR(4) noise + constant residual bias + first-order
-/// Gauss-Markov bias instability (started in its stationary state).
-struct Channel {
-    ar: Ar4,
-    history: [f64; 4],
-    residual_bias: f64,
-    gauss_markov: f64,
-    budget: AxisNoise,
-}
-
-impl Channel {
-    fn new(ar: Ar4, budget: AxisNoise, rng: &mut Normal) -> Self {
-        let mut c = Self {
-            ar,
-            history: [0.0; 4],
-            residual_bias: budget.residual_bias * rng.sample(),
-            gauss_markov: budget.bias_instability * rng.sample(),
-            budget,
-        };
-        for _ in 0..200 {
-            c.next(rng); // AR noise into its stationary state
-        }
-        c
-    }
-
-    fn next(&mut self, rng: &mut Normal) -> f64 {
-        let a = libm::exp(-DT / self.budget.correlation_time);
-        let gm_step = libm::sqrt(1.0 - a * a) * self.budget.bias_instability;
-        self.gauss_markov = a * self.gauss_markov + gm_step * rng.sample();
-        let e = rng.sample() * libm::sqrt(self.ar.noise_variance);
-        self.residual_bias + self.gauss_markov + self.ar.step(&mut self.history, e)
-    }
-}
 
 /// A static tool: accelerometers x, y, z then rates x, y, z.
 struct BiasedStaticSensors {

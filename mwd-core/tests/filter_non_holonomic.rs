@@ -15,9 +15,9 @@
 //! the constraint's own rows H (first order, the same linearisation).
 
 mod common;
-use common::Normal;
+use common::{Channel, Normal};
 use mwd_core::aid_sources::{NonHolonomic, CROSS_AXES, DRILLING_VARIANCE};
-use mwd_core::ar::{Ar4, ACCEL_DEFAULTS, GYRO_DEFAULTS};
+use mwd_core::ar::{ACCEL_DEFAULTS, GYRO_DEFAULTS};
 use mwd_core::conventions::{dcm_from_quat, DrillingAngles, DEG};
 use mwd_core::earth::{gravity_n, LocalEarth, Position};
 use mwd_core::error_model::{AugmentedModel, STATES_WITH_BIASES, VEL};
@@ -25,7 +25,7 @@ use mwd_core::fine_alignment::{FineAlignment, FineAlignmentConfig, TiltPrior};
 use mwd_core::kalman::{FilterScalar, Measurement};
 use mwd_core::mechanization::{frame_rate_in_body, ImuSample, NavState, Strapdown};
 use mwd_core::probe::TieIn;
-use mwd_core::sensor_noise::{AxisNoise, ImuNoise};
+use mwd_core::sensor_noise::ImuNoise;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::{Matrix2, Rotation3, UnitQuaternion, Vector2, Vector3};
 
@@ -33,40 +33,6 @@ const DT: f64 = SAMPLE_INTERVAL_S;
 const STEPS: usize = 1200; // 60 s
 const SPEED: f64 = 0.5;
 const CLEARANCE: f64 = 0.003;
-
-/// One sensor channel: AR(4) noise + constant residual bias + first-order
-/// Gauss-Markov bias instability (the budget of `ImuNoise::scc1300`).
-struct Channel {
-    ar: Ar4,
-    history: [f64; 4],
-    residual_bias: f64,
-    gauss_markov: f64,
-    budget: AxisNoise,
-}
-
-impl Channel {
-    fn new(ar: Ar4, budget: AxisNoise, rng: &mut Normal) -> Self {
-        let mut c = Self {
-            ar,
-            history: [0.0; 4],
-            residual_bias: budget.residual_bias * rng.sample(),
-            gauss_markov: budget.bias_instability * rng.sample(),
-            budget,
-        };
-        for _ in 0..200 {
-            c.next(rng);
-        }
-        c
-    }
-
-    fn next(&mut self, rng: &mut Normal) -> f64 {
-        let a = libm::exp(-DT / self.budget.correlation_time);
-        let gm_step = libm::sqrt(1.0 - a * a) * self.budget.bias_instability;
-        self.gauss_markov = a * self.gauss_markov + gm_step * rng.sample();
-        let e = rng.sample() * libm::sqrt(self.ar.noise_variance);
-        self.residual_bias + self.gauss_markov + self.ar.step(&mut self.history, e)
-    }
-}
 
 /// The drilling tool: the truth (a strapdown run on ideal samples that
 /// keep it moving along its axis with the clearance's lateral motion) and
