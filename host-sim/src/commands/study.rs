@@ -41,10 +41,6 @@ pub struct CoverageArgs {
     /// Vibration level instead of the plan's.
     #[arg(long, value_enum)]
     pub vibration: Option<super::simulate::VibrationLevel>,
-    /// Apply a non-holonomic update from the host after every solution the
-    /// probe does not flag still (for a navigator without its own).
-    #[arg(long)]
-    pub host_nhc: bool,
     /// Run the probe without the calibration of the simulated parts'
     /// deterministic errors (as `simulate`'s captures and the QEMU probe).
     #[arg(long)]
@@ -78,7 +74,6 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         plan,
         tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
         depth_sigma,
-        host_nhc: args.host_nhc,
         uncalibrated: args.uncalibrated,
         terms,
         site: Site {
@@ -109,13 +104,12 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     );
     bar.finish_and_clear();
     outln!(
-        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads{}{})",
+        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads{})",
         args.plan.display(),
         args.runs,
         args.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
-        if args.host_nhc { ", host NHC" } else { "" },
         if args.uncalibrated {
             ", uncalibrated"
         } else {

@@ -13,7 +13,6 @@ use anyhow::{anyhow, Context, Result};
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::{Navigator, TieIn};
-use mwd_core::protocol::frame::nav_flags;
 use mwd_core::protocol::{RawSample, StationSurvey};
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
@@ -30,9 +29,6 @@ pub struct RunConfig {
     /// Draw the depth log's scale and stretch per run from these 1-sigma
     /// (the tool model's DSFS, DSTG); `None`: the plan's values.
     pub depth_sigma: Option<(f64, f64)>,
-    /// Call `Navigator::apply_non_holonomic` after every solution the probe
-    /// does not flag still (for a navigator that does not do it itself).
-    pub host_nhc: bool,
     /// Run the navigator without the calibration that removes the
     /// simulated parts' deterministic errors (as the QEMU probe and
     /// `simulate`'s captures run); default: calibrated, as a probe in a
@@ -159,9 +155,6 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         }
         if let Some(station) = navigator.take_station() {
             stations.push(station);
-        }
-        if config.host_nhc && tied && solution.flags & nav_flags::STILL == 0 {
-            navigator.apply_non_holonomic();
         }
     }
     // The run ends still at TD, where the probe sends its station when the
