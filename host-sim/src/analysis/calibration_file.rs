@@ -82,20 +82,27 @@ impl GyroEntry {
 /// failed part, never a calibration to load into a probe.
 pub mod limits {
     use crate::analysis::ranges::Range;
-    use mwd_core::sensor_units::STANDARD_GRAVITY;
+    // The probe's own bounds for an uplinked calibration: a file the host
+    // accepts, the probe accepts (one place for the numbers).
+    use mwd_core::protocol::uplink::fields as probe;
 
     /// Gyro scale factor applied: a +-50 % error is far beyond the part's
     /// (a few %); a negative or zero scale is not a gyro.
-    pub const GYRO_SCALE: Range = Range::new(0.5, 2.0, "");
+    pub const GYRO_SCALE: Range = Range::new(probe::GYRO_SCALE.0, probe::GYRO_SCALE.1, "");
     /// Gyro bias: 10 deg/s, far beyond the SCC1300's offset (its whole range
     /// is 300 deg/s); more is a unit mistake (deg/s written as rad/s).
-    pub const GYRO_BIAS_RAD_S: Range = Range::within(10.0 * mwd_core::conventions::DEG, "rad/s");
+    pub const GYRO_BIAS_RAD_S: Range = Range::within(probe::MAX_GYRO_BIAS_RAD_S, "rad/s");
     /// Accelerometer zero offset: 1 g, far beyond the part's (tens of mg).
-    pub const ACCEL_BIAS_M_S2: Range = Range::within(STANDARD_GRAVITY, "m/s^2");
+    pub const ACCEL_BIAS_M_S2: Range = Range::within(probe::MAX_ACCEL_BIAS_M_S2, "m/s^2");
     /// Diagonal of M = K^-1: the inverse of a scale factor, as the gyro's.
-    pub const CORRECTION_DIAGONAL: Range = Range::new(0.5, 2.0, "");
+    pub const CORRECTION_DIAGONAL: Range = Range::new(
+        probe::ACCEL_CORRECTION_DIAGONAL.0,
+        probe::ACCEL_CORRECTION_DIAGONAL.1,
+        "",
+    );
     /// Off-diagonal of M: cross-coupling up to 0.2 (11 deg of misalignment).
-    pub const CORRECTION_OFF_DIAGONAL: Range = Range::within(0.2, "");
+    pub const CORRECTION_OFF_DIAGONAL: Range =
+        Range::within(probe::MAX_ACCEL_CORRECTION_OFF_DIAGONAL, "");
     /// Condition number of M (largest over smallest singular value): a
     /// nearly singular correction amplifies noise without bound.
     pub const CORRECTION_CONDITION: Range = Range::new(1.0, 10.0, "");

@@ -200,9 +200,9 @@ pub fn read_tie_in(r: &mut Reader) -> Result<(DrillingAngles, DrillingAngles), R
     Ok((angles, sigma))
 }
 
-// The calibration's ranges are the host's calibration-file limits
-// (`host_sim::analysis::calibration_file::limits`), so that every file the
-// host accepts, the probe accepts: physical bounds far beyond a working
+// The calibration's ranges, which the host's calibration-file limits
+// (`host_sim::analysis::calibration_file::limits`) are built from, so that
+// every file the host accepts, the probe accepts: physical bounds far beyond a working
 // SCC1300's errors, beyond which a number is a unit mistake or a failed
 // fit, never a calibration.
 
