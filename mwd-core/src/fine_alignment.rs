@@ -13,10 +13,13 @@ use crate::aid_sources::{ZeroPosition, ZeroVelocity};
 use crate::conventions::{dcm_from_quat, euler_error_jacobian, DEG};
 use crate::earth::{gravity_n, normal_gravity, LocalEarth, Position, EARTH_RATE};
 use crate::error_model::{
-    is_model_size, AugmentedModel, AugmentedTransition, LinearizationPoint, ProcessNoise,
-    ACCEL_BIAS, ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
+    is_model_size, newest_ar_state, AugmentedModel, AugmentedTransition, LinearizationPoint,
+    ProcessNoise, ACCEL_BIAS, ATT, GYRO_AR, GYRO_BIAS, NAV_STATES, POS, STATES, STATES_WITH_BIASES,
+    VEL,
 };
-use crate::kalman::{std_dev_of, FilterScalar, KalmanFilter, Measurement, UpdateReport};
+use crate::kalman::{
+    std_dev_of, FilterScalar, KalmanFilter, Measurement, Transition, UpdateReport,
+};
 use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -233,6 +236,10 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     reference: LocalEarth,
     steps: u32,
     rejected_samples: u32,
+    /// The tool-axis rate fed to the mechanization is the frame's at the
+    /// computed attitude (`ToolAxisSource::AtRest`), not a measurement:
+    /// see [`hold_tool_axis`](Self::hold_tool_axis).
+    held_tool_axis: bool,
 }
 
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
@@ -248,6 +255,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             reference: LocalEarth::at(&reference),
             steps: 0,
             rejected_samples: 0,
+            held_tool_axis: false,
         };
         alignment.restart(initial, reference, config);
         alignment
@@ -291,6 +299,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.reference = LocalEarth::at(&reference);
         self.steps = 0;
         self.rejected_samples = 0;
+        self.held_tool_axis = false;
     }
 
     /// One sample: mechanization, time update, measurement updates,
@@ -342,14 +351,16 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             self.earth = LocalEarth::at(&state.position);
         }
         let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
-        if extra.is_none() {
-            self.filter.predict(&phi, &self.q);
-        } else {
-            let mut q = self.q;
+        let mut q = self.q;
+        if !extra.is_none() {
             for i in 0..3 {
                 q[ATT + i] += T::of(extra.attitude);
                 q[VEL + i] += T::of(extra.velocity);
             }
+        }
+        if self.held_tool_axis {
+            self.predict_with_held_tool_axis(&phi, &q, &c_bn);
+        } else {
             self.filter.predict(&phi, &q);
         }
 
@@ -378,6 +389,31 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             zero_position,
             correction,
         }
+    }
+
+    /// The time update when the tool-axis rate is held: the rate fed to the
+    /// mechanization about the tool axis t is the frame's at the computed
+    /// attitude, t . (C~^T omega_in), so the computed tool turns about t
+    /// exactly as the frame does, like the still true tool: the attitude
+    /// error about t does not move, phi' = -(I - t t^T)(omega_in x phi) -
+    /// (I - t t^T) C_b^n (b + e) (derivation section 4f). The transition is
+    /// M = Phi - e w^T with e = (t, 0, ...) and w = Phi^T e - e (the
+    /// tool-axis attitude row of Phi, less the identity), so that
+    /// M P M^T = Phi P Phi^T - z e^T - e z^T + s e e^T, z = Phi P w,
+    /// s = w^T P w: the structured time update plus a rank-2 correction of
+    /// the three attitude rows and columns (~2 N^2 multiplies, not a second
+    /// N^3 product). Without it the model expects the earth rate to turn a
+    /// heading error into a drift about the tool axis that the held rate
+    /// cancels, sees none at a station, and reads that as heading
+    /// information it does not have.
+    fn predict_with_held_tool_axis(
+        &mut self,
+        phi: &AugmentedTransition<T, N>,
+        q: &SVector<T, N>,
+        c_bn: &Matrix3<f64>,
+    ) {
+        let tool_axis = Vector3::new(c_bn[(0, 1)], c_bn[(1, 1)], c_bn[(2, 1)]);
+        predict_holding_axis(&mut self.filter, phi, q, &tool_axis);
     }
 
     /// Feeds the estimated navigation errors back into the mechanization
@@ -469,6 +505,14 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         };
     }
 
+    /// Whether the tool-axis rate fed to the following steps is held at the
+    /// frame's rate (`ToolAxisSource::AtRest`) rather than measured: the
+    /// time update then leaves the attitude error about the tool axis
+    /// where it is ([`predict_with_held_tool_axis`](Self::predict_with_held_tool_axis)).
+    pub fn hold_tool_axis(&mut self, held: bool) {
+        self.held_tool_axis = held;
+    }
+
     /// Turns the zero-velocity update on (noise variance `variance`,
     /// (m/s)^2) or off for the following steps: the navigator's station
     /// surveys while the probe is still (`probe::navigator`).
@@ -551,6 +595,72 @@ fn add_levelling_bias_correlation<T: FilterScalar, const N: usize>(
     }
 }
 
+/// `filter`'s time update with the attitude error about the unit vector
+/// `axis` (nav frame) held where it was: transition M = Phi - e w^T, e =
+/// (axis, 0, ...), w = Phi^T e - e ([`FineAlignment::hold_tool_axis`]).
+/// The structured Phi P Phi^T + Q plus the rank-2 correction
+/// -z e^T - e z^T + s e e^T with z = Phi P w and s = w^T P w.
+pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
+    filter: &mut KalmanFilter<T, N>,
+    phi: &AugmentedTransition<T, N>,
+    q: &SVector<T, N>,
+    axis: &Vector3<f64>,
+) {
+    let t: [T; 3] = core::array::from_fn(|i| T::of(axis[i]));
+    // w: the axis's attitude row of Phi (navigation block and the
+    // rate-error couplings) less e.
+    let mut w = SVector::<T, N>::zeros();
+    for j in 0..NAV_STATES {
+        let mut r = T::zero();
+        for (i, ti) in t.iter().enumerate() {
+            r += *ti * phi.nav[(ATT + i, j)];
+        }
+        w[j] = r;
+    }
+    for (i, ti) in t.iter().enumerate() {
+        w[ATT + i] -= *ti;
+    }
+    if phi.coupled {
+        for axis in 0..3 {
+            let mut g = T::zero();
+            for (i, ti) in t.iter().enumerate() {
+                g += *ti * phi.c_bn_dt[(i, axis)];
+            }
+            w[newest_ar_state(GYRO_AR, axis)] = -g;
+            if N == STATES_WITH_BIASES {
+                w[GYRO_BIAS + axis] = -g;
+            }
+        }
+    }
+    let mut z = SVector::<T, N>::zeros();
+    for (j, wj) in w.iter().enumerate() {
+        if *wj != T::zero() {
+            for i in 0..N {
+                z[i] += filter.p[(i, j)] * *wj;
+            }
+        }
+    }
+    let s = w.dot(&z);
+    let wx = w.dot(&filter.x);
+    filter.predict(phi, q);
+    phi.apply_to_vector(&mut z);
+    let p = &mut filter.p;
+    for (k, tk) in t.iter().enumerate() {
+        for i in 0..N {
+            p[(i, ATT + k)] -= z[i] * *tk;
+        }
+    }
+    for (k, tk) in t.iter().enumerate() {
+        for j in 0..N {
+            p[(ATT + k, j)] -= *tk * z[j];
+        }
+        for (l, tl) in t.iter().enumerate() {
+            p[(ATT + k, ATT + l)] += s * *tk * *tl;
+        }
+        filter.x[ATT + k] -= *tk * wx;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -581,5 +691,67 @@ mod tests {
         assert!(std.x.is_nan() && std.y.is_nan(), "{std:?}");
         fa.filter.p[(ATT, ATT)] = f32::NAN;
         assert!(fa.euler_std().iter().all(|s| s.is_nan()));
+    }
+
+    /// The held-axis time update (structured product plus rank-2
+    /// correction) equals the dense M P M^T + Q, M = Phi - e w^T, and
+    /// leaves the attitude error about the axis where it was.
+    #[test]
+    fn holding_an_axis_matches_the_dense_transition() {
+        let model = AugmentedModel::paper();
+        let position = Position::paper_site();
+        let c_bn = nalgebra::Rotation3::from_euler_angles(0.3, 1.2, 2.0).into_inner();
+        let lp = LinearizationPoint {
+            c_bn,
+            velocity_n: Vector3::new(0.01, -0.02, 0.0),
+            position,
+            specific_force_n: -gravity_n(&position),
+        };
+        let phi: AugmentedTransition<f64, STATES_WITH_BIASES> =
+            model.transition_with(&LocalEarth::at(&position), &lp);
+        let n = STATES_WITH_BIASES;
+        let l = SMatrix::<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>::from_fn(|i, j| {
+            if j <= i {
+                1e-3 * (1.0 + ((i * 7 + j * 3) % 11) as f64) / (1.0 + (i + j) as f64)
+            } else {
+                0.0
+            }
+        });
+        let p0 = l * l.transpose();
+        let q = SVector::<f64, STATES_WITH_BIASES>::from_fn(|i, _| 1e-9 * (1 + i % 5) as f64);
+        let x0 = SVector::<f64, STATES_WITH_BIASES>::from_fn(|i, _| 1e-4 * (i as f64 - 17.0));
+        let axis = c_bn.column(1).into_owned();
+        let mut e = SVector::<f64, STATES_WITH_BIASES>::zeros();
+        for i in 0..3 {
+            e[ATT + i] = axis[i];
+        }
+        let dense = phi.to_dense();
+        let w = dense.transpose() * e - e;
+        let m = dense - e * w.transpose();
+        let want_p = m * p0 * m.transpose() + SMatrix::from_diagonal(&q);
+        let want_x = m * x0;
+        let mut filter = KalmanFilter::new(p0);
+        filter.x = x0;
+        predict_holding_axis(&mut filter, &phi, &q, &axis);
+        for i in 0..n {
+            assert!((filter.x[i] - want_x[i]).abs() <= 1e-12, "x[{i}]");
+            for j in 0..n {
+                let tol = 1e-12 * (want_p[(i, i)] * want_p[(j, j)]).sqrt().max(1e-12);
+                assert!(
+                    (filter.p[(i, j)] - want_p[(i, j)]).abs() <= tol,
+                    "P[{i},{j}]"
+                );
+            }
+        }
+        // Along the axis the attitude error is carried unchanged: its
+        // variance grows only by the axis's share of Q.
+        let along = |p: &SMatrix<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>| {
+            (0..3)
+                .flat_map(|a| (0..3).map(move |b| (a, b)))
+                .map(|(a, b)| axis[a] * axis[b] * p[(ATT + a, ATT + b)])
+                .sum::<f64>()
+        };
+        let q_along: f64 = (0..3).map(|a| axis[a] * axis[a] * q[ATT + a]).sum();
+        assert!((along(&filter.p) - along(&p0) - q_along).abs() <= 1e-15);
     }
 }

@@ -163,9 +163,10 @@ pub const SURVEY_SETTLE_EPOCHS: u32 = 40;
 /// accelerometer noise, 0.058 m/s^2 per sample (paper Table 4), over g.
 pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 
-/// The fewest still cycles whose mean makes a vertical-earth-rate bias
-/// update (`aid_sources::VerticalEarthRate`): 30 s.
-pub const MIN_BIAS_UPDATE_SAMPLES: u32 = 600;
+/// The fewest still cycles with both gyros in a block of
+/// [`SURVEY_SETTLE_EPOCHS`] whose mean makes a vertical-earth-rate bias
+/// update (`aid_sources::VerticalEarthRate`): three quarters of the block.
+pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 
 /// The filter's settings for a still probe at `position` whose coarse
 /// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
@@ -206,6 +207,8 @@ struct Station {
     /// residual m and d_x, d_z (`aid_sources::VerticalEarthRate`).
     vertical_sum: f64,
     down_sum: [f64; 2],
+    /// Still cycles in those sums.
+    vertical_epochs: u32,
 }
 
 /// The probe's navigation, one raw sample at a time.
@@ -251,15 +254,6 @@ pub struct Navigator {
     vertical_residual: Option<(f64, [f64; 2])>,
     /// The roll was held for drilling since the last still cycle.
     drilled_since_station: bool,
-    /// Drilled since the heading was last set (alignment or tie-in): the
-    /// azimuth is reported undetermined from then on. Measured in the
-    /// simulated lateral (host-sim/tests/drilling_navigation.rs): the
-    /// filter's heading sigma, honest while drilling, collapses during the
-    /// next station's zero-velocity updates (10 deg to 1.7 deg) with no
-    /// heading information behind it, and station azimuth errors of 8-16
-    /// deg came with 1.7-3.5 deg sigmas. Until that is understood no
-    /// azimuth after drilling is given a finite sigma.
-    heading_after_drilling: bool,
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
@@ -294,7 +288,6 @@ impl Navigator {
             finished_station: None,
             vertical_residual: None,
             drilled_since_station: false,
-            heading_after_drilling: false,
             time_us: 0,
             sample_counter: 0,
         }
@@ -366,12 +359,11 @@ impl Navigator {
                 survey: StationSurvey::default(),
                 vertical_sum: 0.0,
                 down_sum: [0.0; 2],
+                vertical_epochs: 0,
                 checkpoint: None,
                 settled: None,
             });
         }
-        let survey = self.station_survey();
-        let number = self.stations;
         let Some(station) = self.station.as_mut() else {
             return;
         };
@@ -381,7 +373,22 @@ impl Navigator {
             station.vertical_sum += m;
             station.down_sum[0] += d[0];
             station.down_sum[1] += d[1];
+            station.vertical_epochs += 1;
         }
+        let block_done = station.epochs % SURVEY_SETTLE_EPOCHS == 0;
+        if block_done {
+            // Each block's mean is one vertical-earth-rate update, before
+            // the block's survey is taken, so a station's survey holds the
+            // rate biases (and through them the heading drift of the
+            // drilling before it) from all its still cycles but the last
+            // block's.
+            self.update_rate_biases();
+        }
+        let survey = self.station_survey();
+        let number = self.stations;
+        let Some(station) = self.station.as_mut() else {
+            return;
+        };
         let start_sample = if station.epochs == 1 {
             start
         } else {
@@ -393,7 +400,7 @@ impl Navigator {
             still_quality: station.quality_sum / station.epochs as f32,
             ..survey
         };
-        if station.epochs % SURVEY_SETTLE_EPOCHS == 0 {
+        if block_done {
             station.settled = station.checkpoint.replace(station.survey);
         }
         if station.epochs >= MAX_STATION_SAMPLES {
@@ -404,34 +411,44 @@ impl Navigator {
 
     fn finish_station(&mut self, flags: u16) {
         if let Some(station) = self.station.take() {
-            self.update_rate_biases(&station);
             let mut survey = station.settled.unwrap_or(station.survey);
             survey.flags |= flags;
             self.finished_station = Some(survey);
         }
     }
 
-    /// The vertical-earth-rate update of the x and z rate biases from a
-    /// station's still cycles (`aid_sources::VerticalEarthRate`), when it
-    /// had at least [`MIN_BIAS_UPDATE_SAMPLES`] of them.
-    fn update_rate_biases(&mut self, station: &Station) {
-        if station.epochs < MIN_BIAS_UPDATE_SAMPLES || self.covariance_invalid {
+    /// The vertical-earth-rate update of the x and z rate biases from the
+    /// still cycles summed since the last one (`aid_sources::VerticalEarthRate`),
+    /// which it clears: one update per block of [`SURVEY_SETTLE_EPOCHS`]
+    /// still cycles. The block means' gyro noise is independent from block
+    /// to block (the AR models' correlation is a few samples long); their
+    /// attitude terms are not, but at Omega sigma_tilt (< 0.1 deg/h) they
+    /// are far below the block's noise (~38 deg/h for 2 s of SCC1300).
+    fn update_rate_biases(&mut self) {
+        let Some(station) = self.station.as_mut() else {
+            return;
+        };
+        let n = station.vertical_epochs;
+        let (sum, down_sum) = (station.vertical_sum, station.down_sum);
+        station.vertical_sum = 0.0;
+        station.down_sum = [0.0; 2];
+        station.vertical_epochs = 0;
+        if n < MIN_BIAS_UPDATE_SAMPLES || self.covariance_invalid {
             return;
         }
-        let n = f64::from(station.epochs);
-        let d = station.down_sum.map(|v| v / n);
+        let d = down_sum.map(|v| v / f64::from(n));
         let tilt = self.filter.euler_std();
         let cos_inclination = dcm_from_quat(&self.filter.state().attitude)[(2, 1)];
         let variance = VerticalEarthRate::<f32>::variance(
             d,
             GYRO_AXES.map(gyro_long_run_variance),
-            station.epochs,
+            n,
             tilt.x.max(tilt.y),
             cos_inclination,
             tilt.z.min(core::f64::consts::PI),
         );
         let measurement = VerticalEarthRate {
-            vertical_residual: (station.vertical_sum / n) as f32,
+            vertical_residual: (sum / f64::from(n)) as f32,
             down_in_gyro_plane: d.map(|v| v as f32),
             variance: variance as f32,
         };
@@ -466,7 +483,6 @@ impl Navigator {
         survey.correlations = u.correlation.map(|r| r as f32);
         // The navigation frames' rule for the azimuth (see `solution`).
         let determined = self.coarse_std[2].is_finite()
-            && !self.heading_after_drilling
             && self.flags & nav_flags::SINGLE_PART == 0
             && flags & station_flags::NEAR_VERTICAL == 0
             && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
@@ -573,6 +589,7 @@ impl Navigator {
                     source,
                     SAMPLE_INTERVAL_S,
                 );
+                filter.hold_tool_axis(source == ToolAxisSource::AtRest);
                 if tool_axis == ToolAxisRate::Unavailable || drilling {
                     self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
                 }
@@ -586,7 +603,7 @@ impl Navigator {
                     // noise per sample: white, a velocity random walk.
                     extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
                 }
-                filter.linearize_at_gravity(drilling);
+                filter.linearize_at_gravity(drilling || still);
                 let report = filter.step_with(&imu, &extra);
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
@@ -625,7 +642,6 @@ impl Navigator {
                     self.drilled_since_station = false;
                 }
                 self.drilled_since_station |= drilling;
-                self.heading_after_drilling |= drilling;
                 self.vertical_residual = (update && missing_gyro.is_none())
                     .then(|| vertical_residual(filter.state(), &sample));
                 self.held = Some(imu);
@@ -710,7 +726,6 @@ impl Navigator {
         );
         self.covariance_invalid = false;
         self.coasting = false;
-        self.heading_after_drilling = false;
         self.drilled_since_station = false;
         self.phase = Phase::Fine { samples: 0 };
     }
@@ -759,7 +774,6 @@ impl Navigator {
         // The azimuth's sigma: infinite while the heading is undetermined
         // (coarse alignment) or rests on one gyro (single part).
         let heading_std = if self.coarse_std[2].is_finite()
-            && !self.heading_after_drilling
             && solution.flags & nav_flags::SINGLE_PART == 0
             && std.z <= AZIMUTH_SIGMA_LIMIT_RAD
         {
@@ -791,8 +805,8 @@ impl Navigator {
     /// that levelled itself calls it between steps as soon as
     /// [`is_navigating`](Self::is_navigating) first returns true (the end
     /// of the fine alignment); the probe's own levelled tilt is then
-    /// replaced by the tie-in's (not combined). Drilling mode, stations and
-    /// the azimuth rule (`heading_after_drilling`) start afresh.
+    /// replaced by the tie-in's (not combined). Drilling mode and stations
+    /// start afresh.
     pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
         let sigma = tie_in.euler_sigma();
         let mut config = filter_config(&self.position, &sigma);
@@ -809,7 +823,6 @@ impl Navigator {
         self.coasting = false;
         self.covariance_invalid = false;
         self.coarse_single_part = false;
-        self.heading_after_drilling = false;
         self.drilled_since_station = false;
         self.phase = Phase::Navigating;
     }
