@@ -505,6 +505,52 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         };
     }
 
+    /// The accelerometer-bias estimate (m/s^2, body axes) and its
+    /// covariance; `None` in the 33-state form, which has no bias states.
+    pub fn accel_bias(&self) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+        if N != STATES_WITH_BIASES {
+            return None;
+        }
+        let x = &self.filter.x;
+        let estimate = Vector3::from_fn(|i, _| x[ACCEL_BIAS + i].as_f64());
+        let covariance =
+            Matrix3::from_fn(|i, j| self.filter.p[(ACCEL_BIAS + i, ACCEL_BIAS + j)].as_f64());
+        Some((estimate, covariance))
+    }
+
+    /// Puts back an accelerometer-bias estimate and covariance taken
+    /// [`steps`](Self::steps) ago ([`accel_bias`](Self::accel_bias)), grown
+    /// by the biases' random walk since, with no correlation to the other
+    /// states (which keeps P positive semi-definite: a principal block and
+    /// a PSD block). The probe's stations use it: what the filter learns of
+    /// the accelerometers while drilling is the bias plus the vibration's
+    /// rectified share, which is gone at rest (derivation section 4f).
+    pub fn restore_accel_bias(
+        &mut self,
+        estimate: &Vector3<f64>,
+        covariance: &Matrix3<f64>,
+        steps_ago: u32,
+    ) {
+        if N != STATES_WITH_BIASES {
+            return;
+        }
+        let p = &mut self.filter.p;
+        for i in ACCEL_BIAS..ACCEL_BIAS + 3 {
+            for j in 0..N {
+                p[(i, j)] = T::zero();
+                p[(j, i)] = T::zero();
+            }
+        }
+        for i in 0..3 {
+            self.filter.x[ACCEL_BIAS + i] = T::of(estimate[i]);
+            for j in 0..3 {
+                p[(ACCEL_BIAS + i, ACCEL_BIAS + j)] = T::of(covariance[(i, j)]);
+            }
+            let walk = self.q[ACCEL_BIAS + i].as_f64() * f64::from(steps_ago);
+            p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] += T::of(walk);
+        }
+    }
+
     /// Whether the tool-axis rate fed to the following steps is held at the
     /// frame's rate (`ToolAxisSource::AtRest`) rather than measured: the
     /// time update then leaves the attitude error about the tool axis
