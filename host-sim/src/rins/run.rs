@@ -64,6 +64,13 @@ pub struct FilterSummary {
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
     pub drift_true_deg_h: f64,
+    /// The smallest 1-sigma any filter can reach at the failure (deg/h):
+    /// the two systems' headings random-walk apart with density
+    /// 2 ARW^2, and the drift of a random walk observed without noise for a
+    /// time T is known to sqrt(2 ARW^2 / T) at best (its Fisher information
+    /// is T / (2 ARW^2)). Even a directly measured heading difference could
+    /// not do better.
+    pub drift_sigma_bound: f64,
     pub reduced: FilterSummary,
     pub full: FilterSummary,
     /// Radial position errors at the end of the run (m).
@@ -155,6 +162,17 @@ fn share((n, of): (u64, u64)) -> f64 {
         f64::NAN
     } else {
         n as f64 / of as f64
+    }
+}
+
+/// See [`Summary::drift_sigma_bound`] (rad/s); +inf with no time to learn.
+fn drift_sigma_bound(s: &Scenario) -> f64 {
+    let density = s.backup.gyro_arw.powi(2) + s.master.gyro_arw.powi(2);
+    let seconds = s.failure_hour * 3600.0;
+    if seconds > 0.0 {
+        (density / seconds).sqrt()
+    } else {
+        f64::INFINITY
     }
 }
 
@@ -299,6 +317,7 @@ pub fn run(s: &Scenario) -> anyhow::Result<Results> {
     };
     let summary = Summary {
         drift_true_deg_h: truth * to_deg_h,
+        drift_sigma_bound: drift_sigma_bound(s) * to_deg_h,
         reduced: filter_summary(at_failure[0], &inside_reduced, micros_per_step(&reduced)),
         full: filter_summary(at_failure[1], &inside_full, micros_per_step(&full)),
         radial_master_end: end(|r| r.radial_master),

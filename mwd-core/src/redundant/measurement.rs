@@ -27,7 +27,7 @@ impl<T: FilterScalar> Measurement<T> for DifferenceMeasurement<T> {
         4
     }
 
-    /// The rows of H_r (eq. 24 as corrected by erratum 44): each scalar
+    /// The rows of H_r (eq. 24 as corrected by erratum RINS-4): each scalar
     /// selects one velocity or position difference state.
     fn scalar(&self, k: usize) -> Option<ScalarMeasurement<T>> {
         let (z, state, r) = match k {
@@ -45,7 +45,7 @@ impl<T: FilterScalar> Measurement<T> for DifferenceMeasurement<T> {
     }
 }
 
-/// H_r of eq. 24 (corrected, erratum 44) as a matrix, for the
+/// H_r of eq. 24 (corrected, erratum RINS-4) as a matrix, for the
 /// observability analysis.
 pub fn measurement_matrix<T: FilterScalar, const N: usize>() -> nalgebra::SMatrix<T, 4, N> {
     let mut h = nalgebra::SMatrix::zeros();

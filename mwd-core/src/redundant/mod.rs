@@ -3,7 +3,7 @@
 //! reduced-order Kalman filter that learns the backup's azimuth gyro drift,
 //! and a prediction model that compensates the backup's position and
 //! velocity once the master fails. `docs/redundant-rins.md` has the model,
-//! the equations with the paper's numbers and the errata (41-46 in
+//! the equations with the paper's numbers and the errata (RINS-1 to RINS-7 in
 //! `docs/paper-errata.md`).
 //!
 //! * [`model`]: the full 17-state difference model (eq. 1-8) and the

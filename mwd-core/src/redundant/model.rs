@@ -183,7 +183,7 @@ pub fn reduced_dynamics<T: FilterScalar>(
     f
 }
 
-/// G_r of eq. 18 written directly (with erratum 43: the master's velocity
+/// G_r of eq. 18 written directly (with erratum RINS-3: the master's velocity
 /// block is -M C_b2^n M^T, 2 x 2). Equals T G (eq. 10).
 pub fn reduced_noise_input<T: FilterScalar>(
     c_b1: &Matrix3<T>,

@@ -4,7 +4,7 @@
 //!
 //! The paper's eq. 26 stops the powers of F_r at j - 1 (segment index);
 //! the stripped matrix needs them up to n - 1 = 7 in every segment
-//! (erratum 45), so each segment contributes 4 x 8 = 32 rows.
+//! (erratum RINS-5), so each segment contributes 4 x 8 = 32 rows.
 //!
 //! The raw matrix cannot be ranked as it stands: its entries run from
 //! f_U ~ 10 m/s^2 to (Schuler rate)^7 ~ 1e-20, and a singular-value cut-off
@@ -51,7 +51,7 @@ pub fn nondimensional<T: FilterScalar>(
 }
 
 /// One segment's observability matrix O_j = [H; H F; ...; H F^7] (eq. 26
-/// with erratum 45).
+/// with erratum RINS-5).
 pub fn observability_block<T: FilterScalar>(
     f: &SMatrix<T, N, N>,
     h: &SMatrix<T, 4, N>,

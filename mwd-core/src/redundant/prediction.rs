@@ -3,7 +3,7 @@
 //! The backup's own errors x_1 = (phi_1, dv_1, dp_1, eps_z) obey the same
 //! model as the difference (A_1 = F_r, eq. 30). The paper starts the
 //! prediction at x_1(t_0) = 0 (eq. 32); as printed that predicts nothing,
-//! since Phi 0 = 0 forever (erratum 46). The drift state must start at the
+//! since Phi 0 = 0 forever (erratum RINS-6). The drift state must start at the
 //! filter's estimate: x_1(t_0) = (0, ..., 0, eps_z_hat). The model is
 //! linear, so the prediction is eps_z_hat times the response s(t) to a unit
 //! drift, s(t_0) = e_8, s(t_k+1) = Phi_1 s(t_k): the response is propagated
