@@ -38,7 +38,10 @@ pub struct RinsArgs {
 
 pub fn run(args: RinsArgs) -> Result<()> {
     if !(args.gyro_arw.is_finite() && args.gyro_arw >= 0.0) {
-        anyhow::bail!("--gyro-arw must be a non-negative number (deg/sqrt(h)), got {}", args.gyro_arw);
+        anyhow::bail!(
+            "--gyro-arw must be a non-negative number (deg/sqrt(h)), got {}",
+            args.gyro_arw
+        );
     }
     let mut scenario = Scenario {
         seed: args.seed,
@@ -80,7 +83,13 @@ fn num(x: f64, decimals: usize) -> String {
 fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     let m = &r.summary;
     let (red, full) = (&m.reduced, &m.full);
-    let pct = |x: f64| if x.is_finite() { format!("{:.1} %", 100.0 * x) } else { "undetermined".into() };
+    let pct = |x: f64| {
+        if x.is_finite() {
+            format!("{:.1} %", 100.0 * x)
+        } else {
+            "undetermined".into()
+        }
+    };
     let mut lines = vec![
         format!(
             "Redundant RINS paper, section 4.1: {} h, master fails at hour {}, {:.0} deg N, {} m/s due east (seed {}).",
@@ -93,10 +102,16 @@ fn report(s: &Scenario, r: &Results, wall: f64) -> String {
         format!("Backup azimuth drift (truth) {:.5} deg/h.\n", m.drift_true_deg_h),
         format!("{:<58} {:>26} | {}", "", "ours", "paper"),
     ];
-    let mut row = |what: &str, ours: String, paper: &str| lines.push(format!("{what:<58} {ours:>26} | {paper}"));
+    let mut row = |what: &str, ours: String, paper: &str| {
+        lines.push(format!("{what:<58} {ours:>26} | {paper}"))
+    };
     row(
         "drift estimate error at failure, reduced (deg/h, 1 sigma)",
-        format!("{} +- {}", num(red.error_at_failure, 6), num(red.sigma_at_failure, 6)),
+        format!(
+            "{} +- {}",
+            num(red.error_at_failure, 6),
+            num(red.sigma_at_failure, 6)
+        ),
         "accuracy 0.00005 (Fig. 3)",
     );
     row(
@@ -106,22 +121,38 @@ fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     );
     row(
         "drift estimate error at failure, full (deg/h, 1 sigma)",
-        format!("{} +- {}", num(full.error_at_failure, 6), num(full.sigma_at_failure, 6)),
+        format!(
+            "{} +- {}",
+            num(full.error_at_failure, 6),
+            num(full.sigma_at_failure, 6)
+        ),
         "not given",
     );
     row(
         "reduced error inside 3 sigma, before failure / whole run",
-        format!("{} / {}", pct(red.inside_3sigma_before_failure), pct(red.inside_3sigma_run)),
+        format!(
+            "{} / {}",
+            pct(red.inside_3sigma_before_failure),
+            pct(red.inside_3sigma_run)
+        ),
         "within bounds (Fig. 3)",
     );
     row(
         "full error inside 3 sigma, before failure / whole run",
-        format!("{} / {}", pct(full.inside_3sigma_before_failure), pct(full.inside_3sigma_run)),
+        format!(
+            "{} / {}",
+            pct(full.inside_3sigma_before_failure),
+            pct(full.inside_3sigma_run)
+        ),
         "not given",
     );
     row(
         "reduced - full drift at failure (deg/h; RSS of sigmas)",
-        format!("{} ({})", num(m.reduced_minus_full, 6), num(m.combined_sigma, 6)),
+        format!(
+            "{} ({})",
+            num(m.reduced_minus_full, 6),
+            num(m.combined_sigma, 6)
+        ),
         "comparable (Fig. 6)",
     );
     row(
@@ -129,10 +160,18 @@ fn report(s: &Scenario, r: &Results, wall: f64) -> String {
         num(m.radial_master_end, 0),
         "curve only (Fig. 5)",
     );
-    row("  backup uncompensated (m)", num(m.radial_backup_end, 0), "curve only (Fig. 5)");
+    row(
+        "  backup uncompensated (m)",
+        num(m.radial_backup_end, 0),
+        "curve only (Fig. 5)",
+    );
     row(
         "  backup compensated, reduced / full filter (m)",
-        format!("{} / {}", num(m.radial_compensated_reduced_end, 0), num(m.radial_compensated_full_end, 0)),
+        format!(
+            "{} / {}",
+            num(m.radial_compensated_reduced_end, 0),
+            num(m.radial_compensated_full_end, 0)
+        ),
         "comparable with master (Fig. 5-6)",
     );
     row(
@@ -152,7 +191,11 @@ fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     );
     row(
         "cost per step, reduced / full filter (us, this build)",
-        format!("{} / {}", num(red.micros_per_step, 1), num(full.micros_per_step, 1)),
+        format!(
+            "{} / {}",
+            num(red.micros_per_step, 1),
+            num(full.micros_per_step, 1)
+        ),
         "reduced 'relaxes the burden'",
     );
     lines.push(String::new());

@@ -120,7 +120,14 @@ impl DriftFilter<REDUCED_STATES> {
 
     /// Time update over `dt` with the backup's mean orientation over the
     /// step and the orientations at its middle (for Q).
-    pub fn predict(&mut self, m: &Motion, c1: &Matrix3<f64>, mid: [&Matrix3<f64>; 2], dt: f64, t: &Tuning) {
+    pub fn predict(
+        &mut self,
+        m: &Motion,
+        c1: &Matrix3<f64>,
+        mid: [&Matrix3<f64>; 2],
+        dt: f64,
+        t: &Tuning,
+    ) {
         let start = Instant::now();
         let phi = transition(&reduced_dynamics(m, c1), dt);
         let g = reduced_noise_input(mid[0], mid[1]);

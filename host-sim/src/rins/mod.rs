@@ -105,7 +105,10 @@ impl Scenario {
                 anyhow::bail!("{name} must be a positive number, got {v}");
             }
         }
-        if !(self.failure_hour.is_finite() && self.failure_hour >= 0.0 && self.failure_hour <= self.hours) {
+        if !(self.failure_hour.is_finite()
+            && self.failure_hour >= 0.0
+            && self.failure_hour <= self.hours)
+        {
             anyhow::bail!(
                 "the failure hour must lie within the run (0 to {} h), got {}",
                 self.hours,
@@ -117,7 +120,10 @@ impl Scenario {
             anyhow::bail!("the filter step must be a whole number of substeps");
         }
         if !(self.latitude_deg.abs() < 85.0) {
-            anyhow::bail!("latitude must be within +-85 deg (the model's tan L), got {}", self.latitude_deg);
+            anyhow::bail!(
+                "latitude must be within +-85 deg (the model's tan L), got {}",
+                self.latitude_deg
+            );
         }
         if !(self.speed.is_finite() && self.speed >= 0.0 && self.course_deg.is_finite()) {
             anyhow::bail!("speed must be a non-negative number and the course finite");

@@ -53,7 +53,11 @@ impl Lines {
             y = (y.0.min(py), y.1.max(py));
         }
         if !(y.0 < y.1) {
-            y = if y.0.is_finite() { (y.0 - 1.0, y.0 + 1.0) } else { (-1.0, 1.0) };
+            y = if y.0.is_finite() {
+                (y.0 - 1.0, y.0 + 1.0)
+            } else {
+                (-1.0, 1.0)
+            };
         }
         let pad = 0.05 * (y.1 - y.0);
         (x, (y.0 - pad, y.1 + pad))
@@ -86,14 +90,21 @@ impl Figure for Lines {
             ))
             .map_err(plot_error)?
             .label("master fails")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1))
+            });
         for (i, (name, points)) in self.curves.iter().enumerate() {
             let colour = COLOURS[i % COLOURS.len()];
             chart
-                .draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    colour.stroke_width(2),
+                ))
                 .map_err(plot_error)?
                 .label(name.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
         }
         chart
             .configure_series_labels()
@@ -115,37 +126,59 @@ pub fn write_figures(dir: &Path, r: &Results, failure_hour: f64) -> Result<Vec<P
     let figures = [
         (
             "fig3-drift-estimate",
-            Lines::new("Fig. 3: backup azimuth drift estimate error (reduced filter)", "deg/h", failure_hour)
-                .curve("estimate error", h, |r| r.drift_error_reduced)
-                .curve("+3 sigma", h, |r| 3.0 * r.drift_sigma_reduced)
-                .curve("-3 sigma", h, |r| -3.0 * r.drift_sigma_reduced),
+            Lines::new(
+                "Fig. 3: backup azimuth drift estimate error (reduced filter)",
+                "deg/h",
+                failure_hour,
+            )
+            .curve("estimate error", h, |r| r.drift_error_reduced)
+            .curve("+3 sigma", h, |r| 3.0 * r.drift_sigma_reduced)
+            .curve("-3 sigma", h, |r| -3.0 * r.drift_sigma_reduced),
         ),
         (
             "fig4-latitude",
-            Lines::new("Fig. 4: backup latitude error and its prediction", "north error (m)", failure_hour)
-                .curve("backup error", h, |r| r.backup_north)
-                .curve("part due to the azimuth drift", h, |r| r.drift_north)
-                .curve("prediction (eq. 31)", h, |r| r.predicted_north),
+            Lines::new(
+                "Fig. 4: backup latitude error and its prediction",
+                "north error (m)",
+                failure_hour,
+            )
+            .curve("backup error", h, |r| r.backup_north)
+            .curve("part due to the azimuth drift", h, |r| r.drift_north)
+            .curve("prediction (eq. 31)", h, |r| r.predicted_north),
         ),
         (
             "fig4-longitude",
-            Lines::new("Fig. 4: backup longitude error and its prediction", "east error (m)", failure_hour)
-                .curve("backup error", h, |r| r.backup_east)
-                .curve("part due to the azimuth drift", h, |r| r.drift_east)
-                .curve("prediction (eq. 31)", h, |r| r.predicted_east),
+            Lines::new(
+                "Fig. 4: backup longitude error and its prediction",
+                "east error (m)",
+                failure_hour,
+            )
+            .curve("backup error", h, |r| r.backup_east)
+            .curve("part due to the azimuth drift", h, |r| r.drift_east)
+            .curve("prediction (eq. 31)", h, |r| r.predicted_east),
         ),
         (
             "fig5-radial",
             Lines::new("Fig. 5: radial position error", "m", failure_hour)
                 .curve("backup, uncompensated", h, |r| r.radial_backup)
-                .curve("backup, compensated (eq. 33)", h, |r| r.radial_compensated_reduced)
+                .curve("backup, compensated (eq. 33)", h, |r| {
+                    r.radial_compensated_reduced
+                })
                 .curve("master (dual-axis)", h, |r| r.radial_master),
         ),
         (
             "fig6-reduced-vs-full",
-            Lines::new("Fig. 6: compensated backup, reduced vs full filter", "radial error (m)", failure_hour)
-                .curve("reduced-order filter (8 states)", h, |r| r.radial_compensated_reduced)
-                .curve("full augmented filter (17 states)", h, |r| r.radial_compensated_full),
+            Lines::new(
+                "Fig. 6: compensated backup, reduced vs full filter",
+                "radial error (m)",
+                failure_hour,
+            )
+            .curve("reduced-order filter (8 states)", h, |r| {
+                r.radial_compensated_reduced
+            })
+            .curve("full augmented filter (17 states)", h, |r| {
+                r.radial_compensated_full
+            }),
         ),
     ];
     let mut files = Vec::new();

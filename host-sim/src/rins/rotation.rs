@@ -97,20 +97,27 @@ impl PhasedScheme {
     /// -> 360 deg about z.
     pub fn single_axis_four_dwell(timing: Timing) -> Self {
         let z = Vector3::z();
-        Self::new(
-            &[(z, PI), (z, -PI / 2.0), (z, PI), (z, PI / 2.0)],
-            timing,
-        )
+        Self::new(&[(z, PI), (z, -PI / 2.0), (z, PI), (z, PI / 2.0)], timing)
     }
 
     /// The master's 16-phase dual-axis scheme (see the module notes).
     pub fn dual_axis_sixteen_phase(timing: Timing) -> Self {
         let (x, z) = (Vector3::x(), Vector3::z());
         let group = |first: Vector3<f64>, second: Vector3<f64>, sense: f64| {
-            [(first, sense * PI), (second, sense * PI), (first, sense * PI), (second, sense * PI)]
+            [
+                (first, sense * PI),
+                (second, sense * PI),
+                (first, sense * PI),
+                (second, sense * PI),
+            ]
         };
-        let steps: Vec<(Vector3<f64>, f64)> = [group(z, x, 1.0), group(x, z, -1.0), group(z, x, -1.0), group(x, z, 1.0)]
-            .concat();
+        let steps: Vec<(Vector3<f64>, f64)> = [
+            group(z, x, 1.0),
+            group(x, z, -1.0),
+            group(z, x, -1.0),
+            group(x, z, 1.0),
+        ]
+        .concat();
         Self::new(&steps, timing)
     }
 }
@@ -148,7 +155,10 @@ mod tests {
     fn cycle_mean(s: &impl RotationScheme) -> Matrix3<f64> {
         let n = 20_000;
         let dt = s.cycle() / n as f64;
-        (0..n).map(|k| s.orientation((k as f64 + 0.5) * dt)).sum::<Matrix3<f64>>() / n as f64
+        (0..n)
+            .map(|k| s.orientation((k as f64 + 0.5) * dt))
+            .sum::<Matrix3<f64>>()
+            / n as f64
     }
 
     #[test]

@@ -136,7 +136,8 @@ fn compensated(x: &NavErrors, predicted: &nalgebra::SVector<f64, 8>) -> NavError
     };
     let fixed = compensate(&output, predicted);
     let mut out = *x;
-    (out[D_LAT], out[D_LON], out[DV_E], out[DV_N]) = (fixed.lat, fixed.lon, fixed.v_east, fixed.v_north);
+    (out[D_LAT], out[D_LON], out[DV_E], out[DV_N]) =
+        (fixed.lat, fixed.lon, fixed.v_east, fixed.v_north);
     out
 }
 
@@ -234,9 +235,18 @@ pub fn run(s: &Scenario) -> anyhow::Result<Results> {
         }
         let (c1, c2) = (c1_sum / substeps as f64, c2_sum / substeps as f64);
         let t_mid = t0 + 0.5 * s.filter_step;
-        let mid = [body * backup_scheme.orientation(t_mid), body * master_scheme.orientation(t_mid)];
+        let mid = [
+            body * backup_scheme.orientation(t_mid),
+            body * master_scheme.orientation(t_mid),
+        ];
         reduced.predict(&motion, &c1, [&mid[0], &mid[1]], s.filter_step, &tuning);
-        full.predict(&motion, [&c1, &c2], [&mid[0], &mid[1]], s.filter_step, &tuning);
+        full.predict(
+            &motion,
+            [&c1, &c2],
+            [&mid[0], &mid[1]],
+            s.filter_step,
+            &tuning,
+        );
         // eq. 31-32: A_1 = F_r with the backup's orientation
         prediction.propagate(&transition(&reduced_dynamics(&motion, &c1), s.filter_step));
         let before = k < failure;

@@ -88,7 +88,8 @@ impl Ins {
         let mut w = NavErrors::zeros();
         let sd_g = self.sensors.gyro_arw * p.dt.sqrt();
         let sd_a = self.sensors.accel_vrw * p.dt.sqrt();
-        let gyro: Vector3<f64> = Vector3::from_fn(|_, _| sd_g * rng.sample::<f64, _>(StandardNormal));
+        let gyro: Vector3<f64> =
+            Vector3::from_fn(|_, _| sd_g * rng.sample::<f64, _>(StandardNormal));
         let accel = Vector3::new(
             sd_a * rng.sample::<f64, _>(StandardNormal),
             sd_a * rng.sample::<f64, _>(StandardNormal),
