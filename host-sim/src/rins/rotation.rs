@@ -4,8 +4,8 @@
 //! 2012 [ref. 5] and Tucker and Levinson 2000 [ref. 6]) but gives neither
 //! the order, the rates nor the dwell times: those below are ours.
 //!
-//! * Backup: about the vertical (IMU z) axis only, dwells at 0, 180, 90 and
-//!   270 deg. A constant body drift or bias b projects to C b, and the four
+//! * Backup: about the vertical (IMU z) axis only, dwells at 0, 90, 180 and
+//!   270 deg, one turn forward and one back. A constant body drift or bias b projects to C b, and the four
 //!   dwells' C sum to zero in their horizontal columns: the horizontal
 //!   sensor errors average out, the z gyro's (the azimuth drift) never does.
 //! * Master: sixteen 180 deg flips, alternately about the IMU's z and x
@@ -38,7 +38,7 @@ pub struct Timing {
 }
 
 impl Timing {
-    /// Ours: 10 deg/s and a dwell of 60 s, so a backup phase lasts 69-78 s
+    /// Ours: 10 deg/s and a dwell of 60 s, so a backup phase lasts 69 s
     /// and a master flip phase 78 s. Short dwells keep the backup's modulated
     /// accelerometer bias (40 ug) from building more than ~2 cm/s of velocity
     /// swing per dwell.
@@ -93,11 +93,20 @@ impl PhasedScheme {
         }
     }
 
-    /// The backup's four-dwell single-axis scheme: 0 -> 180 -> 90 -> 270
-    /// -> 360 deg about z.
+    /// The backup's four-dwell single-axis scheme: dwells at 0, 90, 180,
+    /// 270 deg about z, turning +90 deg between them for one turn, then
+    /// back the same way (-90 deg steps). The turns sweep every angle
+    /// equally often, so the transits average out too; an order such as
+    /// 0 -> 180 -> 90 -> 270 sweeps some arcs twice and leaves ~4 % of the
+    /// horizontal errors un-averaged.
     pub fn single_axis_four_dwell(timing: Timing) -> Self {
         let z = Vector3::z();
-        Self::new(&[(z, PI), (z, -PI / 2.0), (z, PI), (z, PI / 2.0)], timing)
+        let quarter = PI / 2.0;
+        let mut steps = [(z, quarter); 8];
+        for step in &mut steps[4..] {
+            step.1 = -quarter;
+        }
+        Self::new(&steps, timing)
     }
 
     /// The master's 16-phase dual-axis scheme (see the module notes).
