@@ -119,7 +119,8 @@ impl Scenario {
         if (ratio - ratio.round()).abs() > 1e-9 || ratio < 1.0 {
             anyhow::bail!("the filter step must be a whole number of substeps");
         }
-        if !(self.latitude_deg.abs() < 85.0) {
+        // NaN fails the range check too
+        if !(-85.0..85.0).contains(&self.latitude_deg) {
             anyhow::bail!(
                 "latitude must be within +-85 deg (the model's tan L), got {}",
                 self.latitude_deg

@@ -52,7 +52,8 @@ impl Lines {
             x.1 = x.1.max(px);
             y = (y.0.min(py), y.1.max(py));
         }
-        if !(y.0 < y.1) {
+        // no points, or a flat line: a unit span
+        if y.0 >= y.1 || y.0.is_nan() {
             y = if y.0.is_finite() {
                 (y.0 - 1.0, y.0 + 1.0)
             } else {
