@@ -10,6 +10,7 @@ pub mod live;
 pub mod observability;
 pub mod paper_mgwd;
 pub mod replay;
+pub mod rins;
 pub mod samples_csv;
 pub mod sim;
 pub mod study;

@@ -33,6 +33,7 @@ pub mod mechanization;
 pub mod probe;
 pub mod probe_sample;
 pub mod protocol;
+pub mod redundant;
 pub mod sensor_noise;
 pub mod sensor_units;
 pub mod survey;

@@ -24,6 +24,7 @@ mod limits;
 mod observability;
 mod paper;
 mod paper_mgwd;
+mod paper_rins;
 mod probe;
 mod replay;
 mod simulate;

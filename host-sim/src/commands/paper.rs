@@ -14,12 +14,16 @@ pub enum PaperCommand {
     /// The MGWD paper's 60 s static fine alignment (section 4, Figures 13-15),
     /// ours beside the paper's figures.
     Mgwd(super::paper_mgwd::MgwdArgs),
+    /// The redundant-RINS paper's 120 h simulation (section 4.1, Figures
+    /// 3-6): reduced-order filter, master failure, compensated backup.
+    Rins(super::paper_rins::RinsArgs),
 }
 
 pub fn run(cmd: PaperCommand) -> Result<()> {
     match cmd {
         PaperCommand::Tls(args) => run_tls(args),
         PaperCommand::Mgwd(args) => super::paper_mgwd::run(args),
+        PaperCommand::Rins(args) => super::paper_rins::run(args),
     }
 }
 
