@@ -13,12 +13,14 @@
 //! drilling) is not in the paper: derivation section 4b.
 
 mod axial_speed;
+mod heading_reference;
 mod non_holonomic;
 mod vertical_earth_rate;
 mod zero_position;
 mod zero_velocity;
 
 pub use axial_speed::{AxialSpeed, AXIAL_SPEED_VARIANCE};
+pub use heading_reference::{HeadingReference, HeadingReferenceError};
 pub use non_holonomic::{BhaCrossMotion, NonHolonomic, CROSS_AXES, DRILLING_VARIANCE};
 pub use vertical_earth_rate::VerticalEarthRate;
 pub use zero_position::ZeroPosition;

@@ -880,6 +880,21 @@ impl Navigator {
     pub fn is_navigating(&self) -> bool {
         matches!(self.phase, Phase::Navigating)
     }
+
+    /// One reference-azimuth update (rad, true north; 1-sigma `sigma` rad)
+    /// at the current solution (`aid_sources::HeadingReference`: the probe
+    /// as the backup of a reference heading, docs/redundant-rins.md); call
+    /// it between steps. Only while navigating with a valid covariance;
+    /// `None` then, or for a reference the source refuses.
+    pub fn aid_heading(&mut self, azimuth: f64, sigma: f64) -> Option<UpdateReport> {
+        if !self.is_navigating() || self.covariance_invalid {
+            return None;
+        }
+        let reference =
+            crate::aid_sources::HeadingReference::<f32>::at(self.filter.state(), azimuth, sigma)
+                .ok()?;
+        Some(self.filter.aid(&reference))
+    }
 }
 
 fn square(v: f64) -> f64 {
