@@ -16,6 +16,10 @@ pub enum StudyCommand {
     /// Seeded runs of a simulated lateral: do the probe's station sigmas
     /// and the survey's TD ellipse cover the errors?
     DrillingCoverage(CoverageArgs),
+    /// A reference heading as the master for the first stations, the gyro
+    /// probe as the backup (issue 17 item 4): azimuth error at TD with and
+    /// without it, by gyro grade (docs/redundant-rins.md).
+    RinsProbe(RinsProbeArgs),
 }
 
 fn azimuth_sigma_deg(text: &str) -> Result<f64, String> {
@@ -51,7 +55,10 @@ pub struct CoverageArgs {
 }
 
 pub fn run(cmd: StudyCommand) -> Result<()> {
-    let StudyCommand::DrillingCoverage(args) = cmd;
+    let args = match cmd {
+        StudyCommand::DrillingCoverage(args) => args,
+        StudyCommand::RinsProbe(args) => return rins_probe(args),
+    };
     let mut plan = Plan::load(&args.plan)?;
     if let Some(level) = args.vibration {
         use super::simulate::VibrationLevel as V;
@@ -119,6 +126,109 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     out!("{}", table(&summary));
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&summary)? + "\n";
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]
+pub enum GradeName {
+    Scc1300,
+    Tactical,
+    Navigation,
+}
+
+fn reference_sigma_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the reference azimuth sigma", (0.001, 30.0), "deg")
+}
+
+#[derive(clap::Args, Debug)]
+pub struct RinsProbeArgs {
+    /// Well plan (JSON, docs/drilling-simulation.md).
+    #[arg(long, default_value = "host-sim/data/plans/lateral-100m.json")]
+    pub plan: PathBuf,
+    /// Runs per grade (seeds first-seed, first-seed + 1, ...).
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub runs: u64,
+    #[arg(long, default_value_t = 1)]
+    pub first_seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+    /// Gyro grades (the SCC1300's gyro errors divided by 1, 10, 1000);
+    /// default all three.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub grades: Vec<GradeName>,
+    /// Stations (the window's first) with a reference azimuth, then lost.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(0..=1000))]
+    pub reference_stations: u64,
+    /// 1-sigma of each reference azimuth, deg.
+    #[arg(long, default_value_t = 0.5, value_parser = reference_sigma_deg)]
+    pub reference_sigma_deg: f64,
+    /// 1-sigma of the parent well's azimuth at the tie-in, deg.
+    #[arg(long, default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
+    pub tie_in_azimuth_sigma_deg: f64,
+    /// Write the summaries here (JSON).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+fn rins_probe(args: RinsProbeArgs) -> Result<()> {
+    use host_sim::study::rins_probe::{study, table, ProbeConfig, GRADES};
+    let plan = Plan::load(&args.plan)?;
+    let names = if args.grades.is_empty() {
+        vec![
+            GradeName::Scc1300,
+            GradeName::Tactical,
+            GradeName::Navigation,
+        ]
+    } else {
+        args.grades.clone()
+    };
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    );
+    let mut summaries = Vec::new();
+    for name in names {
+        let grade = GRADES[name as usize];
+        let config = ProbeConfig {
+            plan: plan.clone(),
+            tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
+            reference_sigma: args.reference_sigma_deg.to_radians(),
+            reference_stations: args.reference_stations as usize,
+            grade,
+        };
+        let bar = indicatif::ProgressBar::new(args.runs);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} {bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
+            )
+            .context("progress bar")?,
+        );
+        bar.set_message(grade.name);
+        summaries.push(study(
+            &config,
+            args.runs as usize,
+            args.first_seed,
+            threads,
+            &|| bar.inc(1),
+        ));
+        bar.finish_and_clear();
+    }
+    outln!(
+        "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads)",
+        args.plan.display(),
+        args.runs,
+        args.first_seed,
+        args.reference_sigma_deg,
+        args.reference_stations,
+        args.tie_in_azimuth_sigma_deg,
+        threads
+    );
+    out!("{}", table(&summaries));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&summaries)? + "\n";
         std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())

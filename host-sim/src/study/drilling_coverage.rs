@@ -23,7 +23,7 @@ pub struct Fraction {
 }
 
 impl Fraction {
-    fn of(inside: usize, total: usize) -> Self {
+    pub(crate) fn of(inside: usize, total: usize) -> Self {
         let p = (total > 0).then(|| inside as f64 / total as f64);
         Self {
             inside,

@@ -71,7 +71,7 @@ pub struct RunOutcome {
 /// The tie-in from the navigator's own levelling (its static alignment's
 /// inclination and toolface and their sigmas) and the parent well's
 /// azimuth: the truth plus an error drawn with `sigma_azi`.
-fn tie_in(
+pub(crate) fn tie_in(
     solution: &mwd_core::protocol::NavSolution,
     truth_azimuth: f64,
     sigma_azi: f64,
@@ -95,7 +95,7 @@ fn tie_in(
 
 /// The raw frame of sample `index` of measured body rates and force (both
 /// parts' triads see the same force, as `capture::write_simulated_probe`).
-fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Result<RawSample> {
+pub(crate) fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Result<RawSample> {
     let force = [accel.x, accel.y, accel.z];
     Ok(raw_sample_from_si(&SiSample {
         index: u32::try_from(index).context("more than 2^32 samples")?,

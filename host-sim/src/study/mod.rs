@@ -2,3 +2,4 @@
 
 pub mod drilling_coverage;
 pub mod drilling_run;
+pub mod rins_probe;
