@@ -168,6 +168,11 @@ pub struct RinsProbeArgs {
     /// 1-sigma of the parent well's azimuth at the tie-in, deg.
     #[arg(long, default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
     pub tie_in_azimuth_sigma_deg: f64,
+    /// Keep the SCC1300's white gyro noise (scale the bias and coloured
+    /// noise only): it dithers the raw frame's gyro count, which a quieter
+    /// gyro at rest does not (a diagnostic, docs/redundant-rins.md).
+    #[arg(long)]
+    pub white_noise_kept: bool,
     /// Write the summaries here (JSON).
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -191,13 +196,18 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     );
     let mut summaries = Vec::new();
     for name in names {
-        let grade = GRADES[name as usize];
+        let grade = GRADES[match name {
+            GradeName::Scc1300 => 0,
+            GradeName::Tactical => 1,
+            GradeName::Navigation => 2,
+        }];
         let config = ProbeConfig {
             plan: plan.clone(),
             tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
             reference_sigma: args.reference_sigma_deg.to_radians(),
             reference_stations: args.reference_stations as usize,
             grade,
+            white_noise_kept: args.white_noise_kept,
         };
         let bar = indicatif::ProgressBar::new(args.runs);
         bar.set_style(
@@ -217,14 +227,19 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
         bar.finish_and_clear();
     }
     outln!(
-        "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads)",
+        "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads{})",
         args.plan.display(),
         args.runs,
         args.first_seed,
         args.reference_sigma_deg,
         args.reference_stations,
         args.tie_in_azimuth_sigma_deg,
-        threads
+        threads,
+        if args.white_noise_kept {
+            "; SCC1300 white gyro noise kept"
+        } else {
+            ""
+        }
     );
     out!("{}", table(&summaries));
     if let Some(path) = &args.json {

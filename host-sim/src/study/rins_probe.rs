@@ -60,13 +60,19 @@ pub const GRADES: [Grade; 3] = [
     },
 ];
 
-/// The SCC1300 model with its gyro errors divided by `factor` (> 0). A
-/// better part is not the SCC1300 and has not its LSB: only the SCC1300
-/// grade is quantised at the sensor (the raw frame's count still is).
-pub fn graded_model(seed: u64, factor: f64) -> SensorModel {
+/// The SCC1300 model with its gyro errors divided by `factor` (> 0); with
+/// `white_noise_kept` the white noise (ARW) stays the SCC1300's. A better
+/// part is not the SCC1300 and has not its LSB: only the SCC1300 grade is
+/// quantised at the sensor (the raw frame's count still is, 18 LSB per
+/// deg/s: a quiet gyro at rest is rounded without dither, a bias of up to
+/// half a count, 100 deg/h; the SCC1300's own noise, ~0.06 deg/s per
+/// sample, dithers it, and so does `white_noise_kept`).
+pub fn graded_model(seed: u64, factor: f64, white_noise_kept: bool) -> SensorModel {
     let mut model = SensorModel::scc1300(seed);
     for axis in &mut model.noise.gyro {
-        axis.white_density /= factor;
+        if !white_noise_kept {
+            axis.white_density /= factor;
+        }
         axis.bias_instability /= factor;
         axis.residual_bias /= factor;
         if let Some(ar) = axis.coloured.as_mut() {
@@ -88,6 +94,8 @@ pub struct ProbeConfig {
     /// Stations (the window's first) that get a reference azimuth.
     pub reference_stations: usize,
     pub grade: Grade,
+    /// Keep the SCC1300's white gyro noise (see [`graded_model`]).
+    pub white_noise_kept: bool,
 }
 
 /// An azimuth against the truth.
@@ -142,7 +150,7 @@ pub fn run(config: &ProbeConfig, seed: u64) -> Result<PairOutcome> {
     let end_md = config.plan.end_md();
     let drilling = Drilling::new(config.plan.clone(), seed);
     let site = drilling.truth(0.0).position;
-    let model = graded_model(seed, config.grade.factor);
+    let model = graded_model(seed, config.grade.factor, config.white_noise_kept);
     let calibration = model.deterministic.calibration();
     let mut without = Navigator::with_calibration(site, calibration);
     let mut with = Navigator::with_calibration(site, calibration);
@@ -434,13 +442,22 @@ mod tests {
 
     #[test]
     fn grades_divide_the_gyro_budget_only() {
-        let base = graded_model(3, 1.0);
-        let tactical = graded_model(3, 10.0);
+        let base = graded_model(3, 1.0, false);
+        let tactical = graded_model(3, 10.0, false);
+        let kept = graded_model(3, 10.0, true);
         for (b, t) in base.noise.gyro.iter().zip(&tactical.noise.gyro) {
             assert!((t.white_density * 10.0 - b.white_density).abs() <= 1e-15);
             assert!((t.residual_bias * 10.0 - b.residual_bias).abs() <= 1e-15);
         }
         assert_eq!(base.noise.accel, tactical.noise.accel);
+        assert_eq!(
+            kept.noise.gyro[0].white_density,
+            base.noise.gyro[0].white_density
+        );
+        assert_eq!(
+            kept.noise.gyro[0].residual_bias,
+            tactical.noise.gyro[0].residual_bias
+        );
         assert!(base.quantize && !tactical.quantize);
     }
 
