@@ -207,6 +207,15 @@ const stream = new EventSource("/events");
 stream.onopen = () => setText("connection", "connected");
 stream.onerror = () => setText("connection", "reconnecting...");
 stream.onmessage = (m) => {
-  apply(JSON.parse(m.data));
+  const update = JSON.parse(m.data);
+  apply(update);
   document.body.dataset.updates = String(Number(document.body.dataset.updates || 0) + 1);
+  if (update.rest.finished) {
+    // Nothing more will come (the capture ended, the port closed): stop
+    // the stream rather than reconnect to it.
+    stream.close();
+    draw();
+    setText("connection", "closed: the source has ended");
+    document.body.dataset.finished = "true";
+  }
 };

@@ -66,16 +66,15 @@ fn frame_time_us(frame: &Frame) -> Option<u64> {
 /// thread of its own.
 pub fn replay_file(path: PathBuf, speed: f64, state: Shared) -> thread::JoinHandle<()> {
     thread::spawn(move || {
-        let started = Instant::now();
-        let status = match replay_paced(&path, speed, &state, started) {
+        let status = match replay_paced(&path, speed, &state) {
             Ok(frames) => format!("end of capture: {frames} frames replayed"),
             Err(e) => format!("replay stopped: {e:#}"),
         };
-        lock(&state).set_status(status);
+        lock(&state).finish(status);
     })
 }
 
-fn replay_paced(path: &Path, speed: f64, state: &Shared, started: Instant) -> Result<u64> {
+fn replay_paced(path: &Path, speed: f64, state: &Shared) -> Result<u64> {
     let mut file = File::open(path).with_context(|| format!("reading {}", path.display()))?;
     lock(state).set_status(format!("replaying at {speed}x"));
     let mut decoder = Decoder::new();
@@ -111,12 +110,12 @@ fn replay_paced(path: &Path, speed: f64, state: &Shared, started: Instant) -> Re
             }
             let mut s = lock(state);
             s.push_frame(frame);
-            s.set_link(*decoder.stats(), started.elapsed().as_secs_f64());
+            s.set_link(*decoder.stats(), Instant::now());
             count += 1;
         }
     }
     decoder.finish();
-    lock(state).set_link(*decoder.stats(), started.elapsed().as_secs_f64());
+    lock(state).set_link(*decoder.stats(), Instant::now());
     Ok(count)
 }
 
@@ -144,7 +143,7 @@ pub fn run_port(
     let reader_state = Arc::clone(&state);
     thread::spawn(move || {
         let status = read_port(serial, save, &reader_state, &reply_tx);
-        lock(&reader_state).set_status(status);
+        lock(&reader_state).finish(status);
     });
     thread::spawn(move || send_commands(writer, &command_rx, &reply_rx, &state));
     Ok(command_tx)
@@ -157,7 +156,6 @@ fn read_port(
     state: &Shared,
     replies: &Sender<Reply>,
 ) -> String {
-    let started = Instant::now();
     let mut decoder = Decoder::new();
     let mut buf = [0u8; 4096];
     let mut frames = Vec::new();
@@ -189,7 +187,7 @@ fn read_port(
         for frame in &frames {
             s.push_frame(frame);
         }
-        s.set_link(*decoder.stats(), started.elapsed().as_secs_f64());
+        s.set_link(*decoder.stats(), Instant::now());
     }
 }
 

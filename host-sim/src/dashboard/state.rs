@@ -11,6 +11,7 @@
 //! dropped, so a session of any length holds at most these.
 
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 use mwd_core::protocol::uplink::Reply;
 use mwd_core::protocol::{DecoderStats, Frame, NavSolution, Payload, StationSurvey};
@@ -35,6 +36,9 @@ pub struct Limits {
     pub events: usize,
     pub commands: usize,
 }
+
+/// The span the frame rate is counted over.
+const RATE_WINDOW: Duration = Duration::from_secs(5);
 
 /// 10 min at full rate, 10 s points over 10 h.
 pub const LIMITS: Limits = Limits {
@@ -107,9 +111,12 @@ pub struct DashboardState {
     commands_update: u64,
     config_version: Option<u32>,
     link: DecoderStats,
-    /// (wall-clock s, good frames) of the last link updates: the rate.
-    link_history: VecDeque<(f64, u64)>,
+    /// (when, good frames so far) of the last seconds' link updates: the
+    /// rate.
+    link_history: VecDeque<(Instant, u64)>,
     status: String,
+    /// The source has ended: no more frames will come.
+    finished: bool,
     source: SourceInfo,
 }
 
@@ -142,6 +149,7 @@ impl DashboardState {
             link: DecoderStats::default(),
             link_history: VecDeque::new(),
             status: "waiting for data".into(),
+            finished: false,
             source,
         }
     }
@@ -205,14 +213,14 @@ impl DashboardState {
         }
     }
 
-    /// The link's statistics so far, at wall-clock time `wall_s`.
-    pub fn set_link(&mut self, stats: DecoderStats, wall_s: f64) {
+    /// The link's statistics so far, received at `now`.
+    pub fn set_link(&mut self, stats: DecoderStats, now: Instant) {
         self.link = stats;
-        self.link_history.push_back((wall_s, stats.good_frames()));
+        self.link_history.push_back((now, stats.good_frames()));
         while self
             .link_history
             .front()
-            .is_some_and(|(t, _)| wall_s - t > 5.0)
+            .is_some_and(|(t, _)| now.duration_since(*t) > RATE_WINDOW + Duration::from_secs(1))
         {
             self.link_history.pop_front();
         }
@@ -221,6 +229,12 @@ impl DashboardState {
     pub fn set_status(&mut self, status: impl Into<String>) {
         self.status = status.into();
         self.update += 1;
+    }
+
+    /// The source has ended (end of the capture, the port closed), why.
+    pub fn finish(&mut self, status: impl Into<String>) {
+        self.set_status(status);
+        self.finished = true;
     }
 
     /// Notes a command sent; returns its number for [`Self::command_result`].
@@ -306,6 +320,7 @@ impl DashboardState {
             "latest": self.latest.as_ref().map(latest_json),
             "link": self.link_json(),
             "status": self.status,
+            "finished": self.finished,
             "source": {
                 "description": self.source.description,
                 "controls_disabled": self.source.controls_disabled,
@@ -325,12 +340,24 @@ impl DashboardState {
         )
     }
 
+    /// Good frames per second over the last [`RATE_WINDOW`] before `now`
+    /// (0 once frames stop coming); `None` before two link updates.
+    fn frame_rate(&self, now: Instant) -> Option<f64> {
+        let (_, latest) = self.link_history.back()?;
+        let start = now.checked_sub(RATE_WINDOW)?;
+        let (t0, n0) = self
+            .link_history
+            .iter()
+            .rev()
+            .find(|(t, _)| *t <= start)
+            .or_else(|| self.link_history.front())?;
+        let span = now.duration_since(*t0).as_secs_f64();
+        (span > 0.2).then(|| (latest - n0) as f64 / span)
+    }
+
     fn link_json(&self) -> Value {
         let s = &self.link;
-        let rate = match (self.link_history.front(), self.link_history.back()) {
-            (Some((t0, n0)), Some((t1, n1))) if t1 - t0 > 0.5 => Some((n1 - n0) as f64 / (t1 - t0)),
-            _ => None,
-        };
+        let rate = self.frame_rate(Instant::now());
         json!({
             "frames": s.good_frames(),
             "raw": s.frames[0], "nav": s.frames[1], "events": s.frames[2], "stations": s.frames[3],

@@ -112,7 +112,12 @@ pub fn stations_json(stations: &[StationSurvey], dropped: u64, setup: &SurveySet
             match drilling::survey(stations, depth, tie, &setup.terms, &setup.site) {
                 Ok(survey) => {
                     for d in &survey.rows {
-                        if let Some(k) = stations.iter().position(|s| *s == d.survey) {
+                        // By number and time: a station's NaN correlations
+                        // make `==` false even for itself.
+                        let same = |s: &StationSurvey| {
+                            (s.station, s.time_us) == (d.survey.station, d.survey.time_us)
+                        };
+                        if let Some(k) = stations.iter().position(same) {
                             positioned(&mut rows[k], d);
                         }
                         if d.position_determined {
