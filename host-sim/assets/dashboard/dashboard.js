@@ -102,6 +102,8 @@ function showStations(st) {
     return tr;
   });
   $("stations").replaceChildren(...rows);
+  // No determined position: the note says why; no empty axes.
+  $("station-charts").style.display = st.plan.length ? "" : "none";
   plot.plan.setData([null, [st.plan.map((p) => p[0]), st.plan.map((p) => p[1])]]);
   plot.section.setData([null, [st.section.map((p) => p[0]), st.section.map((p) => p[1])]]);
 }
