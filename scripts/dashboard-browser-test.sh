@@ -103,7 +103,7 @@ check "the page holds every sample, within its bound ($(cell held))" \
 
 mkdir -p "$(dirname "$screenshot")"
 rm -f "$screenshot"
-browse --hide-scrollbars --window-size=1400,1900 --screenshot="$screenshot" >/dev/null \
+browse --hide-scrollbars --window-size=1400,1480 --screenshot="$screenshot" >/dev/null \
   || { echo "chromium failed:"; tail -20 "$work/chromium.err"; exit 1; }
 check "screenshot saved ($screenshot)" \
   "$(head -c 8 "$screenshot" 2>/dev/null | od -An -c | grep -q 'P   N   G' && echo yes || echo no)"

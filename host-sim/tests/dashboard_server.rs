@@ -147,6 +147,81 @@ fn a_replayed_capture_streams_to_its_end_and_a_reconnect_resumes() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// A capture of 100 s with three stations whose azimuth is determined,
+/// and the depth log that pairs them with MD.
+fn capture_with_stations(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    use host_sim::capture::CaptureWriter;
+    use mwd_core::protocol::frame::station_flags;
+    use mwd_core::protocol::{Payload, RawSample, StationSurvey};
+    let mut writer = CaptureWriter::new(Vec::new());
+    for n in 0..2000u32 {
+        let time_us = u64::from(n) * 50_000;
+        writer
+            .write(&Payload::Raw(RawSample {
+                time_us,
+                sample_counter: n,
+                ..RawSample::default()
+            }))
+            .unwrap();
+        if n % 600 == 599 {
+            writer
+                .write(&Payload::Station(StationSurvey {
+                    time_us,
+                    station: (n / 600 + 1) as u16,
+                    flags: station_flags::MAGNETIC_FREE,
+                    start_sample: n - 100,
+                    end_sample: n,
+                    angles: [1.5, 2.0, 0.3],
+                    angles_std: [0.001, 0.02, 0.002],
+                    correlations: [0.0; 3],
+                    still_quality: 1.0,
+                }))
+                .unwrap();
+        }
+    }
+    let capture = dir.join("stations.bin");
+    std::fs::write(&capture, writer.finish().unwrap()).unwrap();
+    let depth = dir.join("depth.csv");
+    std::fs::write(&depth, "time_s,md_m\n0,3000\n100,3030\n").unwrap();
+    (capture, depth)
+}
+
+#[test]
+fn with_a_depth_log_the_stations_get_positions_with_their_sigma() {
+    let dir = common::scratch("dashboard", "stations");
+    let (capture, depth) = capture_with_stations(&dir);
+    let d = start(&[
+        "--file",
+        capture.to_str().unwrap(),
+        "--speed",
+        "1000",
+        "--depth",
+        depth.to_str().unwrap(),
+    ]);
+    let (_, last) = follow(&d.addr, None, |u| u["rest"]["finished"] == true);
+    let stations = &last["rest"]["stations"];
+    let rows = stations["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3, "{stations}");
+    // Station 1 (29.95 s) is the tie-on: MD from the log, at the origin.
+    assert_eq!(rows[0]["md"], "3008.99 m");
+    assert_eq!(rows[2]["md"], "3026.99 m");
+    assert_eq!(rows[2]["azimuth"], "114.592 +- 1.146 deg (1 sigma)");
+    for row in rows {
+        let position = row["position"].as_str().unwrap();
+        assert!(
+            position.starts_with("N ") && position.matches(" +- ").count() == 3,
+            "{position}"
+        );
+    }
+    // Drilled along azimuth 2 rad at 86 deg inclination: north < 0, east > 0.
+    let plan = stations["plan"].as_array().unwrap();
+    assert_eq!(plan.len(), 3);
+    let (east, north) = (plan[2][0].as_f64().unwrap(), plan[2][1].as_f64().unwrap());
+    assert!(east > 0.0 && north < 0.0, "{east} {north}");
+    assert_eq!(stations["section"].as_array().unwrap().len(), 3);
+    std::fs::remove_dir_all(dir).ok();
+}
+
 #[test]
 fn bad_inputs_are_refused_before_serving() {
     let dir = common::scratch("dashboard", "bad");
