@@ -4,6 +4,7 @@
 //! state leave every buffer at its bound, and an update for a new page is
 //! no larger than those bounds allow. A page that reconnects gets what it
 //! missed, or a fresh snapshot once that was dropped.
+#![cfg(feature = "dashboard")]
 
 use host_sim::dashboard::state::{DashboardState, Limits, SourceInfo, LIMITS};
 use host_sim::dashboard::stations::SurveySetup;
@@ -18,6 +19,7 @@ fn state(limits: Limits) -> DashboardState {
         description: "test".into(),
         controls_disabled: None,
         calibration: vec![],
+        job: None,
         survey: SurveySetup::new(None, 45.0).unwrap(),
     };
     DashboardState::new(info, 7, limits)

@@ -4,6 +4,7 @@
 //! with Last-Event-ID that gets only what is new, refused commands while
 //! replaying; and on a pty standing in for the probe, the commands' ACKs
 //! on the page and every byte recorded to --save.
+#![cfg(feature = "dashboard")]
 
 mod common;
 

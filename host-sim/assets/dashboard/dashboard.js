@@ -74,7 +74,10 @@ function showState(rest) {
     `(at most ${limits.recent}); ${data.long.sensors.length} long-window points (at most ${limits.long})`);
   const disabled = rest.source.controls_disabled;
   for (const b of document.querySelectorAll(".controls button, .controls input")) b.disabled = disabled !== null;
-  setText("controls-reason", disabled === null ? "" : "Commands disabled: " + disabled);
+  const noJob = rest.source.job === null;
+  if (noJob) $("cmd-configure").disabled = true;
+  setText("controls-reason", disabled !== null ? "Commands disabled: " + disabled
+    : noJob ? "Configure needs a job file: start with --job JOB.json." : "Job file: " + rest.source.job);
   setText("config-version", rest.source.config_version === null ? "no reply yet" : rest.source.config_version);
   fillList("calibration", rest.source.calibration);
   if (rest.events) fillList("events", rest.events.slice().reverse());

@@ -125,6 +125,7 @@ pub fn run(args: Args) -> Result<()> {
         description: String::new(),
         controls_disabled: None,
         calibration: calibration_lines(job.as_ref()),
+        job: args.job.as_ref().map(|p| p.display().to_string()),
         survey: SurveySetup::new(depth, latitude_deg)?,
     };
     let session = rand::random::<u64>() >> 12;

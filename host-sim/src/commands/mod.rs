@@ -18,6 +18,7 @@ mod align;
 mod allan;
 mod arfit;
 mod calibrate;
+#[cfg(feature = "dashboard")]
 mod dashboard;
 mod decode;
 mod demo;
@@ -73,6 +74,7 @@ pub enum Command {
     Probe(probe::Args),
     /// The probe's live display as a local web page (a serial port, or a
     /// capture replayed at a chosen pace).
+    #[cfg(feature = "dashboard")]
     Dashboard(dashboard::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
@@ -125,6 +127,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Survey(args) => done(survey::run(args)),
         Command::Study(cmd) => done(study::run(cmd)),
         Command::Probe(args) => done(probe::run(args)),
+        #[cfg(feature = "dashboard")]
         Command::Dashboard(args) => done(dashboard::run(args)),
         Command::Paper(cmd) => done(paper::run(cmd)),
     }

@@ -59,6 +59,8 @@ pub struct SourceInfo {
     pub controls_disabled: Option<String>,
     /// The calibration in use, for people.
     pub calibration: Vec<String>,
+    /// The job file "configure" sends, if one was given.
+    pub job: Option<String>,
     /// Pairing of stations with MD, if a depth log was given.
     pub survey: SurveySetup,
 }
@@ -66,6 +68,7 @@ pub struct SourceInfo {
 /// One command sent to the probe and what came of it.
 #[derive(Debug, Clone)]
 struct CommandEntry {
+    number: u64,
     label: String,
     result: String,
 }
@@ -242,23 +245,21 @@ impl DashboardState {
         if self.commands.len() == self.limits.commands {
             self.commands.pop_front();
         }
+        self.commands_sent += 1;
         self.commands.push_back(CommandEntry {
+            number: self.commands_sent,
             label: label.into(),
             result: "sent, waiting for the reply".into(),
         });
-        self.commands_sent += 1;
         self.commands_update = self.next_update();
         self.commands_sent
     }
 
     /// What came of command `number` (ACK/NAK text, or no reply).
     pub fn command_result(&mut self, number: u64, result: String, reply: Option<&Reply>) {
-        let held = self.commands.len() as u64;
-        if let Some(back) = (self.commands_sent + 1).checked_sub(number) {
-            if back >= 1 && back <= held {
-                let index = (held - back) as usize;
-                self.commands[index].result = result;
-            }
+        // Gone from the list already if more were sent since.
+        if let Some(entry) = self.commands.iter_mut().find(|c| c.number == number) {
+            entry.result = result;
         }
         if let Some(reply) = reply {
             self.config_version = Some(reply.config_version);
@@ -325,6 +326,7 @@ impl DashboardState {
                 "description": self.source.description,
                 "controls_disabled": self.source.controls_disabled,
                 "calibration": self.source.calibration,
+                "job": self.source.job,
                 "config_version": self.config_version,
             },
             "stations": changed(self.stations_update).then_some(&self.stations_view),
