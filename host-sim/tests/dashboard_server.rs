@@ -52,10 +52,19 @@ fn start(args: &[&str]) -> Dashboard {
     Dashboard { child, addr }
 }
 
-/// One HTTP/1.0 request (no chunked encoding to undo): status and body.
+/// One HTTP/1.0 request (no chunked encoding to undo) with the page's
+/// command header: status and body.
 fn request(addr: &str, method: &str, path: &str) -> (u16, String) {
+    raw_request(addr, method, path, "X-MWD-Dashboard: 1\r\n")
+}
+
+fn raw_request(addr: &str, method: &str, path: &str, headers: &str) -> (u16, String) {
     let mut stream = TcpStream::connect(addr).unwrap();
-    write!(stream, "{method} {path} HTTP/1.0\r\nHost: {addr}\r\n\r\n").unwrap();
+    write!(
+        stream,
+        "{method} {path} HTTP/1.0\r\nHost: {addr}\r\n{headers}\r\n"
+    )
+    .unwrap();
     let mut response = String::new();
     stream.read_to_string(&mut response).unwrap();
     let (head, body) = response.split_once("\r\n\r\n").unwrap();
@@ -333,6 +342,9 @@ mod on_a_port {
             "--job",
             job.to_str().unwrap(),
         ]);
+        // Not from the page (another site's form): refused, nothing sent.
+        let (status, _) = raw_request(&d.addr, "POST", "/api/align", "");
+        assert_eq!(status, 403);
         let (status, _) = request(&d.addr, "POST", "/api/station");
         assert_eq!(status, 202);
         let (status, _) = request(&d.addr, "POST", "/api/configure");

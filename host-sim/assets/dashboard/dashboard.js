@@ -194,7 +194,8 @@ $("window").addEventListener("change", (e) => { view = e.target.value; dirty = t
 async function command(path) {
   setText("command-response", "sending...");
   try {
-    const r = await fetch(path, { method: "POST" });
+    // The header tells the server the request comes from this page.
+    const r = await fetch(path, { method: "POST", headers: { "X-MWD-Dashboard": "1" } });
     setText("command-response", r.ok ? "sent: the probe's reply shows below" : await r.text());
   } catch (e) {
     setText("command-response", "not sent: " + e);

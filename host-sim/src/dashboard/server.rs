@@ -103,9 +103,20 @@ async fn events(
     Sse::new(updates)
 }
 
-/// Queues commands for the probe: 202, or 409 with the reason when there
-/// is no command link.
-fn send(app: &App, batch: CommandBatch) -> (StatusCode, String) {
+/// The header the page sends with every command. A request with a custom
+/// header needs a CORS preflight, which this server does not grant: so
+/// another site open in the same browser cannot command the probe.
+pub const COMMAND_HEADER: &str = "x-mwd-dashboard";
+
+/// Queues commands for the probe: 202, 403 without the page's header, or
+/// 409 with the reason when there is no command link.
+fn send(app: &App, headers: &HeaderMap, batch: CommandBatch) -> (StatusCode, String) {
+    if !headers.contains_key(COMMAND_HEADER) {
+        return (
+            StatusCode::FORBIDDEN,
+            format!("commands are taken from the dashboard's page only (header {COMMAND_HEADER})"),
+        );
+    }
     match &app.commands {
         Err(reason) => (StatusCode::CONFLICT, reason.clone()),
         Ok(sender) => {
@@ -121,15 +132,19 @@ fn send(app: &App, batch: CommandBatch) -> (StatusCode, String) {
     }
 }
 
-async fn align(State(app): State<App>) -> (StatusCode, String) {
-    send(&app, vec![("re-align".into(), Command::Realign)])
+async fn align(State(app): State<App>, headers: HeaderMap) -> (StatusCode, String) {
+    send(&app, &headers, vec![("re-align".into(), Command::Realign)])
 }
 
-async fn station(State(app): State<App>) -> (StatusCode, String) {
-    send(&app, vec![("take a station".into(), Command::TakeStation)])
+async fn station(State(app): State<App>, headers: HeaderMap) -> (StatusCode, String) {
+    send(
+        &app,
+        &headers,
+        vec![("take a station".into(), Command::TakeStation)],
+    )
 }
 
-async fn configure(State(app): State<App>) -> (StatusCode, String) {
+async fn configure(State(app): State<App>, headers: HeaderMap) -> (StatusCode, String) {
     let Some(job) = app.job.clone() else {
         return (
             StatusCode::CONFLICT,
@@ -138,11 +153,12 @@ async fn configure(State(app): State<App>) -> (StatusCode, String) {
     };
     let mut batch = job.commands();
     batch.push(("report configuration".into(), Command::ReportConfig));
-    send(&app, batch)
+    send(&app, &headers, batch)
 }
 
 async fn index(
     State(app): State<App>,
+    headers: HeaderMap,
     Path((positions, dwell_s)): Path<(u8, u16)>,
 ) -> (StatusCode, String) {
     let (p_lo, p_hi) = INDEX_POSITIONS;
@@ -158,6 +174,7 @@ async fn index(
     }
     send(
         &app,
+        &headers,
         vec![(
             format!("toolface indexing, {positions} positions of {dwell_s} s"),
             Command::IndexToolface(IndexingProcedure { positions, dwell_s }),
