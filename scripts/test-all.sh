@@ -53,3 +53,6 @@ cargo test --release -p system-tests --test alignment_classes -- --ignored
 # controls); fails on any panic, silent acceptance or flood of stderr.
 cargo build -p host-sim
 bash scripts/bad-input-matrix.sh target/debug/host-sim
+# The dashboard in headless Chromium (installs Debian's chromium if absent):
+# DOM checks against `host-sim decode` of the same capture, and a screenshot.
+bash scripts/dashboard-browser-test.sh target/debug/host-sim
