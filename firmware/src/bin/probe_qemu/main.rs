@@ -69,9 +69,11 @@ const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
 const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// When the watchdog run (feature `qemu-stall-demo`) hangs its main loop.
 const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
-/// Uplink bytes the main loop takes per pass: a whole longest command
-/// (124 B) and more, while a flood of bytes costs each pass at most this.
-const UPLINK_BYTES_PER_PASS: usize = 256;
+/// Uplink bytes the main loop takes per pass, once per sample period: the
+/// inbox's capacity, more than the 576 B a period brings at 115200 baud,
+/// so the line is drained as fast as it fills, while a flood costs each
+/// period at most this.
+const UPLINK_BYTES_PER_PASS: usize = firmware::app::uplink_rx::UPLINK_QUEUE_LEN;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
@@ -227,8 +229,18 @@ fn main() -> ! {
     let mut navigator = navigator_for(uplink.config());
     let mut tie_in_pending = uplink.config().tie_in;
     let mut mode = nav_mode::INITIALISING;
+    let mut last_pass_tick = None;
     loop {
         let tick = TICKS.load(Ordering::Relaxed);
+        // One pass per sample period: every byte received wakes the main
+        // loop (its interrupt), and a pass per byte would cost a stream of
+        // them far more than the pass's work (all of which follows a new
+        // sample); their bytes wait in the inbox for the next period.
+        if last_pass_tick == Some(tick) {
+            cortex_m::asm::wfi();
+            continue;
+        }
+        last_pass_tick = Some(tick);
         let mut mode_changed = false;
         PROBE.main_loop_pass(
             &mut TickDelay,
