@@ -45,7 +45,11 @@ pub struct UplinkService<F> {
 impl<F: NorFlash> UplinkService<F> {
     /// Loads the configuration from the two slots at `base` of `flash`
     /// (the defaults when neither holds a valid record, or when the region
-    /// does not fit them).
+    /// does not fit them). Never inlined, like [`Self::serve`]: its record
+    /// buffers must not become part of the caller's (the main loop's)
+    /// frame, which is live under every navigation step (stack budget,
+    /// docs/budgets.md).
+    #[inline(never)]
     pub fn load(flash: F, base: u32) -> Self {
         let mut store = ConfigStore::new(flash, base).ok();
         let (config, source) = match store.as_mut().map(|s| s.load()) {
@@ -85,6 +89,7 @@ impl<F: NorFlash> UplinkService<F> {
     /// Takes at most `max_bytes` from the inbox, answering each command
     /// they complete; returns the first action a board must carry out (the
     /// rest of the bytes wait for the next call).
+    #[inline(never)]
     pub fn serve<G, A, T: Transmitter>(
         &mut self,
         probe: &SharedProbe<G, A, T>,

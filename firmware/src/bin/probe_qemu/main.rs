@@ -160,6 +160,16 @@ fn navigator_for(config: &ProbeConfig) -> Navigator {
     Navigator::with_calibration(config.site, config.calibration)
 }
 
+/// Starts the navigation over from `config`. Not inlined: the new
+/// navigator (~9 KiB, most of it the filter's covariance) is built in this
+/// call's frame, not in a second navigator-sized slot of `main`'s frame,
+/// which would stay on the stack under every navigation step (the stack
+/// high-water mark rose by 9 KiB when it did; docs/budgets.md).
+#[inline(never)]
+fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
+    *navigator = navigator_for(config);
+}
+
 /// UART0 TX: the transmitter's buffer went empty.
 pub fn on_uart_tx() {
     registers::uart_clear_tx_interrupt();
@@ -261,7 +271,7 @@ fn main() -> ! {
         registers::watchdog_feed();
         match uplink.serve(&PROBE, &mut uplink_reader, UPLINK_BYTES_PER_PASS) {
             Some(BoardAction::Realign) => {
-                navigator = navigator_for(uplink.config());
+                realign(&mut navigator, uplink.config());
                 tie_in_pending = uplink.config().tie_in;
                 mode = nav_mode::INITIALISING;
             }
