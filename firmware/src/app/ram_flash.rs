@@ -119,7 +119,7 @@ mod tests {
             ..ProbeConfig::default()
         };
         store.save(&config).unwrap();
-        drop(store);
+        // The first driver is done with the memory (its borrow ends here).
         // As after a reset: a new driver over the same memory.
         let mut store = ConfigStore::new(RamNorFlash::new(&mut memory), 0).unwrap();
         let loaded = store.load();

@@ -230,7 +230,7 @@ mod tests {
             ]
         );
         assert_eq!(service.stats().malformed, 1);
-        drop(service);
+        // A reset: the first service is done with the memory.
 
         let service = UplinkService::load(RamNorFlash::new(&mut memory), 0);
         assert_eq!(service.source(), ConfigSource::Flash);
