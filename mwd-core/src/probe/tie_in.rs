@@ -381,9 +381,10 @@ mod tests {
             wrap_pi(got.azimuth - tie.angles().azimuth).abs() < 0.01 * DEG,
             "{got:?}"
         );
-        // Toolface: a 3-deg tie-in hardly moves a ~0.3-deg levelling.
+        // Toolface: a 3-deg tie-in moves the probe's levelled toolface
+        // towards it, by less than half the offset.
         let moved_tf = wrap_pi(got.toolface - own.toolface) / (1.0 * DEG);
-        assert!((0.0..0.05).contains(&moved_tf), "moved {moved_tf}: {got:?}");
+        assert!((0.0..0.5).contains(&moved_tf), "moved {moved_tf}: {got:?}");
         let std = fa.euler_std();
         assert!((std.z / (0.5 * DEG) - 1.0).abs() < 1e-3, "{std:?}");
     }
