@@ -3,6 +3,12 @@
 # then runs formatting, lints, the probe's cross-builds and the test suites.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# CI time (a 2-core machine, one cold build): no incremental caches, and
+# no debug info in the optimised builds (release, the probe's profiles and
+# the release tests), which only a debugger or a profiler reads; the
+# probe's flash and RAM figures count code and data, not debug sections.
+export CARGO_INCREMENTAL=0
+export CARGO_PROFILE_RELEASE_DEBUG=false
 
 rustup target add thumbv7em-none-eabihf
 rustup component add rustfmt clippy
@@ -47,3 +53,6 @@ cargo test --release -p system-tests --test alignment_classes -- --ignored
 # controls); fails on any panic, silent acceptance or flood of stderr.
 cargo build -p host-sim
 bash scripts/bad-input-matrix.sh target/debug/host-sim
+# The dashboard in headless Chromium (installs Debian's chromium if absent):
+# DOM checks against `host-sim decode` of the same capture, and a screenshot.
+bash scripts/dashboard-browser-test.sh target/debug/host-sim

@@ -6,6 +6,7 @@
 use mwd_core::alignment::MAX_DETERMINED_SIGMA;
 use mwd_core::conventions::wrap_two_pi;
 use mwd_core::protocol::frame::station_flags;
+use mwd_core::protocol::uplink::{Field, NakReason, Reply, ReplyStatus};
 use mwd_core::protocol::StationSurvey;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 
@@ -44,7 +45,7 @@ pub fn azimuth_text(azimuth_rad: f64, sigma_rad: f64, decimals: usize) -> String
 }
 
 /// "12.345 +- 0.050" (deg), "n/a" for a NaN value or sigma.
-fn angle_with_sigma(value_deg: f64, sigma_rad: f64) -> String {
+pub fn angle_with_sigma(value_deg: f64, sigma_rad: f64) -> String {
     if !value_deg.is_finite() || sigma_rad.is_nan() {
         "n/a".to_string()
     } else {
@@ -52,17 +53,23 @@ fn angle_with_sigma(value_deg: f64, sigma_rad: f64) -> String {
     }
 }
 
+/// A station's azimuth for people: "undetermined" when its flag or its
+/// sigma says so (`azimuth_text`'s rule plus the flag).
+pub fn station_azimuth_text(s: &StationSurvey) -> String {
+    if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
+        "undetermined".to_string()
+    } else {
+        azimuth_text(f64::from(s.angles[1]), f64::from(s.angles_std[1]), 3)
+    }
+}
+
 /// One station survey for people: number, span, the three drilling angles
 /// with their 1-sigma (azimuth "undetermined" when its sigma or flag says
 /// so), correlations, still quality and flags.
 pub fn station_text(s: &StationSurvey) -> String {
-    let [inc, azi, tf] = s.angles.map(f64::from);
-    let [s_inc, s_azi, s_tf] = s.angles_std.map(f64::from);
-    let azimuth = if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
-        "undetermined".to_string()
-    } else {
-        azimuth_text(azi, s_azi, 3)
-    };
+    let [inc, _, tf] = s.angles.map(f64::from);
+    let [s_inc, _, s_tf] = s.angles_std.map(f64::from);
+    let azimuth = station_azimuth_text(s);
     let span_s = f64::from(s.end_sample.wrapping_sub(s.start_sample)) * SAMPLE_INTERVAL_S;
     let names = [
         (station_flags::MAGNETIC_FREE, "magnetic-free"),
@@ -105,6 +112,29 @@ pub fn station_text(s: &StationSurvey) -> String {
         s.still_quality,
         flags.join(", ")
     )
+}
+
+/// The probe's ACK or NAK to a command as a person reads it
+/// (`host-sim probe`, the dashboard).
+pub fn reply_text(reply: &Reply) -> String {
+    let version = match reply.config_version {
+        0 => "defaults (never stored)".to_string(),
+        v => format!("version {v}"),
+    };
+    let why = match reply.status {
+        ReplyStatus::Ack => return format!("ACK, configuration {version}"),
+        ReplyStatus::Nak(NakReason::OutOfRange) => {
+            let field = Field::from_byte(reply.detail)
+                .map_or_else(|| format!("field {}", reply.detail), |f| f.name().into());
+            format!("out of range ({field})")
+        }
+        ReplyStatus::Nak(NakReason::Busy) => "busy (not while surveying)".into(),
+        ReplyStatus::Nak(NakReason::StorageFailed) => {
+            "the probe could not store it (previous configuration kept)".into()
+        }
+        ReplyStatus::Nak(reason) => format!("{reason:?}"),
+    };
+    format!("NAK {why}, configuration {version}")
 }
 
 #[cfg(test)]

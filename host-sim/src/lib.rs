@@ -4,6 +4,8 @@
 pub mod analysis;
 pub mod capture;
 pub mod coarse;
+#[cfg(feature = "dashboard")]
+pub mod dashboard;
 pub mod display;
 pub mod job;
 pub mod live;

@@ -505,6 +505,27 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         };
     }
 
+    /// Turns the solution about the vertical by `angle` (rad, exact, not a
+    /// small-angle correction) and makes the heading error independent of
+    /// everything else with variance `variance` (rad^2): a heading given
+    /// from outside the probe's sensors (a tie-in survey's azimuth), which
+    /// replaces the probe's own. A turn about the vertical keeps the
+    /// inclination and toolface, and the tilt errors' covariance with the
+    /// sensor states (the levelling's own accelerometer biases) is kept.
+    pub fn set_heading(&mut self, angle: f64, variance: f64) {
+        let mut state = *self.strapdown.state();
+        let turn = nalgebra::UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
+        state.attitude = turn * state.attitude;
+        self.strapdown.reset(state);
+        let p = &mut self.filter.p;
+        for j in 0..N {
+            p[(ATT + 2, j)] = T::zero();
+            p[(j, ATT + 2)] = T::zero();
+        }
+        p[(ATT + 2, ATT + 2)] = T::of(variance);
+        self.filter.x[ATT + 2] = T::zero();
+    }
+
     /// The accelerometer-bias estimate (m/s^2, body axes) and its
     /// covariance; `None` in the 33-state form, which has no bias states.
     pub fn accel_bias(&self) -> Option<(Vector3<f64>, Matrix3<f64>)> {

@@ -8,6 +8,7 @@
 //! probe's count and the host's loss count must agree.
 
 use heapless::Deque;
+use mwd_core::protocol::uplink::Reply;
 use mwd_core::protocol::{FrameEncoder, Payload, MAX_WIRE_LEN};
 
 /// Transmit queue size of the probe: 20 raw frames (about 90 ms of the
@@ -46,7 +47,21 @@ impl<const N: usize> FrameQueue<N> {
     /// had to be dropped for lack of room.
     pub fn push(&mut self, payload: &Payload) -> bool {
         let mut wire = [0u8; MAX_WIRE_LEN];
-        let Ok(len) = self.encoder.encode(payload, &mut wire) else {
+        let encoded = self.encoder.encode(payload, &mut wire);
+        self.push_encoded(encoded.ok(), &wire)
+    }
+
+    /// Numbers, encodes and queues a reply to a host command (downlink
+    /// kind 5, in the same sequence as the telemetry, so the host counts
+    /// every loss); false (and counted) when it had to be dropped.
+    pub fn push_reply(&mut self, reply: &Reply) -> bool {
+        let mut wire = [0u8; MAX_WIRE_LEN];
+        let encoded = self.encoder.encode_reply(reply, &mut wire);
+        self.push_encoded(encoded.ok(), &wire)
+    }
+
+    fn push_encoded(&mut self, len: Option<usize>, wire: &[u8]) -> bool {
+        let Some(len) = len else {
             // Cannot happen with a MAX_WIRE_LEN buffer; counted, not hidden.
             self.dropped = self.dropped.saturating_add(1);
             return false;
@@ -91,6 +106,7 @@ impl<const N: usize> FrameQueue<N> {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
     use mwd_core::protocol::frame::NO_PART;
     use mwd_core::protocol::{Decoder, Event, EventKind, RawSample};
@@ -131,6 +147,27 @@ mod tests {
         let stats = decoder.stats();
         assert_eq!(stats.lost, 1);
         assert_eq!(stats.corrupt(), 0);
+    }
+
+    #[test]
+    fn a_reply_joins_the_one_downlink_sequence() {
+        use mwd_core::protocol::uplink::reply::decode_reply_body;
+        let mut queue = FrameQueue::<256>::new();
+        assert!(queue.push(&event(1)));
+        assert!(queue.push_reply(&Reply::ack(150_000, 9, 0x49, 4)));
+        assert!(queue.push(&event(2)));
+        let mut decoder = Decoder::new();
+        let mut replies = std::vec::Vec::new();
+        let mut telemetry = 0;
+        while let Some(b) = queue.pop() {
+            telemetry += u32::from(decoder.push(b).is_some());
+            if let Some(Ok(reply)) = decoder.unknown_body().map(decode_reply_body) {
+                replies.push(reply);
+            }
+        }
+        assert_eq!(telemetry, 2);
+        assert_eq!(replies, [(1, Reply::ack(150_000, 9, 0x49, 4))]);
+        assert_eq!(decoder.stats().lost, 0, "the reply's number was counted");
     }
 
     #[test]

@@ -4,23 +4,28 @@
 //! [`budget`] derives the worst recovery, the inbox's size and the
 //! watchdog's worst unfed stretch from the driver's waits, [`watchdog`]
 //! the watchdog's timeout from them; [`config_store`] keeps the
-//! configuration in two flash slots, [`uplink_rx`] receives the host's
-//! commands.
+//! configuration in two flash slots ([`ram_flash`]: a flash emulated in
+//! RAM for QEMU), [`uplink_rx`] receives the host's commands and
+//! [`uplink_service`] answers them from the main loop; [`boot`] packs the
+//! boot event's reset cause and configuration source.
 //! Pure code (no registers, no heap), so the host tests it and every board
 //! binary runs the same logic; a board only supplies the timer interrupt,
 //! its UART ([`Transmitter`]), the sensors' SPI and the watchdog.
 
+pub mod boot;
 pub mod budget;
 pub mod config_store;
 pub mod cycle;
 pub mod frame_queue;
 pub mod probe;
+pub mod ram_flash;
 pub mod sample_inbox;
 pub mod sensor_wire;
 pub mod shared;
 pub mod start_up;
 pub mod transmitter;
 pub mod uplink_rx;
+pub mod uplink_service;
 pub mod watchdog;
 
 pub use cycle::{AcquisitionCycle, CycleReport};

@@ -13,6 +13,7 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::NO_PART;
+use mwd_core::protocol::uplink::Reply;
 use mwd_core::protocol::{EventKind, NavSolution, Payload};
 
 use super::probe::{ProbeState, Sensors};
@@ -47,6 +48,14 @@ impl<G, A, T: Transmitter> Shared<G, A, T> {
     pub fn push(&mut self, payload: &Payload) {
         self.probe.push(payload);
         self.transmitter.kick(self.probe.queue_mut());
+    }
+
+    /// Queues the reply to a host command and gets the transmitter going;
+    /// false (and counted as dropped) when the queue had no room.
+    pub fn push_reply(&mut self, reply: &Reply) -> bool {
+        let queued = self.probe.queue_mut().push_reply(reply);
+        self.transmitter.kick(self.probe.queue_mut());
+        queued
     }
 
     /// The UART's interrupt: the transmitter can take the next byte.
@@ -99,9 +108,16 @@ impl<G, A, T: Transmitter> SharedProbe<G, A, T> {
         });
     }
 
-    /// The boot event, the first frame of a run.
+    /// The boot event, the first frame of a run, reporting nothing of the
+    /// reset or the configuration (value 0).
     pub fn announce_boot(&self) {
         self.push_event(EventKind::Boot, NO_PART, FIRMWARE_VERSION, 0);
+    }
+
+    /// The boot event with its value (`boot::boot_event_value`: the reset
+    /// cause and the configuration's source and version).
+    pub fn announce_boot_with(&self, value: u32) {
+        self.push_event(EventKind::Boot, NO_PART, FIRMWARE_VERSION, value);
     }
 
     /// Navigates the waiting samples, oldest first, outside the critical

@@ -18,6 +18,8 @@ mod align;
 mod allan;
 mod arfit;
 mod calibrate;
+#[cfg(feature = "dashboard")]
+mod dashboard;
 mod decode;
 mod demo;
 mod limits;
@@ -71,6 +73,10 @@ pub enum Command {
     /// Commands to a live probe over its serial port: configure (a job
     /// file), status, align, station, index, reboot.
     Probe(probe::Args),
+    /// The probe's live display as a local web page (a serial port, or a
+    /// capture replayed at a chosen pace).
+    #[cfg(feature = "dashboard")]
+    Dashboard(dashboard::Args),
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
@@ -122,6 +128,8 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Survey(args) => done(survey::run(args)),
         Command::Study(cmd) => done(study::run(cmd)),
         Command::Probe(args) => done(probe::run(args)),
+        #[cfg(feature = "dashboard")]
+        Command::Dashboard(args) => done(dashboard::run(args)),
         Command::Paper(cmd) => done(paper::run(cmd)),
     }
 }

@@ -7,12 +7,12 @@
 //! 1 when any command was refused (NAK) or never answered.
 
 use anyhow::{bail, Context, Result};
+use host_sim::display::reply_text;
 use host_sim::job::Job;
 use mwd_core::protocol::uplink::fields::{INDEX_DWELL_S, INDEX_POSITIONS};
 use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::{
-    encode_command, Command, Field, IndexingProcedure, NakReason, Reply, ReplyStatus,
-    MAX_COMMAND_WIRE_LEN,
+    encode_command, Command, IndexingProcedure, Reply, ReplyStatus, MAX_COMMAND_WIRE_LEN,
 };
 use mwd_core::protocol::Decoder;
 use std::io::{ErrorKind, Read, Write};
@@ -119,7 +119,7 @@ pub fn run(args: Args) -> Result<()> {
     for (label, command) in &commands {
         match session.send(command) {
             Ok(reply) => {
-                outln!("{label}: {}", describe(&reply));
+                outln!("{label}: {}", reply_text(&reply));
                 refused += usize::from(reply.status != ReplyStatus::Ack);
             }
             Err(e) => {
@@ -132,28 +132,6 @@ pub fn run(args: Args) -> Result<()> {
         bail!("{refused} of {} commands not acknowledged", commands.len());
     }
     Ok(())
-}
-
-/// An ACK or NAK as a person reads it.
-fn describe(reply: &Reply) -> String {
-    let version = match reply.config_version {
-        0 => "defaults (never stored)".to_string(),
-        v => format!("version {v}"),
-    };
-    let why = match reply.status {
-        ReplyStatus::Ack => return format!("ACK, configuration {version}"),
-        ReplyStatus::Nak(NakReason::OutOfRange) => {
-            let field = Field::from_byte(reply.detail)
-                .map_or_else(|| format!("field {}", reply.detail), |f| f.name().into());
-            format!("out of range ({field})")
-        }
-        ReplyStatus::Nak(NakReason::Busy) => "busy (not while surveying)".into(),
-        ReplyStatus::Nak(NakReason::StorageFailed) => {
-            "the probe could not store it (previous configuration kept)".into()
-        }
-        ReplyStatus::Nak(reason) => format!("{reason:?}"),
-    };
-    format!("NAK {why}, configuration {version}")
 }
 
 struct Session {

@@ -57,6 +57,23 @@ pub struct Summary {
     pub rms_td_horizontal_m: Option<f64>,
     pub samples: usize,
     pub wall_s: f64,
+    /// The same counts by station number (1 = the window's): where along
+    /// the well the bounds hold or fail.
+    pub by_station: Vec<StationCoverage>,
+}
+
+/// Coverage of the stations with one station number across the runs.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StationCoverage {
+    pub station: u16,
+    pub inclination_within_2_sigma: Fraction,
+    pub azimuth_within_2_sigma: Fraction,
+    pub toolface_within_2_sigma: Fraction,
+    pub azimuth_undetermined: usize,
+    pub rms_toolface_deg: Option<f64>,
+    /// Mean toolface error (deg): a bias the sigmas cannot cover.
+    pub mean_toolface_error_deg: Option<f64>,
+    pub median_toolface_sigma_deg: Option<f64>,
 }
 
 fn rms(values: &[f64]) -> Option<f64> {
@@ -109,6 +126,7 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
     let mut totals = [0usize; 4];
     let k2 = scale_2d(0.95).powi(2);
     let mut unchecked: std::collections::BTreeMap<String, usize> = Default::default();
+    let mut by_station: std::collections::BTreeMap<u16, StationTally> = Default::default();
     for (_, r) in results {
         let o = match r {
             Ok(o) => o,
@@ -128,15 +146,23 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
                 s.invalid_stations += 1;
                 continue;
             }
+            let number = st.survey.station;
+            let slot = by_station.entry(number).or_default();
             let mut count = |i: usize, err: f64, sigma: f64, list: &mut Vec<f64>| {
+                let within = usize::from(err.abs() <= 2.0 * sigma);
                 totals[i] += 1;
-                inside[i] += usize::from(err.abs() <= 2.0 * sigma);
+                inside[i] += within;
+                slot.inside[i] += within;
+                slot.totals[i] += 1;
                 list.push(err.to_degrees());
             };
             count(0, st.error[0], sd[0], &mut inc);
             count(2, st.error[2], sd[2], &mut tf);
+            slot.toolface
+                .push((st.error[2].to_degrees(), sd[2].to_degrees()));
             if st.survey.flags & station_flags::AZIMUTH_UNDETERMINED != 0 || !sd[1].is_finite() {
                 s.undetermined_azimuth_stations += 1;
+                slot.undetermined += 1;
             } else {
                 count(1, st.error[1], sd[1], &mut azi);
             }
@@ -169,7 +195,40 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
     s.rms_azimuth_deg = rms(&azi);
     s.rms_toolface_deg = rms(&tf);
     s.rms_td_horizontal_m = rms(&td);
+    s.by_station = by_station
+        .into_iter()
+        .map(|(station, t)| t.coverage(station))
+        .collect();
     s
+}
+
+/// One station number's counts while summarising.
+#[derive(Default)]
+struct StationTally {
+    inside: [usize; 3],
+    totals: [usize; 3],
+    undetermined: usize,
+    /// (toolface error, its sigma), deg.
+    toolface: Vec<(f64, f64)>,
+}
+
+impl StationTally {
+    fn coverage(self, station: u16) -> StationCoverage {
+        let errors: Vec<f64> = self.toolface.iter().map(|(e, _)| *e).collect();
+        let mut sigmas: Vec<f64> = self.toolface.iter().map(|(_, s)| *s).collect();
+        sigmas.sort_by(f64::total_cmp);
+        let mean = (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64);
+        StationCoverage {
+            station,
+            inclination_within_2_sigma: Fraction::of(self.inside[0], self.totals[0]),
+            azimuth_within_2_sigma: Fraction::of(self.inside[1], self.totals[1]),
+            toolface_within_2_sigma: Fraction::of(self.inside[2], self.totals[2]),
+            azimuth_undetermined: self.undetermined,
+            rms_toolface_deg: rms(&errors),
+            mean_toolface_error_deg: mean,
+            median_toolface_sigma_deg: sigmas.get(sigmas.len() / 2).copied(),
+        }
+    }
 }
 
 fn percent(f: &Fraction) -> String {
@@ -234,5 +293,25 @@ pub fn table(s: &Summary) -> String {
     for e in s.failed_runs.iter().take(5) {
         rows.push(("failed", e.clone()));
     }
-    rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")).collect()
+    let mut out: String = rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")).collect();
+    out.push_str("\nby station: within 2 sigma (inclination, azimuth where determined, toolface); toolface error mean and RMS against its median sigma\n");
+    for c in &s.by_station {
+        let short = |f: &Fraction| {
+            f.fraction
+                .map_or_else(|| "  -  ".into(), |p| format!("{:5.1}", 100.0 * p))
+        };
+        let deg = |v: Option<f64>| v.map_or_else(|| "-".into(), |v| format!("{v:.3}"));
+        out.push_str(&format!(
+            "  station {:>3}: inc {} %  azi {} % ({} undetermined)  tf {} %  tf error mean {} RMS {} sigma {} deg\n",
+            c.station,
+            short(&c.inclination_within_2_sigma),
+            short(&c.azimuth_within_2_sigma),
+            c.azimuth_undetermined,
+            short(&c.toolface_within_2_sigma),
+            deg(c.mean_toolface_error_deg),
+            deg(c.rms_toolface_deg),
+            deg(c.median_toolface_sigma_deg),
+        ));
+    }
+    out
 }

@@ -68,30 +68,42 @@ pub struct RunOutcome {
     pub samples: usize,
 }
 
-/// The tie-in from the navigator's own levelling (its static alignment's
-/// inclination and toolface and their sigmas) and the parent well's
-/// azimuth: the truth plus an error drawn with `sigma_azi`.
+/// The parent well's survey at the window: its inclination is the
+/// truth's plus an error drawn with [`TIE_IN_INCLINATION_SIGMA_DEG`], its
+/// azimuth the truth's plus one drawn with `sigma_azi`; a survey gives no
+/// toolface of the probe, so the toolface is sent with the largest sigma a
+/// tie-in takes (3 deg, the truth plus an error drawn with it), which the
+/// probe's own levelling outweighs. The navigator fuses inclination and
+/// toolface with its levelling and takes the azimuth
+/// (`Navigator::start_from_tie_in`).
 pub(crate) fn tie_in(
-    solution: &mwd_core::protocol::NavSolution,
-    truth_azimuth: f64,
+    truth: &DrillingAngles,
     sigma_azi: f64,
     rng: &mut ChaCha8Rng,
 ) -> Result<TieIn> {
-    let [roll, pitch, _] = solution.attitude.map(f64::from);
-    let [s_roll, s_pitch, _] = solution.attitude_std.map(f64::from);
-    let drawn: f64 = StandardNormal.sample(rng);
-    let angles = DrillingAngles {
-        inclination: std::f64::consts::FRAC_PI_2 + pitch,
-        azimuth: wrap_two_pi(truth_azimuth + sigma_azi * drawn),
-        toolface: wrap_two_pi(roll),
+    let mut draw = |sigma: f64| -> f64 {
+        let z: f64 = StandardNormal.sample(rng);
+        sigma * z
     };
     let sigma = DrillingAngles {
-        inclination: s_pitch,
+        inclination: TIE_IN_INCLINATION_SIGMA_DEG.to_radians(),
         azimuth: sigma_azi,
-        toolface: s_roll,
+        toolface: TIE_IN_TOOLFACE_SIGMA_DEG.to_radians(),
+    };
+    let angles = DrillingAngles {
+        inclination: (truth.inclination + draw(sigma.inclination)).clamp(0.0, std::f64::consts::PI),
+        azimuth: wrap_two_pi(truth.azimuth + draw(sigma.azimuth)),
+        toolface: wrap_two_pi(truth.toolface + draw(sigma.toolface)),
     };
     TieIn::new(angles, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
 }
+
+/// 1-sigma of the parent well's inclination at the window (deg): a
+/// gyro or MWD survey's, ISCWSA MWD's inclination terms at a station.
+pub const TIE_IN_INCLINATION_SIGMA_DEG: f64 = 0.1;
+/// The toolface sigma sent with the tie-in (deg): the largest `TieIn`
+/// takes; the parent well's survey says nothing of the probe's toolface.
+pub const TIE_IN_TOOLFACE_SIGMA_DEG: f64 = 3.0;
 
 /// The raw frame of sample `index` of measured body rates and force (both
 /// parts' triads see the same force, as `capture::write_simulated_probe`).
@@ -133,7 +145,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        let solution = navigator.step(&raw(index, &s.gyro, &s.accel)?);
+        navigator.step(&raw(index, &s.gyro, &s.accel)?);
         samples += 1;
         last = Some((
             s.true_rate,
@@ -143,12 +155,8 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         if !tied && navigator.is_navigating() {
             // levelled and still at the window: the tie-in replaces the
             // gyrocompass azimuth
-            let t = tie_in(
-                &solution,
-                d.truth.point.azimuth,
-                config.tie_in_azimuth_sigma,
-                &mut rng,
-            )?;
+            let truth = DrillingAngles::from_euler(&d.truth.euler());
+            let t = tie_in(&truth, config.tie_in_azimuth_sigma, &mut rng)?;
             navigator.start_from_tie_in(&t);
             tied = true;
             continue;

@@ -21,7 +21,7 @@ use super::drilling_coverage::Fraction;
 use super::drilling_run::{raw, tie_in};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use anyhow::Result;
-use mwd_core::conventions::{dcm_from_quat, wrap_pi};
+use mwd_core::conventions::{dcm_from_quat, wrap_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::station::{angle_uncertainty, angles_and_jacobian};
 use mwd_core::probe::Navigator;
@@ -166,7 +166,7 @@ pub fn run(config: &ProbeConfig, seed: u64) -> Result<PairOutcome> {
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
         let frame = raw(index, &s.gyro, &s.accel)?;
-        let solution = without.step(&frame);
+        without.step(&frame);
         with.step(&frame);
         samples += 1;
         last = Some((
@@ -175,12 +175,8 @@ pub fn run(config: &ProbeConfig, seed: u64) -> Result<PairOutcome> {
             d.truth.state == DrillState::Still,
         ));
         if !tied && without.is_navigating() && with.is_navigating() {
-            let t = tie_in(
-                &solution,
-                d.truth.point.azimuth,
-                config.tie_in_azimuth_sigma,
-                &mut rng,
-            )?;
+            let truth = DrillingAngles::from_euler(&d.truth.euler());
+            let t = tie_in(&truth, config.tie_in_azimuth_sigma, &mut rng)?;
             without.start_from_tie_in(&t);
             with.start_from_tie_in(&t);
             tied = true;

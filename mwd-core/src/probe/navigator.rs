@@ -41,14 +41,16 @@
 use super::raw::{reading, Reading};
 use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::StillDetector;
-use super::tie_in::TieIn;
+use super::tie_in::{TieIn, TieInTilt};
 use crate::aid_sources::{
     AxialSpeed, NonHolonomic, VerticalEarthRate, AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE,
 };
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
 use crate::calibration::ProbeCalibration;
-use crate::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, Euler, DEG};
+use crate::conventions::{
+    dcm_from_quat, euler_from_quat, quat_from_euler, DrillingAngles, Euler, DEG,
+};
 use crate::earth::earth_rate_n;
 use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
@@ -818,20 +820,83 @@ impl Navigator {
         solution
     }
 
-    /// Starts navigation from a tie-in (`super::tie_in`) instead of the
-    /// static alignment, dropping whatever the navigator was doing: the
-    /// tie-in's attitude at rest at the navigator's position, its angles'
-    /// covariance as the attitude-error covariance (independent of the
-    /// sensor states: not levelled with these accelerometers), the other
-    /// states as after a coarse alignment, no zero updates.
+    /// Ties the navigation in to the parent well's survey at the window
+    /// (`super::tie_in`, derivation section 4c).
     ///
-    /// When: at any step boundary. An in-process caller tying in a probe
-    /// that levelled itself calls it between steps as soon as
-    /// [`is_navigating`](Self::is_navigating) first returns true (the end
-    /// of the fine alignment); the probe's own levelled tilt is then
-    /// replaced by the tie-in's (not combined). Drilling mode and stations
-    /// start afresh.
+    /// A probe that has levelled itself (navigating: called between steps
+    /// as soon as [`is_navigating`](Self::is_navigating) first returns true)
+    /// keeps its filter: the azimuth is replaced by the tie-in's (a turn
+    /// about the vertical; the heading error is then the tie-in's alone),
+    /// and the tie-in's inclination and toolface are fused with its own
+    /// levelling as measurements ([`TieInTilt`]), so the levelled tilt keeps
+    /// its correlation with the accelerometer biases it was levelled with.
+    /// (Putting the tie-in's tilt in place of that, as independent, left the
+    /// window station's toolface 4 times outside its sigma in the coverage
+    /// study: the accelerometer bias went into the toolface unseen.)
+    /// Before that (or with an invalid covariance) the filter starts again
+    /// from the tie-in's attitude and sigmas, independent of the sensor
+    /// states, with no zero updates. Drilling mode and stations start
+    /// afresh.
     pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
+        if !matches!(self.phase, Phase::Navigating) || self.covariance_invalid {
+            self.restart_from_tie_in(tie_in);
+            return;
+        }
+        // The filter starts again at the probe's own levelled tilt and the
+        // tie-in's azimuth: what it learned in the fine alignment rested on
+        // a heading that may have been tens of degrees off (its gyro-bias
+        // estimates absorbed the misplaced earth rate: kept, the window's
+        // azimuths came out 11 deg RMS instead of 6). The tilt starts as a
+        // levelling with these accelerometers (`TiltPrior` default: its
+        // error holds their biases) from the coarse levelling's noise; the
+        // heading error is the tie-in's alone.
+        let (own, _) = angles_and_jacobian(&dcm_from_quat(&self.filter.state().attitude));
+        let given = tie_in.angles();
+        let sigma = tie_in.sigma();
+        let start = DrillingAngles {
+            azimuth: given.azimuth,
+            ..own
+        };
+        let levelling = [self.coarse_std[0], self.coarse_std[1]].map(|s| {
+            if s.is_finite() {
+                f64::from(s)
+            } else {
+                10f64.to_radians()
+            }
+        });
+        let config = filter_config(&self.position, &[levelling[0], levelling[1], sigma.azimuth]);
+        let state = NavState::at_rest(quat_from_euler(&start.to_euler()), self.position);
+        self.filter.restart(state, self.position, config);
+        self.filter.set_heading(0.0, square(sigma.azimuth));
+        self.filter.start_navigation();
+        // Inclination and toolface are fused with the probe's levelling.
+        let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&self.filter.state().attitude));
+        let row = |i: usize| [0, 1, 2].map(|k| jacobian[(i, k)] as f32);
+        let tilt = TieInTilt {
+            rows: [row(0), row(2)],
+            innovation: [
+                (angles.inclination - given.inclination) as f32,
+                crate::conventions::wrap_pi(angles.toolface - given.toolface) as f32,
+            ],
+            variance: [
+                square(sigma.inclination) as f32,
+                square(sigma.toolface) as f32,
+            ],
+        };
+        self.filter.aid(&tilt);
+        let euler_std = self.filter.euler_std();
+        self.coarse_std = [euler_std.x, euler_std.y, sigma.azimuth].map(|s| s as f32);
+        self.input = ProbeInput::new();
+        self.coasting = false;
+        self.coarse_single_part = false;
+        self.drilled_since_station = false;
+        self.rest_accel_bias = None;
+    }
+
+    /// [`start_from_tie_in`](Self::start_from_tie_in) before the probe
+    /// has levelled itself (or with a covariance that lost its meaning):
+    /// the filter starts again from the tie-in's attitude and sigmas.
+    fn restart_from_tie_in(&mut self, tie_in: &TieIn) {
         let sigma = tie_in.euler_sigma();
         let mut config = filter_config(&self.position, &sigma);
         config.tilt_prior = TiltPrior::Independent;

@@ -22,6 +22,8 @@
 
 use super::navigator::TILT_SIGMA_LIMIT_RAD;
 use crate::conventions::{dcm_from_euler, quat_from_euler, DrillingAngles, DEG};
+use crate::error_model::ATT;
+use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
 use core::f64::consts::{PI, TAU};
 use nalgebra::{Matrix3, UnitQuaternion};
 
@@ -191,6 +193,38 @@ impl TieIn {
     }
 }
 
+/// The tie-in's inclination and toolface as measurements of the filter's
+/// attitude error (`Navigator::start_from_tie_in`): z = computed - tie-in
+/// (toolface wrapped), h = the angle's row of the drilling-angle Jacobian
+/// (`super::station::angles_and_jacobian`) on the attitude states, r = the
+/// tie-in's variance. Fused with the probe's own levelling, not put in its
+/// place: the levelled tilt carries the accelerometer biases it was
+/// levelled with, and that correlation is the filter's to keep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TieInTilt<T> {
+    pub rows: [[T; 3]; 2],
+    pub innovation: [T; 2],
+    pub variance: [T; 2],
+}
+
+impl<T: FilterScalar> Measurement<T> for TieInTilt<T> {
+    fn len(&self) -> usize {
+        2
+    }
+    fn scalar(&self, k: usize) -> Option<ScalarMeasurement<T>> {
+        let row = self.rows.get(k)?;
+        let mut h = SparseRow::empty();
+        for (i, v) in row.iter().enumerate() {
+            h.push(ATT + i, *v);
+        }
+        Some(ScalarMeasurement {
+            z: self.innovation[k],
+            h,
+            r: self.variance[k],
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,6 +341,52 @@ mod tests {
                 assert_eq!(p[(i, j)], 0.0);
             }
         }
+    }
+
+    /// Tied in while navigating: the azimuth is the tie-in's with its
+    /// sigma, its inclination pulls the probe's own by the weights of the
+    /// two variances, and a toolface with a 3-deg sigma barely moves the
+    /// probe's.
+    #[test]
+    fn a_navigating_probe_takes_the_azimuth_and_fuses_the_tilt() {
+        let first = lateral();
+        let mut navigator = Navigator::new(Position::paper_site());
+        navigator.start_from_tie_in(&first);
+        let own = first.angles();
+        let tie = TieIn::new(
+            DrillingAngles {
+                inclination: own.inclination + 0.3 * DEG,
+                azimuth: own.azimuth + 10.0 * DEG,
+                toolface: own.toolface + 1.0 * DEG,
+            },
+            DrillingAngles {
+                inclination: 0.1 * DEG,
+                azimuth: 0.5 * DEG,
+                toolface: 3.0 * DEG,
+            },
+        )
+        .unwrap();
+        navigator.start_from_tie_in(&tie);
+        let fa = navigator.filter();
+        let got =
+            crate::conventions::DrillingAngles::from_euler(&euler_from_quat(&fa.state().attitude));
+        // Inclination: pulled towards the tie-in's, by the weight of the
+        // two variances: the probe's own is the levelling's (0.1 deg here)
+        // plus its accelerometer biases' share, so more than half way.
+        let moved = (got.inclination - own.inclination) / (0.3 * DEG);
+        assert!((0.5..0.95).contains(&moved), "moved {moved}: {got:?}");
+        // The azimuth is the tie-in's (the tilt update's Jacobian reaches
+        // the heading a little at 89.5 deg).
+        assert!(
+            wrap_pi(got.azimuth - tie.angles().azimuth).abs() < 0.01 * DEG,
+            "{got:?}"
+        );
+        // Toolface: a 3-deg tie-in moves the probe's levelled toolface
+        // towards it, by less than half the offset.
+        let moved_tf = wrap_pi(got.toolface - own.toolface) / (1.0 * DEG);
+        assert!((0.0..0.5).contains(&moved_tf), "moved {moved_tf}: {got:?}");
+        let std = fa.euler_std();
+        assert!((std.z / (0.5 * DEG) - 1.0).abs() < 1e-3, "{std:?}");
     }
 
     /// A still probe feeling gravity at the tie-in's attitude (no earth

@@ -17,7 +17,10 @@ pub fn finish(summary: &Summary) -> ! {
          cycle_ticks_worst={} cycle_ticks_mean={} \
          cycle_instructions_worst={} cycle_instructions_mean={} stack_high_water_bytes={} \
          nav_samples_dropped={} nav_inbox_high_water={} cycle_overruns={} overrun_instructions_longest={} \
-         mode_changes={} mode_change_instructions_longest={}",
+         mode_changes={} mode_change_instructions_longest={} \
+         uplink_bytes={} uplink_ok={} uplink_crc_failures={} uplink_malformed={} \
+         uplink_oversized={} uplink_unknown={} uplink_out_of_range={} \
+         uplink_overflowed_bytes={} uplink_replies_dropped={}",
         summary.samples,
         summary.skipped,
         summary.queued,
@@ -33,6 +36,15 @@ pub fn finish(summary: &Summary) -> ! {
         summary.longest_overrun_ticks * u64::from(INSTRUCTIONS_PER_TICK),
         summary.mode_changes,
         summary.longest_mode_change_ticks * u64::from(INSTRUCTIONS_PER_TICK),
+        summary.uplink.bytes,
+        summary.uplink.frames_ok,
+        summary.uplink.crc_failures,
+        summary.uplink.malformed,
+        summary.uplink.oversized,
+        summary.uplink.unknown,
+        summary.uplink.out_of_range,
+        summary.uplink.overflowed_bytes,
+        summary.replies_dropped,
     );
     debug::exit(debug::EXIT_SUCCESS);
     loop {
@@ -78,13 +90,15 @@ unsafe fn NonMaskableInt() {
     fail("watchdog: the main loop stalled");
 }
 
-/// Every interrupt without its own handler lands here: dispatch the UART's,
+/// Every interrupt without its own handler lands here: dispatch the UART's two,
 /// and treat any other as a fault (nothing else is enabled).
 #[allow(unsafe_code)]
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
     if irqn == crate::registers::UART0_TX_IRQ {
         crate::on_uart_tx();
+    } else if irqn == crate::registers::UART0_RX_IRQ {
+        crate::on_uart_rx();
     } else {
         fail("unexpected interrupt");
     }

@@ -6,9 +6,18 @@
 //! - SysTick at 20 Hz: takes the sample (its instant is the timer's, not the
 //!   main loop's) and queues the raw frame and any fault events;
 //! - UART0 TX interrupt: moves the next queued byte into the transmitter;
+//!   UART0 RX interrupt: moves each received byte into the uplink's
+//!   bounded inbox (`firmware::app::uplink_rx`), nothing more;
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
-//!   raw sample (navigation frames); feeds the watchdog between those steps
-//!   (`firmware::app::budget`); sleeps otherwise.
+//!   raw sample (navigation frames), then the host's commands
+//!   (`firmware::app::uplink_service`: a bounded number of bytes per pass,
+//!   each command answered on the downlink); feeds the watchdog between
+//!   those steps (`firmware::app::budget`); sleeps otherwise.
+//!
+//! The configuration lives in RAM that survives a reset (`persistent.rs`),
+//! behind the same NOR-flash trait as the real board's flash; the boot
+//! event says the reset cause and whether the configuration came from it
+//! or is the defaults.
 //!
 //! What the contexts share and do is `firmware::app::SharedProbe`, as on
 //! the real board; this file adds UART0 as its `Transmitter`, SysTick, the
@@ -25,6 +34,7 @@
 
 mod exit;
 mod mock_sensors;
+mod persistent;
 mod registers;
 mod stack_paint;
 #[cfg(feature = "qemu-drilling")]
@@ -32,11 +42,18 @@ mod stream_file;
 
 use core::sync::atomic::Ordering;
 
+use core::cell::RefCell;
+
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception};
+use critical_section::Mutex;
+use firmware::app::boot::boot_event_value;
+use firmware::app::ram_flash::RamNorFlash;
+use firmware::app::uplink_rx::{InboxWriter, UplinkInbox, UplinkStats};
+use firmware::app::uplink_service::{BoardAction, UplinkService};
 use firmware::app::{FrameQueue, SharedProbe, Transmitter, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS};
-use mwd_core::earth::Position;
+use mwd_core::config::ProbeConfig;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::nav_mode;
 use mwd_core::timing::{SAMPLE_PERIOD_US, SAMPLE_RATE_HZ};
@@ -52,6 +69,11 @@ const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
 const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// When the watchdog run (feature `qemu-stall-demo`) hangs its main loop.
 const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
+/// Uplink bytes the main loop takes per pass, once per sample period: the
+/// inbox's capacity, more than the 576 B a period brings at 115200 baud,
+/// so the line is drained as fast as it fills, while a flood costs each
+/// period at most this.
+const UPLINK_BYTES_PER_PASS: usize = firmware::app::uplink_rx::UPLINK_QUEUE_LEN;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
@@ -115,6 +137,39 @@ fn SysTick() {
     });
 }
 
+/// The receive interrupt's end of the uplink inbox (set once in `main`).
+static UPLINK_WRITER: Mutex<RefCell<Option<InboxWriter<'static>>>> = Mutex::new(RefCell::new(None));
+
+/// UART0 RX: a byte arrived; into the inbox (a full inbox drops and
+/// counts it).
+pub fn on_uart_rx() {
+    registers::uart_clear_rx_interrupt();
+    critical_section::with(|cs| {
+        let mut writer = UPLINK_WRITER.borrow_ref_mut(cs);
+        while let Some(byte) = registers::uart_read() {
+            if let Some(writer) = writer.as_mut() {
+                writer.push(byte);
+            }
+        }
+    });
+}
+
+/// The navigator the configuration asks for (site and calibration; its
+/// tie-in is applied once the navigator levels, in the main loop).
+fn navigator_for(config: &ProbeConfig) -> Navigator {
+    Navigator::with_calibration(config.site, config.calibration)
+}
+
+/// Starts the navigation over from `config`. Not inlined: the new
+/// navigator (~9 KiB, most of it the filter's covariance) is built in this
+/// call's frame, not in a second navigator-sized slot of `main`'s frame,
+/// which would stay on the stack under every navigation step (the stack
+/// high-water mark rose by 9 KiB when it did; docs/budgets.md).
+#[inline(never)]
+fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
+    *navigator = navigator_for(config);
+}
+
 /// UART0 TX: the transmitter's buffer went empty.
 pub fn on_uart_tx() {
     registers::uart_clear_tx_interrupt();
@@ -155,7 +210,22 @@ fn main() -> ! {
     syst.enable_interrupt();
     syst.enable_counter();
 
-    PROBE.announce_boot();
+    let reset_cause = persistent::take_reset_cause();
+    let Some(flash_memory) = persistent::config_flash() else {
+        exit::fail("configuration flash taken twice")
+    };
+    let mut uplink = UplinkService::load(RamNorFlash::new(flash_memory), 0);
+    let Some(inbox) = cortex_m::singleton!(: UplinkInbox = UplinkInbox::new()) else {
+        exit::fail("uplink inbox taken twice")
+    };
+    let (writer, mut uplink_reader) = inbox.split();
+    critical_section::with(|cs| *UPLINK_WRITER.borrow_ref_mut(cs) = Some(writer));
+
+    PROBE.announce_boot_with(boot_event_value(
+        reset_cause,
+        uplink.source(),
+        uplink.config().version,
+    ));
     registers::watchdog_start(WATCHDOG_TIMEOUT_MS);
     PROBE.start_streaming(
         mock_sensors::power_up(),
@@ -164,11 +234,23 @@ fn main() -> ! {
     );
 
     let mut cost = CycleCost::default();
-    // The simulated site: the MGWD paper's test site.
-    let mut navigator = Navigator::new(Position::paper_site());
+    // The configured site and calibration (the defaults: the MGWD paper's
+    // test site, uncorrected sensors).
+    let mut navigator = navigator_for(uplink.config());
+    let mut tie_in_pending = uplink.config().tie_in;
     let mut mode = nav_mode::INITIALISING;
+    let mut last_pass_tick = None;
     loop {
         let tick = TICKS.load(Ordering::Relaxed);
+        // One pass per sample period: every byte received wakes the main
+        // loop (its interrupt), and a pass per byte would cost a stream of
+        // them far more than the pass's work (all of which follows a new
+        // sample); their bytes wait in the inbox for the next period.
+        if last_pass_tick == Some(tick) {
+            cortex_m::asm::wfi();
+            continue;
+        }
+        last_pass_tick = Some(tick);
         let mut mode_changed = false;
         PROBE.main_loop_pass(
             &mut TickDelay,
@@ -180,6 +262,22 @@ fn main() -> ! {
                 mode = solution.mode;
             },
         );
+        // A tie-in replaces the probe's own levelling as soon as it has
+        // one (`Navigator::start_from_tie_in`).
+        if let Some(tie_in) = tie_in_pending.filter(|_| navigator.is_navigating()) {
+            navigator.start_from_tie_in(&tie_in);
+            tie_in_pending = None;
+        }
+        registers::watchdog_feed();
+        match uplink.serve(&PROBE, &mut uplink_reader, UPLINK_BYTES_PER_PASS) {
+            Some(BoardAction::Realign) => {
+                realign(&mut navigator, uplink.config());
+                tie_in_pending = uplink.config().tie_in;
+                mode = nav_mode::INITIALISING;
+            }
+            Some(BoardAction::Reboot) => reboot(),
+            None => {}
+        }
         if cfg!(feature = "qemu-stall-demo")
             && PROBE.with(|s| s.probe().cycle().samples()) >= STALL_AT_SAMPLE
         {
@@ -194,7 +292,7 @@ fn main() -> ! {
             (p.cycle().samples(), done)
         });
         if samples >= mock_sensors::samples_to_run() && idle {
-            exit::finish(&summary(&cost));
+            exit::finish(&summary(&cost, &uplink));
         }
         // The cycle's work is done: SysTick counts since the period began
         // (only if no new period started meanwhile).
@@ -221,6 +319,17 @@ fn main() -> ! {
     }
 }
 
+/// The reboot command: once its ACK (and all queued before it) has left
+/// the UART, restart with the reset mark saying "software".
+fn reboot() -> ! {
+    while !PROBE.with(|s| s.probe().queue().is_empty() && !s.transmitter().busy) {
+        registers::watchdog_feed();
+        cortex_m::asm::wfi();
+    }
+    persistent::mark_software_reset();
+    registers::system_reset()
+}
+
 /// The run's figures for the host (semihosting stdout).
 struct Summary {
     samples: u32,
@@ -236,9 +345,11 @@ struct Summary {
     longest_overrun_ticks: u64,
     mode_changes: u32,
     longest_mode_change_ticks: u64,
+    uplink: UplinkStats,
+    replies_dropped: u32,
 }
 
-fn summary(cost: &CycleCost) -> Summary {
+fn summary(cost: &CycleCost, uplink: &UplinkService<RamNorFlash>) -> Summary {
     let mean_ticks = (cost.total / u64::from(cost.cycles.max(1))) as u32;
     PROBE.with(|s| Summary {
         samples: s.probe().cycle().samples(),
@@ -254,5 +365,7 @@ fn summary(cost: &CycleCost) -> Summary {
         longest_overrun_ticks: cost.longest_overrun,
         mode_changes: cost.mode_changes,
         longest_mode_change_ticks: cost.longest_mode_change,
+        uplink: *uplink.stats(),
+        replies_dropped: uplink.replies_dropped(),
     })
 }

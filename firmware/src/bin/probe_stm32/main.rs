@@ -28,6 +28,7 @@ use core::cell::RefCell;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use critical_section::Mutex;
 use defmt_rtt as _;
+use firmware::app::boot::{boot_event_value, ConfigSource, ResetCause};
 use firmware::app::{FrameQueue, SharedProbe, Transmitter, FIRMWARE_VERSION, TX_QUEUE_LEN};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
@@ -112,6 +113,7 @@ fn main() -> ! {
     let (Some(dp), Some(core)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {
         defmt::panic!("peripherals taken twice");
     };
+    let reset_cause = take_reset_cause(&dp.RCC);
     let board = match board::init(dp, core.SYST) {
         Ok(board) => board,
         Err(what) => defmt::panic!("board set-up failed: {=str}", what),
@@ -141,7 +143,8 @@ fn main() -> ! {
         NVIC::unmask(Interrupt::USART1);
     }
 
-    PROBE.announce_boot();
+    // No configuration on this board yet: its source is not reported.
+    PROBE.announce_boot_with(boot_event_value(reset_cause, ConfigSource::NotReported, 0));
     // The watchdog runs since `board::init`; the start-up feeds it after
     // each attempt.
     watchdog.feed();
@@ -160,4 +163,28 @@ fn main() -> ! {
         );
         cortex_m::asm::wfi();
     }
+}
+
+/// Why the chip restarted, from RCC_CSR's reset flags (RM0383 6.3.21),
+/// which are then cleared (RMVF) so the next boot sees only its own. The
+/// pin flag is set by every reset (the internal ones drive NRST too) and
+/// a power-on also sets the brown-out flag, hence the order.
+fn take_reset_cause(rcc: &pac::RCC) -> ResetCause {
+    let csr = rcc.csr().read();
+    let cause = if csr.porrstf().bit_is_set() {
+        ResetCause::PowerOn
+    } else if csr.borrstf().bit_is_set() {
+        ResetCause::BrownOut
+    } else if csr.wdgrstf().bit_is_set() || csr.wwdgrstf().bit_is_set() {
+        ResetCause::Watchdog
+    } else if csr.sftrstf().bit_is_set() {
+        ResetCause::Software
+    } else if csr.padrstf().bit_is_set() {
+        ResetCause::Pin
+    } else {
+        // The low-power reset, or no flag: nothing to tell.
+        ResetCause::NotReported
+    };
+    rcc.csr().modify(|_, w| w.rmvf().set_bit());
+    cause
 }

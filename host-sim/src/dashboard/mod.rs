@@ -1,0 +1,17 @@
+//! `host-sim dashboard`: the probe's live display as a local web page, in
+//! the spirit of the MGWD paper's data-collection software (both sensor
+//! boards' data and curves, the calibration, parameter setting and system
+//! control). docs/dashboard.md.
+//!
+//! - [`source`]: frames from a serial port (recorded raw as they arrive)
+//!   or a capture replayed at a chosen pace; the probe's commands.
+//! - [`state`]: what the page shows, in bounded buffers, and its updates.
+//! - [`view`], [`stations`]: frames and stations as people read them.
+//! - [`server`]: the page (uPlot embedded) and server-sent events.
+
+pub mod ring;
+pub mod server;
+pub mod source;
+pub mod state;
+pub mod stations;
+pub mod view;

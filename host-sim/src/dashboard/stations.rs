@@ -1,0 +1,155 @@
+//! The stations on the page: each as the probe sent it, with MD and
+//! positions by minimum curvature when a depth log pairs them with depth
+//! (the pairing and positioning of `host-sim survey CAPTURE --depth`,
+//! `survey_listing::drilling`), for the plan view and the vertical section.
+
+use mwd_core::protocol::frame::station_flags;
+use mwd_core::protocol::StationSurvey;
+use serde_json::{json, Value};
+
+use crate::display;
+use crate::survey_error::{ErrorTerm, Site};
+use crate::survey_listing::depth_log::DepthLog;
+use crate::survey_listing::drilling::{self, DrillingRow};
+use crate::survey_listing::TieOnInput;
+
+/// What pairing stations with MD needs; `depth: None` lists the stations
+/// only.
+#[derive(Debug, Clone)]
+pub struct SurveySetup {
+    pub depth: Option<DepthLog>,
+    pub terms: Vec<ErrorTerm>,
+    pub site: Site,
+}
+
+impl SurveySetup {
+    /// As `host-sim survey CAPTURE --depth` sets it up for a site at
+    /// `latitude_deg`: the probe's own angle sigmas plus the depth log's
+    /// scale and stretch terms (no magnetic terms: the probe has none).
+    pub fn new(depth: Option<DepthLog>, latitude_deg: f64) -> anyhow::Result<Self> {
+        Ok(Self {
+            depth,
+            terms: drilling::depth_terms()?,
+            site: Site {
+                gravity: 9.806_65,
+                b_total: 0.0,
+                dip: 0.0,
+                declination: 0.0,
+                vertical_limit: 0.0001_f64.to_radians(),
+                latitude: latitude_deg.to_radians(),
+                gyro_noise_reduction: 1.0,
+            },
+        })
+    }
+}
+
+/// "12.34 +- 0.56 m" from a value and a variance; "n/a" when the variance
+/// is not a valid one (never a sigma of 0 for it).
+fn metres(value: f64, variance: Option<f64>) -> String {
+    match variance {
+        Some(v) if v.is_finite() && v >= 0.0 && value.is_finite() => {
+            format!("{value:.2} +- {:.2} m", v.sqrt())
+        }
+        _ => "n/a".into(),
+    }
+}
+
+fn station_row(s: &StationSurvey) -> Value {
+    let [inc, _, tf] = s.angles.map(f64::from);
+    let [s_inc, _, s_tf] = s.angles_std.map(f64::from);
+    let tf_deg = if tf.is_finite() {
+        display::deg_0_360(tf)
+    } else {
+        f64::NAN
+    };
+    json!({
+        "number": s.station,
+        "time_s": s.time_us as f64 * 1e-6,
+        "inclination": display::angle_with_sigma(inc.to_degrees(), s_inc),
+        "azimuth": display::station_azimuth_text(s),
+        "toolface": display::angle_with_sigma(tf_deg, s_tf),
+        "invalid": s.flags & station_flags::SOLUTION_INVALID != 0,
+        "md": Value::Null,
+        "position": "no depth log",
+    })
+}
+
+fn positioned(row: &mut Value, d: &DrillingRow) {
+    row["md"] = json!(format!("{:.2} m", d.row.md_m));
+    row["position"] = if d.position_determined {
+        let cov = d.row.cov;
+        let part = |i: usize| cov.map(|c| c[i]);
+        json!(format!(
+            "N {}, E {}, TVD {}",
+            metres(d.row.north_m, part(0)),
+            metres(d.row.east_m, part(1)),
+            metres(d.row.tvd_m, part(2)),
+        ))
+    } else {
+        json!("undetermined (an azimuth up to here is undetermined)")
+    };
+}
+
+/// The stations for the page: the list, the note on positions, and the
+/// plan view (east, north) and vertical section (section, TVD) of the
+/// stations whose position is determined.
+pub fn stations_json(stations: &[StationSurvey], dropped: u64, setup: &SurveySetup) -> Value {
+    let mut rows: Vec<Value> = stations.iter().map(station_row).collect();
+    let mut plan = Vec::new();
+    let mut section = Vec::new();
+    let note = match (&setup.depth, stations.is_empty()) {
+        (None, _) => "No depth log: positions by minimum curvature need MD, so the stations \
+                      are listed only (start with --depth DEPTH.csv)."
+            .to_string(),
+        (Some(_), true) => "No station yet.".to_string(),
+        (Some(depth), false) => {
+            let tie = TieOnInput {
+                md: None,
+                tvd: 0.0,
+                north: 0.0,
+                east: 0.0,
+            };
+            match drilling::survey(stations, depth, tie, &setup.terms, &setup.site) {
+                Ok(survey) => {
+                    for d in &survey.rows {
+                        // By number and time: a station's NaN correlations
+                        // make `==` false even for itself.
+                        let same = |s: &StationSurvey| {
+                            (s.station, s.time_us) == (d.survey.station, d.survey.time_us)
+                        };
+                        if let Some(k) = stations.iter().position(same) {
+                            positioned(&mut rows[k], d);
+                        }
+                        if d.position_determined {
+                            plan.push(json!([d.row.east_m, d.row.north_m]));
+                            section.push(json!([d.row.vsec_m, d.row.tvd_m]));
+                        }
+                    }
+                    let skipped: Vec<String> = survey
+                        .skipped
+                        .iter()
+                        .map(|s| format!("station {}: {}", s.survey.station, s.reason))
+                        .collect();
+                    let mut note = "Positions by minimum curvature from the first station \
+                                    (the tie-on, at N 0, E 0, TVD 0), MD from the depth log; \
+                                    1 sigma."
+                        .to_string();
+                    if !skipped.is_empty() {
+                        note += &format!(" Left out: {}.", skipped.join("; "));
+                    }
+                    if plan.is_empty() {
+                        note += " No position is determined yet: the azimuth is undetermined.";
+                    }
+                    note
+                }
+                Err(e) => format!("Positions not computed: {e:#}"),
+            }
+        }
+    };
+    let note = if dropped > 0 {
+        format!("{note} ({dropped} earlier stations no longer held.)")
+    } else {
+        note
+    };
+    json!({"rows": rows, "note": note, "plan": plan, "section": section})
+}

@@ -1,0 +1,393 @@
+//! `host-sim dashboard` served over loopback: the page and the embedded
+//! uPlot, the update stream of a replayed capture to its end (with the
+//! link's counts and an undetermined azimuth as the word), a reconnect
+//! with Last-Event-ID that gets only what is new, refused commands while
+//! replaying; and on a pty standing in for the probe, the commands' ACKs
+//! on the page and every byte recorded to --save.
+#![cfg(feature = "dashboard")]
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+/// A running dashboard, killed when dropped.
+struct Dashboard {
+    child: Child,
+    addr: String,
+}
+
+impl Drop for Dashboard {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn start(args: &[&str]) -> Dashboard {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("dashboard")
+        .args(args)
+        .args(["--http-port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("host-sim runs");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let addr = line
+        .split("http://")
+        .nth(1)
+        .and_then(|rest| rest.split('/').next())
+        .unwrap_or_else(|| panic!("no URL in {line:?}"))
+        .to_string();
+    assert!(addr.starts_with("127.0.0.1:"), "{addr}");
+    Dashboard { child, addr }
+}
+
+/// One HTTP/1.0 request (no chunked encoding to undo) with the page's
+/// command header: status and body.
+fn request(addr: &str, method: &str, path: &str) -> (u16, String) {
+    raw_request(addr, method, path, "X-MWD-Dashboard: 1\r\n")
+}
+
+fn raw_request(addr: &str, method: &str, path: &str, headers: &str) -> (u16, String) {
+    let mut stream = TcpStream::connect(addr).unwrap();
+    write!(
+        stream,
+        "{method} {path} HTTP/1.0\r\nHost: {addr}\r\n{headers}\r\n"
+    )
+    .unwrap();
+    let mut response = String::new();
+    stream.read_to_string(&mut response).unwrap();
+    let (head, body) = response.split_once("\r\n\r\n").unwrap();
+    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
+    (status, body.to_string())
+}
+
+/// Reads the event stream until `done` says so (or 30 s): the last event's
+/// id and data.
+fn follow(addr: &str, last_id: Option<&str>, done: impl Fn(&Value) -> bool) -> (String, Value) {
+    let mut stream = TcpStream::connect(addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(10)))
+        .unwrap();
+    let resume = last_id.map_or(String::new(), |id| format!("Last-Event-ID: {id}\r\n"));
+    write!(
+        stream,
+        "GET /events HTTP/1.0\r\nHost: {addr}\r\n{resume}\r\n"
+    )
+    .unwrap();
+    let started = Instant::now();
+    let mut id = String::new();
+    for line in BufReader::new(stream).lines() {
+        let line = line.unwrap();
+        if let Some(rest) = line.strip_prefix("id:") {
+            id = rest.trim().to_string();
+        } else if let Some(data) = line.strip_prefix("data:") {
+            let update: Value = serde_json::from_str(data).unwrap();
+            if done(&update) || started.elapsed() > Duration::from_secs(30) {
+                return (id, update);
+            }
+        }
+    }
+    panic!("the event stream ended");
+}
+
+fn simulated_capture(dir: &Path) -> std::path::PathBuf {
+    let out = dir.join("run.bin");
+    let run = common::run(&["simulate", "--duration", "30", "-o", out.to_str().unwrap()]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    out
+}
+
+#[test]
+fn a_replayed_capture_streams_to_its_end_and_a_reconnect_resumes() {
+    let dir = common::scratch("dashboard", "replay");
+    let capture = simulated_capture(&dir);
+    let d = start(&["--file", capture.to_str().unwrap(), "--speed", "200"]);
+
+    let (status, page) = request(&d.addr, "GET", "/");
+    assert_eq!(status, 200);
+    assert!(page.contains("/uPlot.js") && page.contains("id=\"azimuth\""));
+    let (status, uplot) = request(&d.addr, "GET", "/uPlot.js");
+    assert_eq!(status, 200);
+    let vendored = include_str!("../assets/dashboard/vendor/uplot/uPlot.iife.min.js");
+    assert_eq!(uplot, vendored);
+
+    let (id, last) = follow(&d.addr, None, |u| u["rest"]["finished"] == true);
+    let rest = &last["rest"];
+    assert_eq!(rest["finished"], true, "{rest}");
+    // 30 s at 20 Hz: a boot event, 600 raw and 600 navigation frames.
+    assert_eq!(rest["link"]["frames"], 1201, "{rest}");
+    assert_eq!(rest["link"]["raw"], 600);
+    assert_eq!(rest["link"]["lost"], 0);
+    assert_eq!(rest["link"]["crc_errors"], 0);
+    assert_eq!(rest["latest"]["azimuth"], "undetermined");
+    assert!(rest["latest"]["inclination"]
+        .as_str()
+        .unwrap()
+        .contains(" +- "));
+    assert!(rest["source"]["controls_disabled"]
+        .as_str()
+        .unwrap()
+        .contains("replaying"));
+
+    // A page that saw everything gets nothing again; a new one all of it.
+    let (_, resumed) = follow(&d.addr, Some(&id), |_| true);
+    assert_eq!(resumed["rest"]["reset"], false);
+    assert_eq!(resumed["sensors"].as_array().unwrap().len(), 0);
+    let (_, fresh) = follow(&d.addr, None, |_| true);
+    assert_eq!(fresh["rest"]["reset"], true);
+    assert_eq!(fresh["sensors"].as_array().unwrap().len(), 600);
+
+    let (status, why) = request(&d.addr, "POST", "/api/align");
+    assert_eq!(status, 409);
+    assert!(why.contains("replaying"), "{why}");
+    let (status, why) = request(&d.addr, "POST", "/api/index/1/30");
+    assert_eq!(status, 400);
+    assert!(why.contains("2 to 36 positions"), "{why}");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A capture of 100 s with three stations whose azimuth is determined,
+/// and the depth log that pairs them with MD.
+fn capture_with_stations(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    use host_sim::capture::CaptureWriter;
+    use mwd_core::protocol::frame::station_flags;
+    use mwd_core::protocol::{Payload, RawSample, StationSurvey};
+    let mut writer = CaptureWriter::new(Vec::new());
+    for n in 0..2000u32 {
+        let time_us = u64::from(n) * 50_000;
+        writer
+            .write(&Payload::Raw(RawSample {
+                time_us,
+                sample_counter: n,
+                ..RawSample::default()
+            }))
+            .unwrap();
+        if n % 600 == 599 {
+            writer
+                .write(&Payload::Station(StationSurvey {
+                    time_us,
+                    station: (n / 600 + 1) as u16,
+                    flags: station_flags::MAGNETIC_FREE,
+                    start_sample: n - 100,
+                    end_sample: n,
+                    angles: [1.5, 2.0, 0.3],
+                    angles_std: [0.001, 0.02, 0.002],
+                    correlations: [0.0; 3],
+                    still_quality: 1.0,
+                }))
+                .unwrap();
+        }
+    }
+    let capture = dir.join("stations.bin");
+    std::fs::write(&capture, writer.finish().unwrap()).unwrap();
+    let depth = dir.join("depth.csv");
+    std::fs::write(&depth, "time_s,md_m\n0,3000\n100,3030\n").unwrap();
+    (capture, depth)
+}
+
+#[test]
+fn with_a_depth_log_the_stations_get_positions_with_their_sigma() {
+    let dir = common::scratch("dashboard", "stations");
+    let (capture, depth) = capture_with_stations(&dir);
+    let d = start(&[
+        "--file",
+        capture.to_str().unwrap(),
+        "--speed",
+        "1000",
+        "--depth",
+        depth.to_str().unwrap(),
+    ]);
+    let (_, last) = follow(&d.addr, None, |u| u["rest"]["finished"] == true);
+    let stations = &last["rest"]["stations"];
+    let rows = stations["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3, "{stations}");
+    // Station 1 (29.95 s) is the tie-on: MD from the log, at the origin.
+    assert_eq!(rows[0]["md"], "3008.99 m");
+    assert_eq!(rows[2]["md"], "3026.99 m");
+    assert_eq!(rows[2]["azimuth"], "114.592 +- 1.146 deg (1 sigma)");
+    for row in rows {
+        let position = row["position"].as_str().unwrap();
+        assert!(
+            position.starts_with("N ") && position.matches(" +- ").count() == 3,
+            "{position}"
+        );
+    }
+    // Drilled along azimuth 2 rad at 86 deg inclination: north < 0, east > 0.
+    let plan = stations["plan"].as_array().unwrap();
+    assert_eq!(plan.len(), 3);
+    let (east, north) = (plan[2][0].as_f64().unwrap(), plan[2][1].as_f64().unwrap());
+    assert!(east > 0.0 && north < 0.0, "{east} {north}");
+    assert_eq!(stations["section"].as_array().unwrap().len(), 3);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn bad_inputs_are_refused_before_serving() {
+    let dir = common::scratch("dashboard", "bad");
+    let not_capture = dir.join("notes.bin");
+    std::fs::write(&not_capture, "time_s,md_m\n0,1\n").unwrap();
+    let run = common::run(&["dashboard", "--file", not_capture.to_str().unwrap()]);
+    assert_eq!(run.code, Some(1));
+    assert!(
+        run.stderr.contains("is not a probe capture"),
+        "{}",
+        run.stderr
+    );
+    let capture = simulated_capture(&dir);
+    let run = common::run(&[
+        "dashboard",
+        "--file",
+        capture.to_str().unwrap(),
+        "--speed",
+        "0",
+    ]);
+    assert_eq!(run.code, Some(2));
+    assert!(run.stderr.contains("above 0"), "{}", run.stderr);
+    let run = common::run(&[
+        "dashboard",
+        "--file",
+        capture.to_str().unwrap(),
+        "--depth",
+        not_capture.with_extension("missing").to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, Some(1));
+    assert!(run.stderr.contains("notes.missing"), "{}", run.stderr);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[cfg(target_os = "linux")]
+mod on_a_port {
+    use super::*;
+    use mwd_core::protocol::uplink::reply::encode_reply;
+    use mwd_core::protocol::uplink::{decode_command, Reply};
+    use mwd_core::protocol::{example, FrameEncoder, MAX_WIRE_LEN};
+    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
+    use std::fs::File;
+    use std::os::fd::AsFd;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    /// A stand-in probe on a pty: raw-sample frames every few ms, an ACK
+    /// to every command; returns every byte it sent.
+    fn stand_in(stop: Arc<AtomicBool>) -> (String, std::thread::JoinHandle<Vec<u8>>) {
+        let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY).unwrap();
+        grantpt(&master).unwrap();
+        unlockpt(&master).unwrap();
+        let port = ptsname(&master, Vec::new()).unwrap().into_string().unwrap();
+        let mut master = File::from(master);
+        let probe = std::thread::spawn(move || {
+            rustix::fs::fcntl_setfl(master.as_fd(), rustix::fs::OFlags::NONBLOCK).unwrap();
+            let mut downlink = FrameEncoder::new();
+            let (mut sent, mut chunk) = (Vec::new(), Vec::new());
+            let (mut buf, mut out) = ([0u8; 256], [0u8; MAX_WIRE_LEN]);
+            while !stop.load(Ordering::Relaxed) {
+                let n = downlink.encode(&example::raw_sample(), &mut out).unwrap();
+                // Until the dashboard opens the port, nobody reads: not sent.
+                if master.write_all(&out[..n]).is_ok() {
+                    sent.extend_from_slice(&out[..n]);
+                }
+                std::thread::sleep(Duration::from_millis(5));
+                let got = master.read(&mut buf).unwrap_or(0);
+                for b in &buf[..got] {
+                    if *b != 0 {
+                        chunk.push(*b);
+                        continue;
+                    }
+                    let command = cobs::decode_in_place(&mut chunk)
+                        .ok()
+                        .and_then(|len| decode_command(&chunk[..len]).ok());
+                    chunk.clear();
+                    if let Some(c) = command {
+                        let reply = Reply::ack(0, c.seq, c.command.kind() as u8, 3);
+                        let n = encode_reply(downlink.next_seq(), &reply, &mut out).unwrap();
+                        master.write_all(&out[..n]).unwrap();
+                        sent.extend_from_slice(&out[..n]);
+                    }
+                }
+            }
+            sent
+        });
+        (port, probe)
+    }
+
+    #[test]
+    fn commands_are_acknowledged_on_the_page_and_the_bytes_recorded() {
+        let dir = common::scratch("dashboard", "port");
+        let job = dir.join("job.json");
+        std::fs::write(
+            &job,
+            r#"{"format": "mwd-job", "version": 1,
+                "site": {"latitude_deg": 30.5, "longitude_deg": 114.25, "height_m": 23.0}}"#,
+        )
+        .unwrap();
+        let saved = dir.join("saved.bin");
+        let stop = Arc::new(AtomicBool::new(false));
+        let (port, probe) = stand_in(stop.clone());
+        let d = start(&[
+            "--port",
+            &port,
+            "--save",
+            saved.to_str().unwrap(),
+            "--job",
+            job.to_str().unwrap(),
+        ]);
+        // Not from the page (another site's form): refused, nothing sent.
+        let (status, _) = raw_request(&d.addr, "POST", "/api/align", "");
+        assert_eq!(status, 403);
+        let (status, _) = request(&d.addr, "POST", "/api/station");
+        assert_eq!(status, 202);
+        let (status, _) = request(&d.addr, "POST", "/api/configure");
+        assert_eq!(status, 202);
+        let all_answered = |u: &Value| {
+            u["rest"]["commands"].as_array().is_some_and(|c| {
+                c.len() == 6
+                    && c.iter()
+                        .all(|c| c["result"] != "sent, waiting for the reply")
+            })
+        };
+        let (_, update) = follow(&d.addr, None, all_answered);
+        let commands = update["rest"]["commands"].as_array().unwrap();
+        assert_eq!(commands.len(), 6, "{commands:?}");
+        assert_eq!(commands[0]["label"], "take a station");
+        for c in commands {
+            assert_eq!(c["result"], "ACK, configuration version 3", "{c}");
+        }
+        assert_eq!(update["rest"]["source"]["config_version"], 3);
+        assert_eq!(update["rest"]["source"]["controls_disabled"], Value::Null);
+        assert!(update["rest"]["link"]["raw"].as_u64().unwrap() > 0);
+
+        stop.store(true, Ordering::Relaxed);
+        let sent = probe.join().unwrap();
+        // The dashboard reads every 100 ms at most: give it time to record.
+        std::thread::sleep(Duration::from_millis(500));
+        drop(d);
+        let recorded = std::fs::read(&saved).unwrap();
+        // What was sent before the dashboard opened the port and set the
+        // pty to raw mode may be lost or mangled by the line discipline
+        // (the first few frames); from then on, every byte, in order.
+        let common = recorded
+            .iter()
+            .rev()
+            .zip(sent.iter().rev())
+            .take_while(|(a, b)| a == b)
+            .count();
+        assert!(
+            recorded.len() - common < 4 * MAX_WIRE_LEN && common * 2 > sent.len(),
+            "{common} bytes in common at the end of {} recorded, {} sent",
+            recorded.len(),
+            sent.len()
+        );
+        std::fs::remove_dir_all(dir).ok();
+    }
+}
