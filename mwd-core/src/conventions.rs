@@ -152,6 +152,17 @@ pub fn euler_error_jacobian(c_bn: &Matrix3<f64>) -> Matrix3<f64> {
     -Matrix3::new(ch / cp, sh / cp, 0.0, -sh, ch, 0.0, tp * ch, tp * sh, 1.0)
 }
 
+/// Inclination, azimuth, toolface (rad) and d(inc, azi, tf)/d(phi) at
+/// C_b^n `c_bn`: the rows of [`euler_error_jacobian`] for pitch, heading
+/// and roll (`probe::station` has the derivation and the tests).
+pub fn angles_and_jacobian(c_bn: &Matrix3<f64>) -> (DrillingAngles, Matrix3<f64>) {
+    let angles = DrillingAngles::from_euler(&euler_from_dcm(c_bn));
+    let euler = euler_error_jacobian(c_bn);
+    // Rows of `euler` are roll, pitch, heading.
+    let j = Matrix3::from_fn(|i, k| euler[([1, 2, 0][i], k)]);
+    (angles, j)
+}
+
 /// The unit quaternion of the rotation C_b^n.
 pub fn quat_from_dcm(c: &Matrix3<f64>) -> UnitQuaternion<f64> {
     // Shepperd's method: take the square root of the largest of the four

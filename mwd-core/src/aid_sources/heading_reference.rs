@@ -17,11 +17,11 @@
 //! the computed azimuth minus the reference, wrapped to (-pi, pi].
 
 use crate::attitude::NEAR_VERTICAL;
+use crate::conventions::angles_and_jacobian;
 use crate::conventions::{dcm_from_quat, wrap_pi};
 use crate::error_model::ATT;
 use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
 use crate::mechanization::NavState;
-use crate::probe::station::angles_and_jacobian;
 
 /// One reference azimuth against the filter's attitude: one scalar.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -15,19 +15,9 @@
 //! axis azimuth and toolface are undefined and their rows infinite.
 //! Checked against central differences in the tests.
 
-use crate::conventions::{euler_error_jacobian, euler_from_dcm, DrillingAngles};
+pub use crate::conventions::angles_and_jacobian;
 use crate::kalman::std_dev_of;
 use nalgebra::Matrix3;
-
-/// Inclination, azimuth, toolface (rad) and d(inc, azi, tf)/d(phi) at
-/// C_b^n `c_bn`.
-pub fn angles_and_jacobian(c_bn: &Matrix3<f64>) -> (DrillingAngles, Matrix3<f64>) {
-    let angles = DrillingAngles::from_euler(&euler_from_dcm(c_bn));
-    let euler = euler_error_jacobian(c_bn);
-    // Rows of `euler` are roll, pitch, heading.
-    let j = Matrix3::from_fn(|i, k| euler[([1, 2, 0][i], k)]);
-    (angles, j)
-}
 
 /// Sigmas and correlations of (inc, azi, tf) from their covariance.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,7 +43,9 @@ pub fn angle_uncertainty(jacobian: &Matrix3<f64>, attitude_cov: &Matrix3<f64>) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::conventions::{dcm_from_euler, skew, wrap_pi, Euler, DEG};
+    use crate::conventions::{
+        dcm_from_euler, euler_from_dcm, skew, wrap_pi, DrillingAngles, Euler, DEG,
+    };
     use nalgebra::Vector3;
 
     fn numeric_jacobian(c_bn: &Matrix3<f64>) -> Matrix3<f64> {
