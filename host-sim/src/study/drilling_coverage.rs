@@ -9,8 +9,6 @@ use super::drilling_run::{run, RunConfig, RunOutcome};
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 /// A fraction and its binomial standard error.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
@@ -91,26 +89,9 @@ pub fn study(
     progress: &(dyn Fn() + Sync),
 ) -> Summary {
     let started = std::time::Instant::now();
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(u64, Result<RunOutcome, String>)>> = Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..threads.max(1) {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= runs {
-                    break;
-                }
-                let seed = first_seed + k as u64;
-                let outcome = run(config, seed).map_err(|e| format!("seed {seed}: {e:#}"));
-                if let Ok(mut r) = results.lock() {
-                    r.push((seed, outcome));
-                }
-                progress();
-            });
-        }
+    let results = super::run_seeds(runs, first_seed, threads, progress, |seed| {
+        run(config, seed)
     });
-    let mut results = results.into_inner().unwrap_or_default();
-    results.sort_by_key(|r| r.0);
     let mut summary = summarise(&results);
     summary.wall_s = started.elapsed().as_secs_f64();
     summary

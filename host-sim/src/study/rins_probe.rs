@@ -32,8 +32,6 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 /// A gyro grade: the SCC1300's gyro errors divided by `factor`.
 #[derive(Clone, Copy, Debug, Serialize, PartialEq)]
@@ -354,26 +352,9 @@ pub fn study(
     progress: &(dyn Fn() + Sync),
 ) -> GradeSummary {
     let started = std::time::Instant::now();
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(u64, Result<PairOutcome, String>)>> = Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..threads.max(1) {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= runs {
-                    break;
-                }
-                let seed = first_seed + k as u64;
-                let outcome = run(config, seed).map_err(|e| format!("seed {seed}: {e:#}"));
-                if let Ok(mut r) = results.lock() {
-                    r.push((seed, outcome));
-                }
-                progress();
-            });
-        }
+    let results = super::run_seeds(runs, first_seed, threads, progress, |seed| {
+        run(config, seed)
     });
-    let mut results = results.into_inner().unwrap_or_default();
-    results.sort_by_key(|r| r.0);
     let outcomes: Vec<_> = results.into_iter().map(|r| r.1).collect();
     let mut summary = summarise(config.grade, config.reference_sigma, &outcomes);
     summary.wall_s = started.elapsed().as_secs_f64();
