@@ -210,6 +210,35 @@ impl StepNoise {
     }
 }
 
+/// How the bias states' random walk is added in the following steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BiasWalk {
+    /// The Gauss-Markov instability's one-step increment variance every
+    /// step (derivation section 3b): an alignment or a station, where the
+    /// biases are observed and the walk stays small against what the
+    /// updates learn.
+    EveryStep,
+    /// The same increments damped by exp(-dt/tau) per step since the last
+    /// [`EveryStep`](Self::EveryStep) step: over T unobserved they sum to
+    /// 2 sigma^2 (1 - exp(-T/tau)), the variance of the true instability's
+    /// change over T, never more than 2 sigma^2. A random walk over an hour
+    /// of drilling would add 72 sigma^2 (2 T / tau) for a change the
+    /// process cannot make. Conservative: the estimate's own error is
+    /// positively correlated with the instability it has absorbed, which
+    /// the change then partly undoes (derivation section 4g).
+    BoundedSinceObserved,
+}
+
+/// The accelerometer biases' estimate (m/s^2, body axes) and covariance
+/// at one step ([`FineAlignment::accel_bias`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccelBiasSnapshot {
+    pub estimate: Vector3<f64>,
+    pub covariance: Matrix3<f64>,
+    /// The random-walk variance added per axis up to then.
+    walk_added: [f64; 3],
+}
+
 /// What one fine-alignment step did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepReport {
@@ -240,6 +269,12 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     /// computed attitude (`ToolAxisSource::AtRest`), not a measurement:
     /// see [`hold_tool_axis`](Self::hold_tool_axis).
     held_tool_axis: bool,
+    bias_walk: BiasWalk,
+    /// Per bias state (accelerometers x, y, z then rates): the factor on
+    /// its random-walk variance this step (1 while
+    /// [`BiasWalk::EveryStep`]), and the variance added since the start.
+    bias_walk_factor: [f64; 6],
+    bias_walk_added: [f64; 6],
 }
 
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
@@ -256,6 +291,9 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             steps: 0,
             rejected_samples: 0,
             held_tool_axis: false,
+            bias_walk: BiasWalk::EveryStep,
+            bias_walk_factor: [1.0; 6],
+            bias_walk_added: [0.0; 6],
         };
         alignment.restart(initial, reference, config);
         alignment
@@ -300,6 +338,9 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.steps = 0;
         self.rejected_samples = 0;
         self.held_tool_axis = false;
+        self.bias_walk = BiasWalk::EveryStep;
+        self.bias_walk_factor = [1.0; 6];
+        self.bias_walk_added = [0.0; 6];
     }
 
     /// One sample: mechanization, time update, measurement updates,
@@ -352,6 +393,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
         let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
         let mut q = self.q;
+        self.scale_bias_walk(&mut q);
         if !extra.is_none() {
             for i in 0..3 {
                 q[ATT + i] += T::of(extra.attitude);
@@ -389,6 +431,32 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             zero_position,
             correction,
         }
+    }
+
+    /// Applies this step's bias-walk factors to `q` and moves them on
+    /// ([`BiasWalk`]); keeps the total added per bias.
+    fn scale_bias_walk(&mut self, q: &mut SVector<T, N>) {
+        if N != STATES_WITH_BIASES {
+            return;
+        }
+        let biases = &self.config.model.biases;
+        let states = biases.accel.iter().chain(biases.gyro.iter());
+        for (k, bias) in states.enumerate() {
+            let i = ACCEL_BIAS + k; // the rate biases follow the accelerometers'
+            let factor = match self.bias_walk {
+                BiasWalk::EveryStep => 1.0,
+                BiasWalk::BoundedSinceObserved => self.bias_walk_factor[k],
+            };
+            q[i] = T::of(bias.variance_per_step * factor);
+            self.bias_walk_added[k] += bias.variance_per_step * factor;
+            self.bias_walk_factor[k] = factor * bias.step_correlation;
+        }
+    }
+
+    /// How the bias random walk is added from the next step on
+    /// ([`BiasWalk`]); switching to `EveryStep` restarts the bound.
+    pub fn set_bias_walk(&mut self, walk: BiasWalk) {
+        self.bias_walk = walk;
     }
 
     /// The time update when the tool-axis rate is held: the rate fed to the
@@ -527,31 +595,35 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     }
 
     /// The accelerometer-bias estimate (m/s^2, body axes) and its
-    /// covariance; `None` in the 33-state form, which has no bias states.
-    pub fn accel_bias(&self) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+    /// covariance now, to put back later; `None` in the 33-state form,
+    /// which has no bias states.
+    pub fn accel_bias(&self) -> Option<AccelBiasSnapshot> {
         if N != STATES_WITH_BIASES {
             return None;
         }
         let x = &self.filter.x;
-        let estimate = Vector3::from_fn(|i, _| x[ACCEL_BIAS + i].as_f64());
-        let covariance =
-            Matrix3::from_fn(|i, j| self.filter.p[(ACCEL_BIAS + i, ACCEL_BIAS + j)].as_f64());
-        Some((estimate, covariance))
+        Some(AccelBiasSnapshot {
+            estimate: Vector3::from_fn(|i, _| x[ACCEL_BIAS + i].as_f64()),
+            covariance: Matrix3::from_fn(|i, j| {
+                self.filter.p[(ACCEL_BIAS + i, ACCEL_BIAS + j)].as_f64()
+            }),
+            walk_added: [
+                self.bias_walk_added[0],
+                self.bias_walk_added[1],
+                self.bias_walk_added[2],
+            ],
+        })
     }
 
     /// Puts back an accelerometer-bias estimate and covariance taken
-    /// [`steps`](Self::steps) ago ([`accel_bias`](Self::accel_bias)), grown
-    /// by the biases' random walk since, with no correlation to the other
-    /// states (which keeps P positive semi-definite: a principal block and
-    /// a PSD block). The probe's stations use it: what the filter learns of
-    /// the accelerometers while drilling is the bias plus the vibration's
-    /// rectified share, which is gone at rest (derivation section 4f).
-    pub fn restore_accel_bias(
-        &mut self,
-        estimate: &Vector3<f64>,
-        covariance: &Matrix3<f64>,
-        steps_ago: u32,
-    ) {
+    /// earlier ([`accel_bias`](Self::accel_bias)), grown by the random walk
+    /// the filter has added since ([`BiasWalk`]), with no correlation to
+    /// the other states (which keeps P positive semi-definite: a principal
+    /// block and a PSD block). The probe's stations use it: what the filter
+    /// learns of the accelerometers while drilling is the bias plus the
+    /// vibration's rectified share, which is gone at rest (derivation
+    /// section 4f).
+    pub fn restore_accel_bias(&mut self, snapshot: &AccelBiasSnapshot) {
         if N != STATES_WITH_BIASES {
             return;
         }
@@ -563,11 +635,11 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             }
         }
         for i in 0..3 {
-            self.filter.x[ACCEL_BIAS + i] = T::of(estimate[i]);
+            self.filter.x[ACCEL_BIAS + i] = T::of(snapshot.estimate[i]);
             for j in 0..3 {
-                p[(ACCEL_BIAS + i, ACCEL_BIAS + j)] = T::of(covariance[(i, j)]);
+                p[(ACCEL_BIAS + i, ACCEL_BIAS + j)] = T::of(snapshot.covariance[(i, j)]);
             }
-            let walk = self.q[ACCEL_BIAS + i].as_f64() * f64::from(steps_ago);
+            let walk = (self.bias_walk_added[i] - snapshot.walk_added[i]).max(0.0);
             p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] += T::of(walk);
         }
     }
@@ -731,6 +803,7 @@ pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::earth::earth_rate_n;
     use nalgebra::UnitQuaternion;
 
     /// A negative or NaN attitude variance gives NaN Euler sigmas, never
@@ -820,5 +893,62 @@ mod tests {
         };
         let q_along: f64 = (0..3).map(|a| axis[a] * axis[a] * q[ATT + a]).sum();
         assert!((along(&filter.p) - along(&p0) - q_along).abs() <= 1e-15);
+    }
+
+    /// Unobserved (navigating, no updates), a bias state's variance grows
+    /// by q per step as a random walk, and by the Gauss-Markov increment
+    /// 2 sigma^2 (1 - exp(-T/tau)) when bounded: after an hour that is
+    /// under 2 sigma^2, where the walk has added 2 sigma^2 T/tau = 72
+    /// sigma^2. Switching back to every-step restarts the bound.
+    #[test]
+    fn the_bounded_bias_walk_adds_the_instabilitys_increment() {
+        let site = Position::paper_site();
+        let noise = ImuNoise::scc1300();
+        let mut config = FineAlignmentConfig::<STATES_WITH_BIASES>::physical(
+            AugmentedModel::paper(),
+            &noise,
+            &[0.01, 0.01, 0.1],
+            site.lat,
+        );
+        config.zero_velocity_variance = None;
+        config.zero_position_variance = None;
+        let dt = config.model.dt;
+        let mut fa = FineAlignment::<f64, STATES_WITH_BIASES>::new(
+            NavState::at_rest(UnitQuaternion::identity(), site),
+            site,
+            config,
+        );
+        let g = -gravity_n(&site);
+        let at_rest = ImuSample {
+            rate: earth_rate_n(site.lat),
+            specific_force: g,
+        };
+        let bias_variance = |fa: &FineAlignment<f64, STATES_WITH_BIASES>| {
+            [fa.filter.p[(GYRO_BIAS, GYRO_BIAS)], fa.filter.p[(ACCEL_BIAS, ACCEL_BIAS)]]
+        };
+        let steps = 3600.0 / dt;
+        let (sigma_g, sigma_a) = (noise.gyro[0].bias_instability, noise.accel[0].bias_instability);
+        let tau = noise.gyro[0].correlation_time;
+        let bounded = |sigma: f64, t: f64| 2.0 * sigma * sigma * (1.0 - libm::exp(-t / tau));
+
+        let start = bias_variance(&fa);
+        fa.set_bias_walk(BiasWalk::BoundedSinceObserved);
+        for _ in 0..steps as usize {
+            fa.step(&at_rest);
+        }
+        let hour = bias_variance(&fa);
+        let added = [hour[0] - start[0], hour[1] - start[1]];
+        for (got, want) in added.iter().zip([bounded(sigma_g, 3600.0), bounded(sigma_a, 3600.0)]) {
+            assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}");
+        }
+        assert!(added[0] < 2.0 * sigma_g * sigma_g);
+
+        // Observed again: one step adds the full increment once more.
+        fa.set_bias_walk(BiasWalk::EveryStep);
+        fa.step(&at_rest);
+        let step = fa.config.model.biases.gyro[0].variance_per_step;
+        assert!((bias_variance(&fa)[0] - hour[0] - step).abs() < 1e-9 * step);
+        // The unbounded walk over the same hour: 2 sigma^2 T / tau.
+        assert!(steps * step > 30.0 * added[0]);
     }
 }

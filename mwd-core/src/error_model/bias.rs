@@ -15,6 +15,13 @@
 //! T by 2 sigma^2 (T/tau - (1 - exp(-T/tau))) - conservative, and small over
 //! an alignment of about a minute against tau = 100 s. Two states per axis
 //! (45 in all) would be exact and cost about 30 % more in the time update.
+//!
+//! Over hours (a drilling probe between stations) the random walk would
+//! grow without bound, while the Gauss-Markov increment never exceeds
+//! 2 sigma^2 in variance: `step_correlation` lets the filter add the walk
+//! as the geometric series q a^k, which sums to exactly that increment's
+//! variance 2 sigma^2 (1 - exp(-T/tau)) over T unobserved
+//! (`fine_alignment::BiasWalk`, derivation section 3b).
 
 use crate::sensor_noise::{AxisNoise, ImuNoise};
 
@@ -26,21 +33,27 @@ pub struct BiasState {
     pub initial_sigma: f64,
     /// Random-walk variance added per step (SI units squared).
     pub variance_per_step: f64,
+    /// exp(-dt/tau) of the Gauss-Markov instability: the ratio of one
+    /// step's increment variance to the previous one's when the walk is
+    /// bounded (`fine_alignment::BiasWalk::BoundedSinceObserved`).
+    pub step_correlation: f64,
 }
 
 impl BiasState {
     /// From one axis of the error budget at sample interval `dt`.
     pub fn from_axis(axis: &AxisNoise, dt: f64) -> Self {
         let gm = axis.bias_instability;
-        let step_increment = if axis.correlation_time > 0.0 {
-            // Var(b(t + dt) - b(t)) of a stationary first-order GM process.
-            2.0 * gm * gm * (1.0 - libm::exp(-dt / axis.correlation_time))
+        let step_correlation = if axis.correlation_time > 0.0 {
+            libm::exp(-dt / axis.correlation_time)
         } else {
-            0.0
+            1.0
         };
+        // Var(b(t + dt) - b(t)) of a stationary first-order GM process.
+        let step_increment = 2.0 * gm * gm * (1.0 - step_correlation);
         Self {
             initial_sigma: libm::sqrt(axis.residual_bias * axis.residual_bias + gm * gm),
             variance_per_step: step_increment,
+            step_correlation,
         }
     }
 }

@@ -54,7 +54,9 @@ use crate::conventions::{
 use crate::earth::earth_rate_n;
 use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
-use crate::fine_alignment::{FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior};
+use crate::fine_alignment::{
+    AccelBiasSnapshot, BiasWalk, FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior,
+};
 use crate::kalman::UpdateReport;
 use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
@@ -257,10 +259,10 @@ pub struct Navigator {
     /// The roll was held for drilling since the last still cycle.
     drilled_since_station: bool,
     /// The accelerometer-bias estimate and covariance at the last still
-    /// cycle of the last station, and the filter's step count then: put
-    /// back at the next station after drilling
+    /// cycle of the last station: put back at the next station after
+    /// drilling
     /// (`FineAlignment::restore_accel_bias`).
-    rest_accel_bias: Option<(Vector3<f64>, Matrix3<f64>, u32)>,
+    rest_accel_bias: Option<AccelBiasSnapshot>,
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
@@ -612,6 +614,15 @@ impl Navigator {
                     extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
                 }
                 filter.linearize_at_gravity(drilling || still);
+                // Between stations nothing observes the biases for hours:
+                // their walk is bounded by the instability's own variance
+                // (`BiasWalk`); at a station it is added every step again,
+                // as in the alignment the walk was tuned for.
+                filter.set_bias_walk(if update {
+                    BiasWalk::EveryStep
+                } else {
+                    BiasWalk::BoundedSinceObserved
+                });
                 let report = filter.step_with(&imu, &extra);
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
@@ -655,17 +666,14 @@ impl Navigator {
                     // (seen in the simulated lateral: 0.10-0.15 deg of
                     // toolface error, the same sign in every seed, against
                     // 0.035-deg sigmas).
-                    if let Some((estimate, covariance, at_step)) = self.rest_accel_bias {
-                        let ago = filter.steps().wrapping_sub(at_step);
-                        filter.restore_accel_bias(&estimate, &covariance, ago);
+                    if let Some(snapshot) = &self.rest_accel_bias {
+                        filter.restore_accel_bias(snapshot);
                     }
                     self.drilled_since_station = false;
                 }
                 self.drilled_since_station |= drilling;
                 if still && !self.drilled_since_station {
-                    self.rest_accel_bias = filter
-                        .accel_bias()
-                        .map(|(estimate, covariance)| (estimate, covariance, filter.steps()));
+                    self.rest_accel_bias = filter.accel_bias();
                 }
                 self.vertical_residual = (update && missing_gyro.is_none())
                     .then(|| vertical_residual(filter.state(), &sample));
