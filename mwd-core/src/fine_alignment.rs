@@ -10,7 +10,9 @@
 //! takes raw samples: the filter's dynamics carry the bias's effect).
 
 use crate::aid_sources::{ZeroPosition, ZeroVelocity};
-use crate::conventions::{dcm_from_quat, euler_error_jacobian, DEG};
+use crate::conventions::{
+    dcm_from_quat, euler_error_jacobian, euler_from_quat, quat_from_euler, DEG,
+};
 use crate::earth::{gravity_n, normal_gravity, LocalEarth, Position, EARTH_RATE};
 use crate::error_model::{
     is_model_size, newest_ar_state, AugmentedModel, AugmentedTransition, LinearizationPoint,
@@ -592,6 +594,19 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
         p[(ATT + 2, ATT + 2)] = T::of(variance);
         self.filter.x[ATT + 2] = T::zero();
+    }
+
+    /// Turns the solution about the tool axis so that its roll is `roll`
+    /// (rad), exactly (not a small-angle correction), keeping pitch and
+    /// heading: a toolface found far from the filter's while drilling
+    /// (`aid_sources::DrillingToolface`). The caller adds the new roll's
+    /// uncertainty ([`add_attitude_noise`](Self::add_attitude_noise)).
+    pub fn set_roll(&mut self, roll: f64) {
+        let mut state = *self.strapdown.state();
+        let mut euler = euler_from_quat(&state.attitude);
+        euler.roll = roll;
+        state.attitude = quat_from_euler(&euler);
+        self.strapdown.reset(state);
     }
 
     /// The accelerometer-bias estimate (m/s^2, body axes) and its

@@ -72,6 +72,9 @@ pub struct StationCoverage {
     /// Mean toolface error (deg): a bias the sigmas cannot cover.
     pub mean_toolface_error_deg: Option<f64>,
     pub median_toolface_sigma_deg: Option<f64>,
+    /// The same of the determined azimuths.
+    pub rms_azimuth_deg: Option<f64>,
+    pub median_azimuth_sigma_deg: Option<f64>,
 }
 
 fn rms(values: &[f64]) -> Option<f64> {
@@ -146,6 +149,8 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
                 slot.undetermined += 1;
             } else {
                 count(1, st.error[1], sd[1], &mut azi);
+                slot.azimuth
+                    .push((st.error[1].to_degrees(), sd[1].to_degrees()));
             }
         }
         match (&o.td, &o.td_note) {
@@ -189,25 +194,37 @@ struct StationTally {
     inside: [usize; 3],
     totals: [usize; 3],
     undetermined: usize,
-    /// (toolface error, its sigma), deg.
+    /// (error, its sigma), deg: toolface, determined azimuth.
     toolface: Vec<(f64, f64)>,
+    azimuth: Vec<(f64, f64)>,
+}
+
+/// The RMS of the errors and the median of the sigmas of (error, sigma)
+/// pairs.
+fn rms_and_median_sigma(pairs: &[(f64, f64)]) -> (Option<f64>, Option<f64>) {
+    let errors: Vec<f64> = pairs.iter().map(|(e, _)| *e).collect();
+    let mut sigmas: Vec<f64> = pairs.iter().map(|(_, s)| *s).collect();
+    sigmas.sort_by(f64::total_cmp);
+    (rms(&errors), sigmas.get(sigmas.len() / 2).copied())
 }
 
 impl StationTally {
     fn coverage(self, station: u16) -> StationCoverage {
-        let errors: Vec<f64> = self.toolface.iter().map(|(e, _)| *e).collect();
-        let mut sigmas: Vec<f64> = self.toolface.iter().map(|(_, s)| *s).collect();
-        sigmas.sort_by(f64::total_cmp);
-        let mean = (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64);
+        let n = self.toolface.len();
+        let mean = (n > 0).then(|| self.toolface.iter().map(|(e, _)| e).sum::<f64>() / n as f64);
+        let (rms_toolface_deg, median_toolface_sigma_deg) = rms_and_median_sigma(&self.toolface);
+        let (rms_azimuth_deg, median_azimuth_sigma_deg) = rms_and_median_sigma(&self.azimuth);
         StationCoverage {
             station,
             inclination_within_2_sigma: Fraction::of(self.inside[0], self.totals[0]),
             azimuth_within_2_sigma: Fraction::of(self.inside[1], self.totals[1]),
             toolface_within_2_sigma: Fraction::of(self.inside[2], self.totals[2]),
             azimuth_undetermined: self.undetermined,
-            rms_toolface_deg: rms(&errors),
+            rms_toolface_deg,
             mean_toolface_error_deg: mean,
-            median_toolface_sigma_deg: sigmas.get(sigmas.len() / 2).copied(),
+            median_toolface_sigma_deg,
+            rms_azimuth_deg,
+            median_azimuth_sigma_deg,
         }
     }
 }
@@ -275,7 +292,7 @@ pub fn table(s: &Summary) -> String {
         rows.push(("failed", e.clone()));
     }
     let mut out: String = rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")).collect();
-    out.push_str("\nby station: within 2 sigma (inclination, azimuth where determined, toolface); toolface error mean and RMS against its median sigma\n");
+    out.push_str("\nby station: within 2 sigma (inclination, azimuth where determined, toolface); azimuth error RMS against its median sigma; toolface error mean and RMS against its median sigma\n");
     for c in &s.by_station {
         let short = |f: &Fraction| {
             f.fraction
@@ -283,11 +300,13 @@ pub fn table(s: &Summary) -> String {
         };
         let deg = |v: Option<f64>| v.map_or_else(|| "-".into(), |v| format!("{v:.3}"));
         out.push_str(&format!(
-            "  station {:>3}: inc {} %  azi {} % ({} undetermined)  tf {} %  tf error mean {} RMS {} sigma {} deg\n",
+            "  station {:>3}: inc {} %  azi {} % ({} undetermined, RMS {} sigma {})  tf {} %  tf error mean {} RMS {} sigma {} deg\n",
             c.station,
             short(&c.inclination_within_2_sigma),
             short(&c.azimuth_within_2_sigma),
             c.azimuth_undetermined,
+            deg(c.rms_azimuth_deg),
+            deg(c.median_azimuth_sigma_deg),
             short(&c.toolface_within_2_sigma),
             deg(c.mean_toolface_error_deg),
             deg(c.rms_toolface_deg),

@@ -13,6 +13,7 @@
 //! drilling) is not in the paper: derivation section 4b.
 
 mod axial_speed;
+mod drilling_toolface;
 mod heading_reference;
 mod non_holonomic;
 mod vertical_earth_rate;
@@ -20,6 +21,7 @@ mod zero_position;
 mod zero_velocity;
 
 pub use axial_speed::{AxialSpeed, AXIAL_SPEED_VARIANCE};
+pub use drilling_toolface::{DrillingToolface, ForceBlock, TOOLFACE_BLOCK_SAMPLES};
 pub use heading_reference::{HeadingReference, HeadingReferenceError};
 pub use non_holonomic::{BhaCrossMotion, NonHolonomic, CROSS_AXES, DRILLING_VARIANCE};
 pub use vertical_earth_rate::VerticalEarthRate;

@@ -43,7 +43,8 @@ use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::StillDetector;
 use super::tie_in::{TieIn, TieInTilt};
 use crate::aid_sources::{
-    AxialSpeed, NonHolonomic, VerticalEarthRate, AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE,
+    AxialSpeed, DrillingToolface, ForceBlock, NonHolonomic, VerticalEarthRate,
+    AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
 };
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
@@ -263,6 +264,9 @@ pub struct Navigator {
     /// drilling
     /// (`FineAlignment::restore_accel_bias`).
     rest_accel_bias: Option<AccelBiasSnapshot>,
+    /// The drilling samples' force since the last toolface update
+    /// (`aid_sources::DrillingToolface`).
+    toolface_block: ForceBlock,
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
@@ -298,6 +302,7 @@ impl Navigator {
             vertical_residual: None,
             drilled_since_station: false,
             rest_accel_bias: None,
+            toolface_block: ForceBlock::default(),
             time_us: 0,
             sample_counter: 0,
         }
@@ -646,6 +651,15 @@ impl Navigator {
                     filter.aid(&cross);
                     filter.aid(&axial);
                 }
+                if drilling && report.sample_used && !self.covariance_invalid {
+                    self.toolface_block.add(&sample.specific_force);
+                    if self.toolface_block.samples() >= TOOLFACE_BLOCK_SAMPLES {
+                        aid_drilling_toolface(filter, &self.toolface_block);
+                        self.toolface_block.clear();
+                    }
+                } else {
+                    self.toolface_block.clear();
+                }
                 if still && self.drilled_since_station {
                     // The first still cycle after drilling: the roll was
                     // held through it, so the orienter's steps were not
@@ -761,6 +775,7 @@ impl Navigator {
         self.coasting = false;
         self.drilled_since_station = false;
         self.rest_accel_bias = None;
+        self.toolface_block.clear();
         self.phase = Phase::Fine { samples: 0 };
     }
 
@@ -899,6 +914,7 @@ impl Navigator {
         self.coarse_single_part = false;
         self.drilled_since_station = false;
         self.rest_accel_bias = None;
+        self.toolface_block.clear();
     }
 
     /// [`start_from_tie_in`](Self::start_from_tie_in) before the probe
@@ -922,6 +938,7 @@ impl Navigator {
         self.coarse_single_part = false;
         self.drilled_since_station = false;
         self.rest_accel_bias = None;
+        self.toolface_block.clear();
         self.phase = Phase::Navigating;
     }
 
@@ -985,6 +1002,34 @@ fn drilling_attitude_noise(state: &NavState) -> Matrix3<f64> {
     let vibration = square(DRILLING_ANGULAR_SIGMA_RAD_S * SAMPLE_INTERVAL_S);
     (Matrix3::identity() - tt) * vibration
         + tt * (DRILLING_TOOLFACE_VARIANCE_PER_S * SAMPLE_INTERVAL_S)
+}
+
+/// A drilling toolface innovation beyond this many sigma (squared) is not
+/// a small-angle error: the driller turned the toolface on bottom, and the
+/// roll is set to the block's instead of updated towards it.
+const GROSS_TOOLFACE_CHI2: f64 = 16.0;
+
+/// The toolface of one block of drilling samples against the held roll
+/// (`aid_sources::DrillingToolface`, derivation section 4g): an update, or
+/// when the roll is grossly off (a toolface turned on bottom) the block's
+/// roll with its variance about the tool axis.
+fn aid_drilling_toolface(filter: &mut Filter, block: &ForceBlock) {
+    let budget = ImuNoise::scc1300().accel[0];
+    let bias_variance = square(budget.residual_bias) + square(budget.bias_instability);
+    let Some(m) = DrillingToolface::<f32>::at(filter.state(), block, bias_variance) else {
+        return;
+    };
+    let h = Vector3::from(m.attitude_row.map(f64::from));
+    let variance = f64::from(m.variance);
+    let innovation_variance = h.dot(&(filter.attitude_error_covariance() * h)) + variance;
+    if square(f64::from(m.toolface_residual)) > GROSS_TOOLFACE_CHI2 * innovation_variance {
+        filter.set_roll(m.block_toolface);
+        let c_bn = dcm_from_quat(&filter.state().attitude);
+        let t: Vector3<f64> = c_bn.column(1).into_owned();
+        filter.add_attitude_noise(&(t * t.transpose() * variance));
+    } else {
+        filter.aid(&m);
+    }
 }
 
 /// One still cycle's vertical-earth-rate residual m = d_x (g_x - w_x) +
