@@ -84,7 +84,10 @@ fn a_configuration_write_cut_part_way_leaves_the_previous_configuration() {
 
     // Past the plan: whole writes again, kept across the reboot command.
     stored += 1;
-    acked(&link.send(&Uplink::SetSite(site(POWER_CUT_PLAN.len()))), stored);
+    acked(
+        &link.send(&Uplink::SetSite(site(POWER_CUT_PLAN.len()))),
+        stored,
+    );
     acked(&link.send(&Uplink::Reboot), stored);
     let software = boot_event_value(ResetCause::Software, ConfigSource::Flash, stored);
     assert_eq!(link.boot_value(), software);
