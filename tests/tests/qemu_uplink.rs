@@ -21,9 +21,8 @@
 //! falls behind the wall clock when the host is busy, and more so under a
 //! byte stream (QEMU's CMSDK UART takes one byte per main-loop turn), so
 //! the wall-clock rate is printed and only checked to be far from zero (a
-//! wedged probe sends nothing). The pty is
-//! raw: QEMU makes it so when it creates it (`qemu_openpty_raw`); a
-//! cooked line would show as corrupt frames, which are asserted absent.
+//! wedged probe sends nothing). The pty is raw (`qemu_link`); a cooked
+//! line would show as corrupt frames, which are asserted absent.
 //!
 //! qemu-system-arm must be installed: without it this test fails, it does
 //! not skip. Linux only (ptys of /dev/pts), like the CI that runs it.
@@ -145,6 +144,7 @@ fn the_qemu_probe_is_configured_keeps_it_across_reboots_and_survives_random_upli
     let status = qemu.wait();
     let qemu_out = qemu.out.clone();
     assert!(status.success(), "probe-qemu failed: {qemu_out}");
+    // The reader thread reports the corrupt frames once QEMU closed the pty.
     let link_corrupt = link.corrupt;
 
     let frames = raws.len();
