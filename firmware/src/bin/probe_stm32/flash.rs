@@ -54,7 +54,7 @@ const IWDG_RELOAD: u32 = 0xAAAA;
 const ERASE_FEED_ROUNDS: u32 = 4 * 96_000_000 / 4;
 
 /// A failed operation: the checks of embedded-storage, or the flash's
-/// error flags (SR bits, `Other`).
+/// error flags (`status`: SR, or CR when it stayed locked; kind `Other`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FlashError {
     kind: NorFlashErrorKind,
@@ -83,21 +83,32 @@ impl SectorFlash {
         Self { flash }
     }
 
-    fn unlock(&mut self) {
+    /// Unlocks CR and clears the error flags; fails if CR stays locked
+    /// (a wrong key sequence locks it until the next reset).
+    fn unlock(&mut self) -> Result<(), FlashError> {
+        while self.flash.sr().read().bsy().bit_is_set() {}
         if self.flash.cr().read().lock().bit_is_set() {
             // SAFETY: KEYR is write-only and takes any value; the two keys
-            // in order unlock CR (a wrong one locks it until reset).
+            // in order unlock CR.
             self.flash.keyr().write(|w| unsafe { w.key().bits(KEY1) });
             self.flash.keyr().write(|w| unsafe { w.key().bits(KEY2) });
         }
         // SAFETY: writing 1s clears exactly the error flags.
         self.flash.sr().write(|w| unsafe { w.bits(SR_ERRORS) });
+        if self.flash.cr().read().lock().bit_is_set() {
+            return Err(FlashError {
+                kind: NorFlashErrorKind::Other,
+                status: self.flash.cr().read().bits(),
+            });
+        }
+        Ok(())
     }
 
     /// Locks CR, resets the data cache, and reports the error flags.
     fn finish(&mut self) -> Result<(), FlashError> {
         while self.flash.sr().read().bsy().bit_is_set() {}
         let status = self.flash.sr().read().bits();
+        // From CR's reset value: PG and SER cleared, LOCK set.
         self.flash.cr().write(|w| w.lock().set_bit());
         // The data cache may hold words read before the operation: reset it
         // (only while disabled, RM0383 3.4.2).
@@ -172,13 +183,16 @@ impl NorFlash for SectorFlash {
     fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
         check_erase(self, from, to)?;
         for sector in (from as usize / SECTOR_LEN)..(to as usize / SECTOR_LEN) {
-            self.unlock();
+            self.unlock()?;
             // At most 2 sectors (checked above): 6 or 7.
             let snb = FIRST_SECTOR + sector as u8;
+            // `modify`, not `write`: a write starts from CR's reset value,
+            // whose LOCK bit would lock the flash again.
             // SAFETY: SNB takes a sector number (6 and 7 exist on the F411).
-            self.flash
-                .cr()
-                .write(|w| unsafe { w.psize().psize32().ser().set_bit().snb().bits(snb) });
+            self.flash.cr().modify(|_, w| unsafe {
+                w.pg().clear_bit().mer().clear_bit();
+                w.psize().psize32().ser().set_bit().snb().bits(snb)
+            });
             let cr_start = self.flash.cr().read().bits() | CR_STRT;
             let iwdg_kr = pac::IWDG::ptr();
             cortex_m::interrupt::free(|_| {
@@ -200,10 +214,12 @@ impl NorFlash for SectorFlash {
 
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
         check_write(self, offset, bytes.len())?;
-        self.unlock();
-        self.flash
-            .cr()
-            .write(|w| w.psize().psize32().pg().set_bit());
+        self.unlock()?;
+        // `modify`: see `erase`.
+        self.flash.cr().modify(|_, w| {
+            w.ser().clear_bit().mer().clear_bit();
+            w.psize().psize32().pg().set_bit()
+        });
         let mut address = (CONFIG_FLASH_START + offset) as *mut u32;
         for word in bytes.chunks_exact(4) {
             let value = u32::from_le_bytes([word[0], word[1], word[2], word[3]]);
