@@ -21,30 +21,24 @@
 //! falls behind the wall clock when the host is busy, and more so under a
 //! byte stream (QEMU's CMSDK UART takes one byte per main-loop turn), so
 //! the wall-clock rate is printed and only checked to be far from zero (a
-//! wedged probe sends nothing). The pty is
-//! raw: QEMU makes it so when it creates it (`qemu_openpty_raw`); a
-//! cooked line would show as corrupt frames, which are asserted absent.
+//! wedged probe sends nothing). The pty is raw (`qemu_link`); a cooked
+//! line would show as corrupt frames, which are asserted absent.
 //!
 //! qemu-system-arm must be installed: without it this test fails, it does
 //! not skip. Linux only (ptys of /dev/pts), like the CI that runs it.
 #![cfg(target_os = "linux")]
 
-use std::fs::File;
-use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Command, Stdio};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+mod qemu_link;
+
 use std::time::{Duration, Instant};
 
 use firmware::app::boot::{boot_event_value, ConfigSource, ResetCause};
 use mwd_core::earth::Position;
-use mwd_core::protocol::uplink::reply::decode_reply_body;
-use mwd_core::protocol::uplink::{
-    encode_command, Command as Uplink, Reply, ReplyStatus, MAX_COMMAND_WIRE_LEN,
-};
-use mwd_core::protocol::{Decoder, EventKind, Payload};
+use mwd_core::protocol::uplink::{encode_command, Command as Uplink, MAX_COMMAND_WIRE_LEN};
+use qemu_link::{acked, Link, QemuOnPty, Seen, BOOT_TIMEOUT};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use system_tests::{build_firmware_for, require_qemu, summary_value, wait_or_kill};
+use system_tests::{build_firmware_for, require_qemu, summary_value};
 
 /// Simulated seconds each boot streams before the probe ends its run; the
 /// last boot's run holds the fuzzing and the check after it.
@@ -54,135 +48,6 @@ const FUZZ: Duration = Duration::from_secs(30);
 const RATE_HZ: f64 = 20.0;
 /// The line's pace, 115200 baud 8N1: the host sends no faster.
 const LINE_BYTES_PER_S: f64 = 11_520.0;
-/// Only a hang reaches these.
-const REPLY_TIMEOUT: Duration = Duration::from_secs(3);
-const BOOT_TIMEOUT: Duration = Duration::from_secs(30);
-const QEMU_TIMEOUT: Duration = Duration::from_secs(300);
-
-/// What the downlink brought, as the reader thread saw it.
-enum Seen {
-    Boot(u32),
-    Raw { counter: u32, at: Instant },
-    Nav { at: Instant },
-    Reply(Reply),
-    Other,
-}
-
-/// Reads and decodes the pty until it closes.
-fn read_downlink(mut pty: File, to: mpsc::Sender<Seen>, corrupt: mpsc::Sender<u64>) {
-    std::thread::spawn(move || {
-        let mut decoder = Decoder::new();
-        let mut buf = [0u8; 512];
-        while let Ok(n) = pty.read(&mut buf) {
-            if n == 0 {
-                break;
-            }
-            for &b in &buf[..n] {
-                let seen = match decoder.push(b).map(|f| f.payload) {
-                    Some(Payload::Event(e)) if e.kind == EventKind::Boot => Seen::Boot(e.value),
-                    Some(Payload::Raw(r)) => Seen::Raw {
-                        counter: r.sample_counter,
-                        at: Instant::now(),
-                    },
-                    Some(Payload::Nav(_)) => Seen::Nav { at: Instant::now() },
-                    Some(_) => Seen::Other,
-                    None => match decoder.unknown_body().map(decode_reply_body) {
-                        Some(Ok((_, reply))) => Seen::Reply(reply),
-                        _ => continue,
-                    },
-                };
-                if to.send(seen).is_err() {
-                    return;
-                }
-            }
-        }
-        let _ = corrupt.send(decoder.stats().corrupt());
-    });
-}
-
-/// The test's end of the serial line.
-struct Link {
-    pty: File,
-    seen: Receiver<Seen>,
-    /// Raw frames (sample counter, arrival) and navigation frames
-    /// (arrival) seen so far.
-    raws: Vec<(u32, Instant)>,
-    navs: Vec<Instant>,
-    next_seq: u16,
-    /// Bytes written since the last `take_written`.
-    written: u64,
-}
-
-impl Link {
-    /// Waits for what `wanted` picks, noting raw frames meanwhile.
-    fn wait_for<T>(
-        &mut self,
-        timeout: Duration,
-        mut wanted: impl FnMut(&Seen) -> Option<T>,
-    ) -> Option<T> {
-        let deadline = Instant::now() + timeout;
-        loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            match self.seen.recv_timeout(left) {
-                Ok(seen) => {
-                    match seen {
-                        Seen::Raw { counter, at } => self.raws.push((counter, at)),
-                        Seen::Nav { at } => self.navs.push(at),
-                        _ => {}
-                    }
-                    if let Some(found) = wanted(&seen) {
-                        return Some(found);
-                    }
-                }
-                Err(RecvTimeoutError::Timeout) => return None,
-                Err(RecvTimeoutError::Disconnected) => panic!("the pty closed"),
-            }
-        }
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        self.pty
-            .write_all(bytes)
-            .and_then(|()| self.pty.flush())
-            .expect("write to the pty");
-        self.written += bytes.len() as u64;
-    }
-
-    /// Sends `command` until it is answered (3 attempts).
-    fn send(&mut self, command: &Uplink) -> Reply {
-        let seq = self.next_seq;
-        self.next_seq += 1;
-        let mut wire = [0u8; MAX_COMMAND_WIRE_LEN];
-        let n = encode_command(seq, command, &mut wire).expect("encode a command");
-        for _ in 0..3 {
-            self.write(&wire[..n]);
-            let reply = self.wait_for(REPLY_TIMEOUT, |s| match s {
-                Seen::Reply(r) if r.command_seq == seq => Some(*r),
-                _ => None,
-            });
-            if let Some(reply) = reply {
-                return reply;
-            }
-        }
-        panic!("no reply to {command:?}")
-    }
-
-    fn boot_value(&mut self) -> u32 {
-        self.wait_for(BOOT_TIMEOUT, |s| match s {
-            Seen::Boot(value) => Some(*value),
-            _ => None,
-        })
-        .expect("a boot event")
-    }
-}
-
-fn acked(reply: &Reply, version: u32) {
-    assert_eq!(
-        (reply.status, reply.config_version),
-        (ReplyStatus::Ack, version),
-        "{reply:?}"
-    );
-}
 
 /// A random uplink string: noise, noise with delimiters, a good command
 /// with a flipped bit (its CRC fails), or an oversized run.
@@ -216,68 +81,9 @@ fn random_string(rng: &mut ChaCha8Rng, seq: u16) -> Vec<u8> {
 fn the_qemu_probe_is_configured_keeps_it_across_reboots_and_survives_random_uplink_bytes() {
     require_qemu();
     let elf = build_firmware_for("board-qemu", "uplink", Some(RUN_SECONDS));
-    let mut qemu = Command::new("qemu-system-arm")
-        .args(["-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-S"])
-        .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-serial", "pty", "-icount", "shift=0,sleep=on", "-kernel"])
-        .arg(&elf)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start qemu-system-arm");
-    let (out_tx, qemu_lines) = mpsc::channel::<String>();
-    for stream in [
-        Box::new(qemu.stdout.take().expect("piped")) as Box<dyn Read + Send>,
-        Box::new(qemu.stderr.take().expect("piped")),
-    ] {
-        let out_tx = out_tx.clone();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stream).lines().map_while(Result::ok) {
-                let _ = out_tx.send(line);
-            }
-        });
-    }
-    drop(out_tx);
-    let mut qemu_out = String::new();
-    let pty_path = loop {
-        let line = qemu_lines
-            .recv_timeout(BOOT_TIMEOUT)
-            .unwrap_or_else(|e| panic!("no pty from QEMU ({e}): {qemu_out}"));
-        qemu_out += &line;
-        qemu_out.push('\n');
-        if let Some(path) = line.split_whitespace().find(|w| w.starts_with("/dev/pts/")) {
-            break path.to_string();
-        }
-    };
-    let pty = File::options()
-        .read(true)
-        .write(true)
-        .open(&pty_path)
-        .expect("open QEMU's pty");
-    let (seen_tx, seen) = mpsc::channel();
-    let (corrupt_tx, corrupt) = mpsc::channel();
-    read_downlink(
-        pty.try_clone().expect("a second handle"),
-        seen_tx,
-        corrupt_tx,
-    );
-    let mut link = Link {
-        pty,
-        seen,
-        raws: Vec::new(),
-        navs: Vec::new(),
-        next_seq: 1,
-        written: 0,
-    };
-    let mut monitor = qemu.stdin.take().expect("piped");
-    let mut tell_monitor = |command: &str| {
-        monitor
-            .write_all(command.as_bytes())
-            .and_then(|()| monitor.flush())
-            .expect("QEMU's monitor takes commands");
-    };
-    tell_monitor("cont\n");
+    let mut qemu = QemuOnPty::start(&elf, None);
+    let mut link = Link::open(&qemu.pty_path);
+    qemu.monitor("cont");
 
     // 1-2: the defaults, then a site set and read back.
     let defaults = boot_event_value(ResetCause::PowerOn, ConfigSource::Defaults, 0);
@@ -293,7 +99,7 @@ fn the_qemu_probe_is_configured_keeps_it_across_reboots_and_survives_random_upli
     let software = boot_event_value(ResetCause::Software, ConfigSource::Flash, 1);
     assert_eq!(link.boot_value(), software);
     acked(&link.send(&Uplink::ReportConfig), 1);
-    tell_monitor("system_reset\n");
+    qemu.monitor("system_reset");
     let pin = boot_event_value(ResetCause::Pin, ConfigSource::Flash, 1);
     assert_eq!(link.boot_value(), pin);
     // The first raw frame of this boot: streaming has started.
@@ -335,13 +141,11 @@ fn the_qemu_probe_is_configured_keeps_it_across_reboots_and_survives_random_upli
         .collect();
     let navs = link.navs.iter().filter(|at| during(at)).count();
 
-    let status = wait_or_kill(&mut qemu, "QEMU", QEMU_TIMEOUT);
-    while let Ok(line) = qemu_lines.recv_timeout(Duration::from_secs(5)) {
-        qemu_out += &line;
-        qemu_out.push('\n');
-    }
+    let status = qemu.wait();
+    let qemu_out = qemu.out.clone();
     assert!(status.success(), "probe-qemu failed: {qemu_out}");
-    drop(link);
+    // The reader thread reports the corrupt frames once QEMU closed the pty.
+    let link_corrupt = link.corrupt;
 
     let frames = raws.len();
     let counters: Vec<u32> = raws.iter().map(|(c, _)| *c).collect();
@@ -372,7 +176,7 @@ fn the_qemu_probe_is_configured_keeps_it_across_reboots_and_survives_random_upli
         frames as f64 >= 0.25 * fuzz_wall * RATE_HZ,
         "{frames} raw frames in {fuzz_wall:.1} s"
     );
-    if let Ok(corrupt) = corrupt.recv_timeout(Duration::from_secs(5)) {
+    if let Ok(corrupt) = link_corrupt.recv_timeout(Duration::from_secs(5)) {
         assert_eq!(corrupt, 0, "corrupt downlink frames");
     }
 

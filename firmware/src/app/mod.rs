@@ -5,7 +5,8 @@
 //! watchdog's worst unfed stretch from the driver's waits, [`watchdog`]
 //! the watchdog's timeout from them; [`config_store`] keeps the
 //! configuration in two flash slots ([`ram_flash`]: a flash emulated in
-//! RAM for QEMU), [`uplink_rx`] receives the host's commands and
+//! RAM for QEMU; [`power_cut`]: a write cut on purpose, for QEMU's
+//! power-cut test), [`uplink_rx`] receives the host's commands and
 //! [`uplink_service`] answers them from the main loop; [`boot`] packs the
 //! boot event's reset cause and configuration source.
 //! Pure code (no registers, no heap), so the host tests it and every board
@@ -17,6 +18,7 @@ pub mod budget;
 pub mod config_store;
 pub mod cycle;
 pub mod frame_queue;
+pub mod power_cut;
 pub mod probe;
 pub mod ram_flash;
 pub mod sample_inbox;

@@ -61,6 +61,24 @@ use mwd_core::timing::{SAMPLE_PERIOD_US, SAMPLE_RATE_HZ};
 use mock_sensors::{MockBus, TickDelay, TICKS};
 use registers::SYSTEM_CLOCK_HZ;
 
+/// The configuration's flash: RAM kept across resets, whose writes the
+/// power-cut test (feature `power-cut-test`) cuts short on purpose
+/// (`firmware::app::power_cut`).
+#[cfg(not(feature = "power-cut-test"))]
+type ConfigFlash = RamNorFlash<'static>;
+#[cfg(feature = "power-cut-test")]
+type ConfigFlash =
+    firmware::app::power_cut::PowerCutFlash<RamNorFlash<'static>, persistent::PowerCut>;
+
+#[cfg(not(feature = "power-cut-test"))]
+fn config_flash(memory: &'static mut [u8]) -> ConfigFlash {
+    RamNorFlash::new(memory)
+}
+#[cfg(feature = "power-cut-test")]
+fn config_flash(memory: &'static mut [u8]) -> ConfigFlash {
+    firmware::app::power_cut::PowerCutFlash::new(RamNorFlash::new(memory), persistent::PowerCut)
+}
+
 /// Simulated seconds of streaming before the probe exits.
 const RUN_SECONDS: u32 = parse_seconds(option_env!("PROBE_QEMU_RUN_SECONDS"), 60);
 #[cfg_attr(feature = "qemu-drilling", allow(dead_code))]
@@ -214,7 +232,7 @@ fn main() -> ! {
     let Some(flash_memory) = persistent::config_flash() else {
         exit::fail("configuration flash taken twice")
     };
-    let mut uplink = UplinkService::load(RamNorFlash::new(flash_memory), 0);
+    let mut uplink = UplinkService::load(config_flash(flash_memory), 0);
     let Some(inbox) = cortex_m::singleton!(: UplinkInbox = UplinkInbox::new()) else {
         exit::fail("uplink inbox taken twice")
     };
@@ -349,7 +367,7 @@ struct Summary {
     replies_dropped: u32,
 }
 
-fn summary(cost: &CycleCost, uplink: &UplinkService<RamNorFlash>) -> Summary {
+fn summary(cost: &CycleCost, uplink: &UplinkService<ConfigFlash>) -> Summary {
     let mean_ticks = (cost.total / u64::from(cost.cycles.max(1))) as u32;
     PROBE.with(|s| Summary {
         samples: s.probe().cycle().samples(),

@@ -12,7 +12,11 @@
 //!   set at each boot, so finding it means something else reset the chip
 //!   while it ran: the reset pin (QEMU's monitor `system_reset`). The
 //!   watchdog's reset never happens here (its first timeout ends the QEMU
-//!   run, `exit.rs`).
+//!   run, `exit.rs`). The power-cut test's cut (`PowerCut`) clears the
+//!   mark, so its reset reads as the power-on it stands for;
+//! - under the feature `power-cut-test`, the number of configuration
+//!   writes of the run, which `firmware::app::power_cut::POWER_CUT_PLAN`
+//!   is indexed by.
 #![allow(unsafe_code)]
 
 use core::mem::MaybeUninit;
@@ -77,4 +81,47 @@ pub fn take_reset_cause() -> ResetCause {
 pub fn mark_software_reset() {
     // SAFETY: as in `take_reset_cause`.
     unsafe { mark().write_volatile(MARK_SOFTWARE) };
+}
+
+/// The next boot is to report a power-on (the power-cut test's cut).
+#[cfg(feature = "power-cut-test")]
+fn mark_power_on() {
+    // SAFETY: as in `take_reset_cause`.
+    unsafe { mark().write_volatile(0) };
+}
+
+/// The configuration writes of the run, in the low 16 bits under a tag
+/// (RAM that no write of this count left reads as none).
+#[cfg(feature = "power-cut-test")]
+#[link_section = ".uninit.probe_power_cut_writes"]
+static mut WRITES: MaybeUninit<u32> = MaybeUninit::uninit();
+
+#[cfg(feature = "power-cut-test")]
+const WRITES_TAG: u32 = 0x4D57_0000; // "MW", count
+
+/// The QEMU board's power as the power-cut test cuts it.
+#[cfg(feature = "power-cut-test")]
+pub struct PowerCut;
+
+#[cfg(feature = "power-cut-test")]
+impl firmware::app::power_cut::PowerSupply for PowerCut {
+    fn next_write(&mut self) -> usize {
+        let cell = core::ptr::addr_of_mut!(WRITES).cast::<u32>();
+        // SAFETY: an aligned word of RAM only this module touches, from
+        // the main thread (the uplink service's flash writes).
+        let found = unsafe { cell.read_volatile() };
+        let count = if found & 0xFFFF_0000 == WRITES_TAG {
+            found & 0xFFFF
+        } else {
+            0
+        };
+        // SAFETY: as above.
+        unsafe { cell.write_volatile(WRITES_TAG | (count + 1).min(0xFFFF)) };
+        count as usize
+    }
+
+    fn cut(&mut self) -> ! {
+        mark_power_on();
+        crate::registers::system_reset()
+    }
 }

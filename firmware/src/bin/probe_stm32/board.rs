@@ -11,11 +11,12 @@
 //! | part 1 gyro CS      | PB1  | active low                             |
 //! | part 1 accel CS     | PB10 | active low (PB2 is BOOT1: not used)    |
 //! | USART1 TX           | PA9  | frames to the surface, 115200 8N1      |
-//! | USART1 RX           | PA10 | reserved (the probe does not listen)   |
+//! | USART1 RX           | PA10 | the host's commands (uplink), 115200   |
 //! | SWDIO / SWCLK       | PA13 / PA14 | probe-rs: flashing, RTT logs    |
 //!
 //! Timers: TIM2 at 20 Hz is the acquisition; SysTick is the blocking delay
 //! of start-up and recovery; the independent watchdog runs from the LSI.
+//! Flash sectors 6-7 hold the configuration (`flash.rs`).
 
 use core::cell::RefCell;
 
@@ -28,7 +29,7 @@ use stm32f4xx_hal::gpio::{ErasedPin, Output, PushPull};
 use stm32f4xx_hal::pac::{self, SPI1, TIM2, USART1};
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::rcc::Clocks;
-use stm32f4xx_hal::serial::{config::Config, Serial, Tx};
+use stm32f4xx_hal::serial::{config::Config, Rx, Serial, Tx};
 use stm32f4xx_hal::spi::{Mode, Phase, Polarity, Spi};
 use stm32f4xx_hal::timer::{CounterHz, SysDelay};
 use stm32f4xx_hal::watchdog::IndependentWatchdog;
@@ -44,12 +45,16 @@ pub type Cs = ErasedPin<Output<PushPull>>;
 pub type Device = CriticalSectionDevice<'static, Bus, Cs, NoDelay>;
 pub type Sensors = firmware::app::Sensors<Device, Device>;
 pub type Uart = Tx<USART1>;
+pub type UartRx = Rx<USART1>;
 pub type Timer = CounterHz<TIM2>;
 
 /// What the application needs from the board.
 pub struct Board {
     pub sensors: Sensors,
     pub uart: Uart,
+    pub uart_rx: UartRx,
+    /// The flash's registers (the configuration's sectors).
+    pub flash: pac::FLASH,
     pub timer: Timer,
     pub delay: SysDelay,
     pub watchdog: IndependentWatchdog,
@@ -104,18 +109,21 @@ pub fn init(dp: pac::Peripherals, syst: cortex_m::peripheral::SYST) -> Result<Bo
         ),
     ];
 
-    let uart = Serial::tx(
+    let (uart, uart_rx) = Serial::new(
         dp.USART1,
-        gpioa.pa9,
+        (gpioa.pa9, gpioa.pa10),
         Config::default().baudrate(BAUD.bps()),
         &clocks,
     )
-    .map_err(|_| "USART1 configuration")?;
+    .map_err(|_| "USART1 configuration")?
+    .split();
     let timer = dp.TIM2.counter_hz(&clocks);
     let delay = syst.delay(&clocks);
     Ok(Board {
         sensors,
         uart,
+        uart_rx,
+        flash: dp.FLASH,
         timer,
         delay,
         watchdog,

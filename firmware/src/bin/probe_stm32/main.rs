@@ -6,46 +6,65 @@
 //! Contexts, highest priority first:
 //! - TIM2 at 20 Hz: takes the sample (its instant is the timer's, not the
 //!   main loop's) and queues the raw frame and any fault events;
-//! - USART1 (TX empty): moves the next queued byte into the transmitter;
+//! - USART1: each received byte into the uplink's bounded inbox
+//!   (`firmware::app::uplink_rx`), nothing more; on TX empty, the next
+//!   queued byte into the transmitter;
 //! - main loop: start-up, blocking sensor recovery, the navigation on each
-//!   raw sample (navigation frames); feeds the watchdog between those steps
-//!   (`firmware::app::budget`); sleeps otherwise.
+//!   raw sample (navigation frames), then the host's commands
+//!   (`firmware::app::uplink_service`: a bounded number of bytes per
+//!   sample period, each command answered on the downlink); feeds the
+//!   watchdog between those steps (`firmware::app::budget`); sleeps
+//!   otherwise.
+//!
+//! The configuration lives in flash sectors 6-7 (`flash.rs`); the boot
+//! event says the reset cause (RCC_CSR) and whether the configuration came
+//! from flash or is the defaults.
 //!
 //! Nothing hangs the board: the watchdog starts first thing
 //! (`board::init`), and a panic or fault resets the chip at once (the
 //! `HardFault` handler below), after panic-probe has logged it.
 //!
 //! What the contexts share and do is `firmware::app::SharedProbe`, as on
-//! the QEMU board; this file adds USART1 as its `Transmitter`, TIM2, the
-//! NVIC and the watchdog.
+//! the QEMU board (`probe_qemu/main.rs`, whose main loop this one
+//! follows); this file adds USART1 as its `Transmitter` and receiver, TIM2,
+//! the NVIC, the flash and the watchdog.
 #![no_std]
 #![no_main]
 
 mod board;
+mod flash;
 
 use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use critical_section::Mutex;
 use defmt_rtt as _;
-use firmware::app::boot::{boot_event_value, ConfigSource, ResetCause};
+use firmware::app::boot::{boot_event_value, ResetCause};
+use firmware::app::uplink_rx::{InboxWriter, UplinkInbox, UPLINK_QUEUE_LEN};
+use firmware::app::uplink_service::{BoardAction, UplinkService};
 use firmware::app::{FrameQueue, SharedProbe, Transmitter, FIRMWARE_VERSION, TX_QUEUE_LEN};
-use mwd_core::earth::Position;
+use mwd_core::config::ProbeConfig;
 use mwd_core::probe::Navigator;
 use mwd_core::timing::SAMPLE_RATE_HZ;
 use panic_probe as _;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, NVIC};
 use stm32f4xx_hal::prelude::*;
-use stm32f4xx_hal::serial::TxListen;
+use stm32f4xx_hal::serial::{RxISR, RxListen, TxISR, TxListen};
 use stm32f4xx_hal::timer::{Event as TimerEvent, Flag};
 
-use board::{Device, Timer, Uart};
+use board::{Device, Timer, Uart, UartRx};
+use flash::SectorFlash;
 
 /// The acquisition timer's rate: one interrupt per sample.
 const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// NVIC priorities (upper 4 bits on the F411; lower number = more urgent).
 const PRIORITY_ACQUISITION: u8 = 0x10;
 const PRIORITY_UART: u8 = 0x20;
+/// Uplink bytes the main loop takes per sample period: the inbox's
+/// capacity, more than the 576 B a period brings at 115200 baud (as on
+/// the QEMU board).
+const UPLINK_BYTES_PER_PASS: usize = UPLINK_QUEUE_LEN;
 
 /// USART1's transmitter, driven by its TX-empty interrupt.
 struct Usart1 {
@@ -66,6 +85,11 @@ impl Transmitter for Usart1 {
         let Some(uart) = self.uart.as_mut() else {
             return;
         };
+        // The interrupt is shared with the receiver: only an empty
+        // transmit register takes a byte (none is lost to a full one).
+        if !uart.is_tx_empty() {
+            return;
+        }
         match queue.pop() {
             // TXE is set (that is why we are here), so the write succeeds.
             Some(byte) => {
@@ -80,6 +104,12 @@ impl Transmitter for Usart1 {
 static PROBE: SharedProbe<Device, Device, Usart1> = SharedProbe::new(Usart1 { uart: None });
 /// The acquisition timer, whose interrupt flag its interrupt clears.
 static TIMER: Mutex<RefCell<Option<Timer>>> = Mutex::new(RefCell::new(None));
+/// Sample periods begun (TIM2 interrupts), for one main-loop pass each.
+static TICKS: AtomicU32 = AtomicU32::new(0);
+/// USART1's receiver and the interrupt's end of the uplink inbox (set once
+/// in `main`).
+static UPLINK_RX: Mutex<RefCell<Option<(UartRx, InboxWriter<'static>)>>> =
+    Mutex::new(RefCell::new(None));
 
 /// Every panic ends here (panic-probe logs it, then executes `udf`, which
 /// escalates to a hard fault), as does any real fault: reset the chip
@@ -100,12 +130,39 @@ fn TIM2() {
             timer.clear_flags(Flag::Update);
         }
     });
+    TICKS.fetch_add(1, Ordering::Relaxed);
     PROBE.with(|shared| shared.acquire());
 }
 
+/// USART1: received bytes into the inbox (a full inbox drops and counts
+/// them; a byte with a framing, noise or overrun error is discarded, which
+/// the uplink's CRC then catches), then the transmitter.
 #[interrupt]
 fn USART1() {
+    critical_section::with(|cs| {
+        if let Some((rx, writer)) = UPLINK_RX.borrow_ref_mut(cs).as_mut() {
+            while rx.is_rx_not_empty() {
+                if let Ok(byte) = rx.read() {
+                    writer.push(byte);
+                }
+            }
+        }
+    });
     PROBE.with(|shared| shared.transmitter_ready());
+}
+
+/// The navigator the configuration asks for (site and calibration; its
+/// tie-in is applied once the navigator levels, in the main loop).
+fn navigator_for(config: &ProbeConfig) -> Navigator {
+    Navigator::with_calibration(config.site, config.calibration)
+}
+
+/// Starts the navigation over from `config`; not inlined, so the new
+/// navigator is built in this call's frame, not in `main`'s (as on the
+/// QEMU board, docs/budgets.md).
+#[inline(never)]
+fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
+    *navigator = navigator_for(config);
 }
 
 #[entry]
@@ -121,6 +178,8 @@ fn main() -> ! {
     let board::Board {
         sensors,
         uart,
+        mut uart_rx,
+        flash,
         mut timer,
         mut delay,
         mut watchdog,
@@ -131,6 +190,13 @@ fn main() -> ! {
     }
     timer.listen(TimerEvent::Update);
     PROBE.with(|shared| shared.transmitter_mut().uart = Some(uart));
+    let mut uplink = UplinkService::load(SectorFlash::new(flash), 0);
+    let Some(inbox) = cortex_m::singleton!(: UplinkInbox = UplinkInbox::new()) else {
+        defmt::panic!("uplink inbox taken twice");
+    };
+    let (writer, mut uplink_reader) = inbox.split();
+    uart_rx.listen();
+    critical_section::with(|cs| *UPLINK_RX.borrow_ref_mut(cs) = Some((uart_rx, writer)));
     critical_section::with(|cs| *TIMER.borrow_ref_mut(cs) = Some(timer));
     // SAFETY: register writes of the NVIC, done once before the handlers
     // share anything; both handlers only touch state behind critical
@@ -143,17 +209,39 @@ fn main() -> ! {
         NVIC::unmask(Interrupt::USART1);
     }
 
-    // No configuration on this board yet: its source is not reported.
-    PROBE.announce_boot_with(boot_event_value(reset_cause, ConfigSource::NotReported, 0));
+    PROBE.announce_boot_with(boot_event_value(
+        reset_cause,
+        uplink.source(),
+        uplink.config().version,
+    ));
+    defmt::info!(
+        "configuration version {=u32} ({=str})",
+        uplink.config().version,
+        match uplink.source() {
+            firmware::app::boot::ConfigSource::Flash => "flash",
+            _ => "defaults",
+        }
+    );
     // The watchdog runs since `board::init`; the start-up feeds it after
     // each attempt.
     watchdog.feed();
     PROBE.start_streaming(sensors, &mut delay, &mut || watchdog.feed());
     defmt::info!("streaming at {=u32} Hz", SAMPLES_PER_SECOND);
 
-    // The probe's site: the MGWD paper's test site until it is configurable.
-    let mut navigator = Navigator::new(Position::paper_site());
+    // The configured site and calibration (the defaults: the MGWD paper's
+    // test site, uncorrected sensors).
+    let mut navigator = navigator_for(uplink.config());
+    let mut tie_in_pending = uplink.config().tie_in;
+    let mut last_pass_tick = None;
     loop {
+        // One pass per sample period: each received byte wakes the loop,
+        // its bytes wait in the inbox for the period's pass.
+        let tick = TICKS.load(Ordering::Relaxed);
+        if last_pass_tick == Some(tick) {
+            cortex_m::asm::wfi();
+            continue;
+        }
+        last_pass_tick = Some(tick);
         PROBE.main_loop_pass(
             &mut delay,
             &mut navigator,
@@ -161,6 +249,32 @@ fn main() -> ! {
             |part, code| defmt::warn!("part {=u8} recovered, code {=u16}", part, code),
             |_| {},
         );
+        // A tie-in replaces the probe's own levelling as soon as it has
+        // one (`Navigator::start_from_tie_in`).
+        if let Some(tie_in) = tie_in_pending.filter(|_| navigator.is_navigating()) {
+            navigator.start_from_tie_in(&tie_in);
+            tie_in_pending = None;
+        }
+        watchdog.feed();
+        match uplink.serve(&PROBE, &mut uplink_reader, UPLINK_BYTES_PER_PASS) {
+            Some(BoardAction::Realign) => {
+                realign(&mut navigator, uplink.config());
+                tie_in_pending = uplink.config().tie_in;
+                defmt::info!("re-aligning");
+            }
+            Some(BoardAction::Reboot) => {
+                defmt::info!("rebooting");
+                // Once the ACK (and all queued before it) has left.
+                while !PROBE.with(|s| s.probe().queue().is_empty()) {
+                    watchdog.feed();
+                    cortex_m::asm::wfi();
+                }
+                // The last byte's 87 us on the line at 115200 baud.
+                delay.delay_ms(1);
+                cortex_m::peripheral::SCB::sys_reset()
+            }
+            None => {}
+        }
         cortex_m::asm::wfi();
     }
 }
