@@ -10,6 +10,7 @@ pub mod filters;
 pub mod plot;
 pub mod rotation;
 mod run;
+pub mod strapdown_check;
 pub mod system;
 
 pub use run::{run, Record, Results, Summary};

@@ -102,7 +102,7 @@ pub struct Results {
 
 /// The vehicle's body-to-ENU rotation for a level vehicle on `course`
 /// (x right, y forward, z up, as `mwd_core::conventions`' body frame).
-fn vehicle(course: f64) -> Matrix3<f64> {
+pub(super) fn vehicle(course: f64) -> Matrix3<f64> {
     let (s, c) = course.sin_cos();
     Matrix3::new(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0)
 }
