@@ -24,6 +24,8 @@ use std::process::{Command, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
+use hil_mock::StillProbe;
+use mwd_core::conventions::{wrap_pi, DrillingAngles};
 use mwd_core::protocol::frame::{nav_mode, station_flags};
 use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::{
@@ -227,11 +229,20 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
     });
     assert_ne!(dwell.flags & station_flags::INDEXING_DWELL, 0, "{dwell:?}");
     assert_eq!(dwell.station, 1, "{dwell:?}");
-    let toolface_sigma = dwell.angles_std[2];
-    assert!(
-        toolface_sigma.is_finite() && toolface_sigma > 0.0 && toolface_sigma < 1f32.to_radians(),
-        "{dwell:?}"
-    );
+    // The simulated parts' attitude: inclination and toolface within
+    // their 3 sigma (the azimuth is still the coarse alignment's).
+    let truth = DrillingAngles::from_euler(&StillProbe::paper_test(1).attitude);
+    let errors = [
+        f64::from(dwell.angles[0]) - truth.inclination,
+        wrap_pi(f64::from(dwell.angles[2]) - truth.toolface),
+    ];
+    let sigmas = [dwell.angles_std[0], dwell.angles_std[2]].map(f64::from);
+    for (error, sigma) in errors.iter().zip(sigmas) {
+        assert!(
+            sigma > 0.0 && error.abs() < 3.0 * sigma,
+            "error {error} rad, sigma {sigma}: {dwell:?}"
+        );
+    }
 
     // 4: a station on request: the same still period's frame, right after
     // the ACK.
@@ -262,11 +273,13 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
     assert!(status.success(), "probe-qemu failed: {qemu_out}");
     println!(
         "qemu commands: surveying from sample {counter}; dwell station {} samples {}..{}, \
-         toolface {:.3} +- {:.3} deg",
+         inclination error {:.3} deg (sigma {:.3}), toolface error {:.3} deg (sigma {:.3})",
         dwell.station,
         dwell.start_sample,
         dwell.end_sample,
-        dwell.angles[2].to_degrees(),
-        toolface_sigma.to_degrees()
+        errors[0].to_degrees(),
+        sigmas[0].to_degrees(),
+        errors[1].to_degrees(),
+        sigmas[1].to_degrees()
     );
 }

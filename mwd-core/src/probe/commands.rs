@@ -176,7 +176,10 @@ impl Navigator {
     /// After each navigation cycle's station tracking: keeps the one-frame
     /// rule and reports indexing dwells.
     pub(super) fn follow_commands(&mut self, still: bool) {
-        if let Some(finished) = self.finished_station {
+        // A frame the station tracking finished (never one of ours, which
+        // carry these bits).
+        let ours = station_flags::REQUESTED | station_flags::INDEXING_DWELL;
+        if let Some(finished) = self.finished_station.filter(|f| f.flags & ours == 0) {
             match self.commands.sent {
                 // Already sent by request or as a dwell.
                 Some(sent) if sent.station == finished.station => self.finished_station = None,
@@ -197,6 +200,11 @@ impl Navigator {
             return;
         };
         if indexing.judged || station.epochs < indexing.dwell_epochs() {
+            return;
+        }
+        if self.commands.sent.is_some() {
+            // Sent on request before the dwell time: not a dwell.
+            indexing.judged = true;
             return;
         }
         indexing.judged = true;

@@ -273,3 +273,45 @@ fn indexing_needs_navigation_and_a_new_procedure_restarts_the_count() {
         n += 1;
     }
 }
+
+/// One frame per still period also when a request comes before the dwell
+/// time of a running procedure, and a dwell not taken at once is kept.
+#[test]
+fn a_request_before_the_dwell_time_is_the_still_periods_only_frame() {
+    let mut navigator = aligned();
+    let procedure = IndexingProcedure {
+        positions: 2,
+        dwell_s: 10,
+    };
+    assert_eq!(navigator.index_toolface(procedure), Ok(()));
+    let mut n = ALL_ALIGNMENT + 1;
+    for _ in 0..100 {
+        navigator.step(&still(n));
+        n += 1;
+    }
+    let requested = navigator.take_station_now().expect("still for 5 s");
+    for _ in 0..300 {
+        navigator.step(&still(n));
+        assert!(navigator.take_station().is_none(), "sample {n}");
+        n += 1;
+    }
+    assert_eq!(navigator.indexing().map(|i| i.reported), Some(0));
+    // The next still period, after a turn about the vertical: its dwell,
+    // kept until taken even across further steps.
+    for _ in 0..20 {
+        navigator.step(&sample(n, 0.0, 3.0));
+        n += 1;
+    }
+    assert_eq!(
+        navigator.take_station().map(|s| s.station),
+        None,
+        "the requested station's natural end is not sent"
+    );
+    for _ in 0..400 {
+        navigator.step(&still(n));
+        n += 1;
+    }
+    let dwell = navigator.take_station().expect("the dwell, kept");
+    assert_eq!(dwell.station, requested.station + 1);
+    assert_ne!(dwell.flags & station_flags::INDEXING_DWELL, 0);
+}
