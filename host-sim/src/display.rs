@@ -77,6 +77,8 @@ pub fn station_text(s: &StationSurvey) -> String {
         (station_flags::MAX_DURATION, "longest station reached"),
         (station_flags::NEAR_VERTICAL, "near vertical"),
         (station_flags::SOLUTION_INVALID, "INVALID"),
+        (station_flags::REQUESTED, "requested"),
+        (station_flags::INDEXING_DWELL, "indexing dwell"),
     ];
     let flags: Vec<&str> = names
         .iter()
@@ -129,6 +131,8 @@ pub fn reply_text(reply: &Reply) -> String {
             format!("out of range ({field})")
         }
         ReplyStatus::Nak(NakReason::Busy) => "busy (not while surveying)".into(),
+        ReplyStatus::Nak(NakReason::NotReady) => "not ready (still aligning)".into(),
+        ReplyStatus::Nak(NakReason::NotStill) => "not still (no station in progress)".into(),
         ReplyStatus::Nak(NakReason::StorageFailed) => {
             "the probe could not store it (previous configuration kept)".into()
         }

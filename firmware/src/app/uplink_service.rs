@@ -3,6 +3,13 @@
 //! answers each command on the downlink (an ACK or a NAK, kind 5) and
 //! keeps the configuration in the board's flash ([`super::config_store`]).
 //!
+//! The survey commands (start surveying, take a station, toolface
+//! indexing) are carried out on the navigator here, between navigation
+//! steps, and answered by what it did: an ACK when they took effect, a NAK
+//! with the navigator's reason (not ready, not still) when not
+//! (`mwd_core::probe::navigator::commands`). A station taken on request
+//! follows its ACK on the downlink.
+//!
 //! Acquisition is never delayed by it: it runs in the main loop, takes at
 //! most a given number of bytes per call, and queues a reply only when the
 //! transmit queue has the room a navigation step needs
@@ -11,7 +18,10 @@
 
 use embedded_storage::nor_flash::NorFlash;
 use mwd_core::config::ProbeConfig;
+use mwd_core::probe::navigator::commands::Refusal;
+use mwd_core::probe::Navigator;
 use mwd_core::protocol::uplink::{NakReason, ReplyStatus};
+use mwd_core::protocol::{Payload, StationSurvey};
 use mwd_core::timing::sample_time_us;
 
 use super::boot::ConfigSource;
@@ -87,12 +97,14 @@ impl<F: NorFlash> UplinkService<F> {
     }
 
     /// Takes at most `max_bytes` from the inbox, answering each command
-    /// they complete; returns the first action a board must carry out (the
-    /// rest of the bytes wait for the next call).
+    /// they complete (the survey commands carried out on `navigator`);
+    /// returns the first action a board must carry out (the rest of the
+    /// bytes wait for the next call).
     #[inline(never)]
     pub fn serve<G, A, T: Transmitter>(
         &mut self,
         probe: &SharedProbe<G, A, T>,
+        navigator: &mut Navigator,
         inbox: &mut InboxReader,
         max_bytes: usize,
     ) -> Option<BoardAction> {
@@ -125,26 +137,54 @@ impl<F: NorFlash> UplinkService<F> {
             let Some(mut outcome) = outcome else {
                 continue;
             };
+            let mut station = None;
+            let done = match outcome.action {
+                Some(Action::StartSurveying) => navigator.start_surveying(),
+                Some(Action::TakeStation) => navigator.take_station_now().map(|s| {
+                    station = Some(s);
+                }),
+                Some(Action::IndexToolface(p)) => navigator.index_toolface(p),
+                _ => Ok(()),
+            };
+            if let Err(refusal) = done {
+                outcome.reply.status = ReplyStatus::Nak(nak_reason(refusal));
+            }
             let action = match outcome.action {
                 Some(Action::Realign) => Some(BoardAction::Realign),
                 Some(Action::Reboot) => Some(BoardAction::Reboot),
-                Some(Action::ReportConfig) | None => None,
-                // Drilling mode, stations on demand and the indexing
-                // procedure need the navigator's support (issue 15 item
-                // 1), not there yet: refused, never acknowledged and
-                // ignored.
-                Some(Action::StartSurveying | Action::TakeStation | Action::IndexToolface(_)) => {
-                    outcome.reply.status = ReplyStatus::Nak(NakReason::UnknownCommand);
-                    None
-                }
+                _ => None,
             };
-            if !probe.with(|s| s.push_reply(&outcome.reply)) {
-                self.replies_dropped = self.replies_dropped.saturating_add(1);
-            }
+            self.send(probe, &outcome.reply, station);
             if action.is_some() {
                 return action;
             }
         }
+    }
+}
+
+impl<F> UplinkService<F> {
+    /// Queues a reply and the station it answered with, if any (the queue
+    /// had the room of a navigation step, which holds both).
+    fn send<G, A, T: Transmitter>(
+        &mut self,
+        probe: &SharedProbe<G, A, T>,
+        reply: &mwd_core::protocol::uplink::Reply,
+        station: Option<StationSurvey>,
+    ) {
+        if !probe.with(|s| s.push_reply(reply)) {
+            self.replies_dropped = self.replies_dropped.saturating_add(1);
+        }
+        if let Some(station) = station {
+            probe.push(&Payload::Station(station));
+        }
+    }
+}
+
+/// The NAK reason of the navigator's refusal.
+fn nak_reason(refusal: Refusal) -> NakReason {
+    match refusal {
+        Refusal::NotReady => NakReason::NotReady,
+        Refusal::NotStill => NakReason::NotStill,
     }
 }
 
@@ -156,9 +196,13 @@ mod tests {
     use crate::app::uplink_rx::UplinkInbox;
     use crate::app::FrameQueue;
     use mwd_core::earth::Position;
+    use mwd_core::protocol::frame::{raw_flags, station_flags};
     use mwd_core::protocol::uplink::reply::decode_reply_body;
-    use mwd_core::protocol::uplink::{encode_command, Command, Reply, MAX_COMMAND_WIRE_LEN};
-    use mwd_core::protocol::Decoder;
+    use mwd_core::protocol::uplink::{
+        encode_command, Command, IndexingProcedure, Reply, MAX_COMMAND_WIRE_LEN,
+    };
+    use mwd_core::protocol::{Decoder, RawPart, RawSample};
+    use mwd_core::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
     use std::vec::Vec;
 
     /// A UART that sends at once everything queued.
@@ -177,16 +221,54 @@ mod tests {
     }
 
     fn replies(probe: &SharedProbe<(), (), Wire>) -> Vec<Reply> {
+        downlink(probe)
+            .into_iter()
+            .filter_map(|f| match f {
+                Sent::Reply(r) => Some(r),
+                Sent::Station(_) => None,
+            })
+            .collect()
+    }
+
+    /// What the probe sent: replies and station frames, in order.
+    #[derive(Debug)]
+    enum Sent {
+        Reply(Reply),
+        Station(StationSurvey),
+    }
+
+    fn downlink(probe: &SharedProbe<(), (), Wire>) -> Vec<Sent> {
         let wire = probe.with(|s| core::mem::take(&mut s.transmitter_mut().0));
         let mut decoder = Decoder::new();
         let mut out = Vec::new();
         for b in wire {
-            decoder.push(b);
+            if let Some(Payload::Station(s)) = decoder.push(b).map(|f| f.payload) {
+                out.push(Sent::Station(s));
+            }
             if let Some(Ok((_, reply))) = decoder.unknown_body().map(decode_reply_body) {
-                out.push(reply);
+                out.push(Sent::Reply(reply));
             }
         }
         out
+    }
+
+    fn navigator() -> Navigator {
+        Navigator::new(Position::paper_site())
+    }
+
+    /// A still, level probe's sample `n` (no earth rate).
+    fn still(n: u32) -> RawSample {
+        let force = [0.0, 0.0, STANDARD_GRAVITY_M_S2];
+        let parts = PART_MOUNTINGS.map(|mounting| RawPart {
+            accel: mounting.body_to_sensor(force).map(m_s2_to_accel_count),
+            flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
+            ..RawPart::default()
+        });
+        RawSample {
+            time_us: u64::from(n) * 50_000,
+            sample_counter: n,
+            parts,
+        }
     }
 
     fn command(seq: u16, command: &Command) -> Vec<u8> {
@@ -212,14 +294,15 @@ mod tests {
         bytes.extend(command(10, &Command::Reboot));
         bytes.iter().for_each(|b| writer.push(*b));
         assert_eq!(
-            service.serve(&probe, &mut reader, 1024),
+            service.serve(&probe, &mut navigator(), &mut reader, 1024),
             Some(BoardAction::Reboot)
         );
         let got: Vec<(u16, ReplyStatus, u32)> = replies(&probe)
             .iter()
             .map(|r| (r.command_seq, r.status, r.config_version))
             .collect();
-        let nak = ReplyStatus::Nak(NakReason::UnknownCommand);
+        // A station before the probe has even levelled itself.
+        let nak = ReplyStatus::Nak(NakReason::NotReady);
         assert_eq!(
             got,
             [
@@ -245,7 +328,71 @@ mod tests {
         let probe = SharedProbe::<(), (), Wire>::new(Wire::default());
         let mut service = UplinkService::load(RamNorFlash::new(&mut memory), 0);
         (0..300).for_each(|i| writer.push(i as u8 | 1));
-        assert_eq!(service.serve(&probe, &mut reader, 100), None);
+        assert_eq!(
+            service.serve(&probe, &mut navigator(), &mut reader, 100),
+            None
+        );
         assert_eq!((service.stats().bytes, reader.pending()), (100, 200));
+    }
+
+    /// The survey commands through the service: refused with the
+    /// navigator's reason, acknowledged when they took effect, and a
+    /// requested station right after its ACK.
+    #[test]
+    fn survey_commands_are_answered_by_what_the_navigator_did() {
+        let mut memory = [0u8; 2 * RAM_FLASH_ERASE_SIZE];
+        let mut inbox = UplinkInbox::new();
+        let (mut writer, mut reader) = inbox.split();
+        let probe = SharedProbe::<(), (), Wire>::new(Wire::default());
+        let mut service = UplinkService::load(RamNorFlash::new(&mut memory), 0);
+        let mut navigator = navigator();
+        let mut send = |seq, c: &Command, navigator: &mut Navigator| {
+            command(seq, c).iter().for_each(|b| writer.push(*b));
+            assert_eq!(service.serve(&probe, navigator, &mut reader, 1024), None);
+            downlink(&probe)
+        };
+        let status = |sent: &[Sent]| match sent {
+            [Sent::Reply(r)] => r.status,
+            other => panic!("{other:?}"),
+        };
+        let nak = |reason| ReplyStatus::Nak(reason);
+        let indexing = Command::IndexToolface(IndexingProcedure {
+            positions: 4,
+            dwell_s: 10,
+        });
+        for (seq, c) in [(1, Command::StartSurveying), (2, indexing)] {
+            let sent = send(seq, &c, &mut navigator);
+            assert_eq!(status(&sent), nak(NakReason::NotReady));
+        }
+        // Into the fine alignment, long enough to end it.
+        let mut n = 0;
+        while !navigator.is_aligned() || n < 200 {
+            navigator.step(&still(n));
+            n += 1;
+        }
+        let sent = send(3, &Command::StartSurveying, &mut navigator);
+        assert_eq!(status(&sent), ReplyStatus::Ack);
+        assert!(navigator.is_navigating());
+        // Navigating, but the still detector has not seen a second yet.
+        navigator.step(&still(n));
+        n += 1;
+        let sent = send(4, &Command::TakeStation, &mut navigator);
+        assert_eq!(status(&sent), nak(NakReason::NotStill));
+        for _ in 0..100 {
+            navigator.step(&still(n));
+            n += 1;
+        }
+        let sent = send(5, &Command::TakeStation, &mut navigator);
+        match sent.as_slice() {
+            [Sent::Reply(r), Sent::Station(s)] => {
+                assert_eq!((r.command_seq, r.status), (5, ReplyStatus::Ack));
+                assert_eq!(s.station, 1);
+                assert_ne!(s.flags & station_flags::REQUESTED, 0, "{s:?}");
+            }
+            other => panic!("{other:?}"),
+        }
+        let sent = send(6, &indexing, &mut navigator);
+        assert_eq!(status(&sent), ReplyStatus::Ack);
+        assert!(navigator.indexing().is_some());
     }
 }

@@ -1,4 +1,4 @@
-//! `host-sim probe configure | status | align | station | index | reboot`: commands
+//! `host-sim probe configure | status | align | survey | station | index | reboot`: commands
 //! to a live probe over its serial port (`docs/protocol.md`, "Uplink").
 //! Each command is sent and its reply awaited among the probe's telemetry
 //! (`Decoder::unknown_body`, `decode_reply_body`), matched by sequence
@@ -7,14 +7,15 @@
 //! 1 when any command was refused (NAK) or never answered.
 
 use anyhow::{bail, Context, Result};
-use host_sim::display::reply_text;
+use host_sim::display::{reply_text, station_text};
 use host_sim::job::Job;
+use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::uplink::fields::{INDEX_DWELL_S, INDEX_POSITIONS};
 use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::{
     encode_command, Command, IndexingProcedure, Reply, ReplyStatus, MAX_COMMAND_WIRE_LEN,
 };
-use mwd_core::protocol::Decoder;
+use mwd_core::protocol::{Decoder, Payload, StationSurvey};
 use std::io::{ErrorKind, Read, Write};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -40,7 +41,11 @@ enum Action {
     Status(LinkArgs),
     /// Align again (the probe must be still).
     Align(LinkArgs),
-    /// Take a station survey now (the probe must be still).
+    /// Start surveying (drilling mode): end the static alignment now, so
+    /// the string may move (refused in the alignment's first 6 s).
+    Survey(LinkArgs),
+    /// Take a station survey now (the probe must be still); the station
+    /// frame follows the ACK on the downlink.
     Station(LinkArgs),
     /// Start the guided toolface-indexing procedure: the probe reports
     /// each dwell it detects.
@@ -88,6 +93,10 @@ pub fn run(args: Args) -> Result<()> {
             vec![("report configuration".into(), Command::ReportConfig)],
         ),
         Action::Align(link) => (link, vec![("re-align".into(), Command::Realign)]),
+        Action::Survey(link) => (
+            link,
+            vec![("start surveying".into(), Command::StartSurveying)],
+        ),
         Action::Station(link) => (link, vec![("take a station".into(), Command::TakeStation)]),
         Action::Index {
             positions,
@@ -114,6 +123,7 @@ pub fn run(args: Args) -> Result<()> {
         next_seq: rand::random(),
         timeout: Duration::from_millis(link.reply_timeout_ms),
         attempts: link.attempts,
+        stations: Vec::new(),
     };
     let mut refused = 0;
     for (label, command) in &commands {
@@ -121,6 +131,16 @@ pub fn run(args: Args) -> Result<()> {
             Ok(reply) => {
                 outln!("{label}: {}", reply_text(&reply));
                 refused += usize::from(reply.status != ReplyStatus::Ack);
+                // A station taken on request follows its ACK.
+                if reply.status == ReplyStatus::Ack && matches!(command, Command::TakeStation) {
+                    match session.await_requested_station()? {
+                        Some(station) => outln!("  {}", station_text(&station)),
+                        None => {
+                            outln!("  the station frame did not arrive");
+                            refused += 1;
+                        }
+                    }
+                }
             }
             Err(e) => {
                 outln!("{label}: {e:#}");
@@ -140,6 +160,8 @@ struct Session {
     next_seq: u16,
     timeout: Duration,
     attempts: u32,
+    /// Station frames that came after the last reply.
+    stations: Vec<StationSurvey>,
 }
 
 impl Session {
@@ -165,27 +187,66 @@ impl Session {
         )
     }
 
+    /// Reads until the reply to `seq` comes (the rest of that read is
+    /// decoded too: a station frame may follow the reply at once).
     fn await_reply(&mut self, seq: u16) -> Result<Option<Reply>> {
+        self.stations.clear();
+        let mut found = None;
+        self.read_until(|_, reply| {
+            if let Some(reply) = reply.filter(|r| r.command_seq == seq) {
+                found = Some(reply);
+            }
+            found.is_some()
+        })?;
+        Ok(found)
+    }
+
+    /// The station frame flagged requested, from what followed the reply
+    /// or what comes within the reply timeout.
+    fn await_requested_station(&mut self) -> Result<Option<StationSurvey>> {
+        let requested = |s: &StationSurvey| s.flags & station_flags::REQUESTED != 0;
+        if let Some(station) = self.stations.iter().copied().find(requested) {
+            return Ok(Some(station));
+        }
+        let mut found = None;
+        self.read_until(|station, _| {
+            found = found.or(station.filter(requested));
+            found.is_some()
+        })?;
+        Ok(found)
+    }
+
+    /// Reads the port for up to the reply timeout, showing `done` each
+    /// station frame and reply, until it returns true; telemetry frames
+    /// are passed over, replies found among the kinds the telemetry
+    /// decoder does not know. Station frames are kept in `stations`.
+    fn read_until(
+        &mut self,
+        mut done: impl FnMut(Option<StationSurvey>, Option<Reply>) -> bool,
+    ) -> Result<()> {
         let deadline = Instant::now() + self.timeout;
         let mut buf = [0u8; 256];
-        while Instant::now() < deadline {
+        let mut finished = false;
+        while !finished && Instant::now() < deadline {
             let got = match self.port.read(&mut buf) {
                 Ok(got) => got,
                 Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::Interrupted) => 0,
                 Err(e) => return Err(e).context("reading the serial port"),
             };
             for b in &buf[..got] {
-                // Telemetry frames are passed over; replies are found
-                // among the kinds the telemetry decoder does not know.
-                self.decoder.push(*b);
+                let station = match self.decoder.push(*b).map(|f| f.payload) {
+                    Some(Payload::Station(s)) => Some(s),
+                    _ => None,
+                };
                 let reply = self.decoder.unknown_body().map(decode_reply_body);
-                if let Some(Ok((_, reply))) = reply {
-                    if reply.command_seq == seq {
-                        return Ok(Some(reply));
-                    }
+                let reply = reply.and_then(|r| r.ok()).map(|(_, r)| r);
+                if finished {
+                    self.stations.extend(station);
+                } else if station.is_some() || reply.is_some() {
+                    finished = done(station, reply);
                 }
             }
         }
-        Ok(None)
+        Ok(())
     }
 }

@@ -5,6 +5,8 @@
 //! * [`raw`]: a raw sample's counts to calibrated body-frame rates and force.
 //! * [`navigator`]: coarse alignment, fine alignment, navigation with
 //!   station surveys at still periods.
+//! * [`navigator::commands`]: the surface's survey commands (start
+//!   surveying, take a station now, toolface indexing).
 //! * [`still`]: the still detector.
 //! * [`station`]: a station's drilling angles and their covariance.
 //! * [`tie_in`]: a start from a parent well's survey instead of the

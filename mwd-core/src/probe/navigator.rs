@@ -38,6 +38,9 @@
 //! raw frames through this same code and must get the probe's solutions
 //! bit for bit.
 
+#[path = "commands.rs"]
+pub mod commands;
+
 use super::raw::{reading, Reading};
 use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::StillDetector;
@@ -270,6 +273,8 @@ pub struct Navigator {
     /// The raw sample being processed.
     time_us: u64,
     sample_counter: u32,
+    /// The surface's survey commands' state (`commands`).
+    commands: commands::CommandState,
 }
 
 impl Navigator {
@@ -305,6 +310,7 @@ impl Navigator {
             toolface_block: ForceBlock::default(),
             time_us: 0,
             sample_counter: 0,
+            commands: commands::CommandState::default(),
         }
     }
 
@@ -334,6 +340,7 @@ impl Navigator {
         }
         if let Some(still) = still {
             self.track_station(still);
+            self.follow_commands(still);
         }
         self.solution(raw)
     }
@@ -426,7 +433,7 @@ impl Navigator {
 
     fn finish_station(&mut self, flags: u16) {
         if let Some(station) = self.station.take() {
-            let mut survey = station.settled.unwrap_or(station.survey);
+            let mut survey = station.to_send();
             survey.flags |= flags;
             self.finished_station = Some(survey);
         }
@@ -708,10 +715,7 @@ impl Navigator {
             self.finish_coarse_alignment(&segment, !self.coarse_single_part);
         }
         if fine_done {
-            self.filter.start_navigation();
-            // The roll-derived tool-axis rate starts from this sample on.
-            self.input = ProbeInput::new();
-            self.phase = Phase::Navigating;
+            self.enter_navigation();
         }
         navigating_still
     }

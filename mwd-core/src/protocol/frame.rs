@@ -169,6 +169,13 @@ pub mod station_flags {
     /// Do not use: the covariance failed its health check (sigmas NaN) or
     /// a tilt sigma is beyond the small-angle limit (as navigation bit 4).
     pub const SOLUTION_INVALID: u16 = 1 << 4;
+    /// Sent because the surface asked for it (uplink "take a station
+    /// now") while the probe was still, before the still period ended.
+    pub const REQUESTED: u16 = 1 << 5;
+    /// A dwell of the toolface-indexing procedure (uplink 0x48): still for
+    /// the procedure's dwell time at a toolface that changed from the
+    /// previous dwell's (`probe::navigator::commands`).
+    pub const INDEXING_DWELL: u16 = 1 << 6;
 }
 
 /// A station survey (kind 4): the attitude at the end of a still period

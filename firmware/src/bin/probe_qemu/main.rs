@@ -287,7 +287,12 @@ fn main() -> ! {
             tie_in_pending = None;
         }
         registers::watchdog_feed();
-        match uplink.serve(&PROBE, &mut uplink_reader, UPLINK_BYTES_PER_PASS) {
+        match uplink.serve(
+            &PROBE,
+            &mut navigator,
+            &mut uplink_reader,
+            UPLINK_BYTES_PER_PASS,
+        ) {
             Some(BoardAction::Realign) => {
                 realign(&mut navigator, uplink.config());
                 tie_in_pending = uplink.config().tie_in;

@@ -256,7 +256,12 @@ fn main() -> ! {
             tie_in_pending = None;
         }
         watchdog.feed();
-        match uplink.serve(&PROBE, &mut uplink_reader, UPLINK_BYTES_PER_PASS) {
+        match uplink.serve(
+            &PROBE,
+            &mut navigator,
+            &mut uplink_reader,
+            UPLINK_BYTES_PER_PASS,
+        ) {
             Some(BoardAction::Realign) => {
                 realign(&mut navigator, uplink.config());
                 tie_in_pending = uplink.config().tie_in;

@@ -40,6 +40,12 @@ pub enum NakReason {
     /// The configuration could not be written to flash; the probe keeps
     /// the previous one.
     StorageFailed,
+    /// Not yet: the navigation has not reached the state the command needs
+    /// (still aligning, or not long enough to end the alignment).
+    NotReady,
+    /// A station was asked for while the probe is not still (moving, or
+    /// still for less than the still detector's delay).
+    NotStill,
     /// A code this decoder does not know (a newer probe's).
     Other(u8),
 }
@@ -53,6 +59,8 @@ impl NakReason {
             Self::OutOfRange => 4,
             Self::Busy => 5,
             Self::StorageFailed => 6,
+            Self::NotReady => 7,
+            Self::NotStill => 8,
             Self::Other(b) => b,
         }
     }
@@ -67,6 +75,8 @@ impl NakReason {
             4 => Self::OutOfRange,
             5 => Self::Busy,
             6 => Self::StorageFailed,
+            7 => Self::NotReady,
+            8 => Self::NotStill,
             b => Self::Other(b),
         })
     }

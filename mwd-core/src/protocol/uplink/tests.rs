@@ -370,3 +370,14 @@ fn errors_read_as_sentences_with_their_numbers() {
     let text = UplinkError::UnknownCommand { seq: 2, kind: 0x99 }.to_string();
     assert!(text.contains("0x99"), "{text}");
 }
+
+#[test]
+fn the_survey_commands_refusals_have_their_own_codes() {
+    // Codes 1-6 keep their meaning (worked examples, older hosts read 7
+    // and 8 as unknown reasons and keep them).
+    assert_eq!(NakReason::from_byte(7), Some(NakReason::NotReady));
+    assert_eq!(NakReason::from_byte(8), Some(NakReason::NotStill));
+    assert_eq!(NakReason::Busy.to_byte(), 5);
+    assert_eq!(NakReason::StorageFailed.to_byte(), 6);
+    assert_eq!(NakReason::from_byte(9), Some(NakReason::Other(9)));
+}

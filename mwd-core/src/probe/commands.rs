@@ -1,0 +1,232 @@
+//! The surface's survey commands (uplink 0x46-0x48, docs/protocol.md,
+//! "Uplink"): start surveying, take a station now, the toolface-indexing
+//! procedure. A child module of `navigator` (declared there), so that the
+//! navigator's state stays private to the two.
+//!
+//! * **Start surveying** ends the static fine alignment now and enters
+//!   navigation (the phase in which still periods become stations). The
+//!   fine alignment applies a zero-velocity update every cycle without
+//!   asking the still detector: once the rig starts moving the string
+//!   those updates are false, so the surface must be able to end it before
+//!   the 60 s the probe would otherwise wait. Refused (not ready) during
+//!   the coarse alignment and for the first [`MIN_FINE_ALIGNMENT_SAMPLES`]
+//!   of the fine one; acknowledged, with nothing to do, once navigating
+//!   (a resend after a lost reply must not read as a refusal).
+//! * **Take a station now** sends the current still period's station at
+//!   once, flagged `REQUESTED`, with the survey its natural end would
+//!   have sent (the older of its last two settled checkpoints,
+//!   `SURVEY_SETTLE_EPOCHS`). The filter is not touched: the still period
+//!   goes on with its zero-velocity and bias updates, but sends nothing
+//!   more. Refused when not navigating (not ready) or not still.
+//! * **Toolface indexing**: for the next `positions` still periods that
+//!   last the procedure's dwell time at a toolface [`INDEX_MIN_TURN_RAD`]
+//!   or more from the previous dwell's, the station is sent as soon as the
+//!   dwell time is reached, flagged `INDEXING_DWELL` (its toolface and
+//!   sigma are the dwell's); the procedure ends after the last. The first
+//!   dwell is the toolface the tool is at.
+//!
+//! One rule keeps the stations unambiguous: a still period sends at most
+//! one station frame, whatever made it (its end, the longest station, a
+//! request, a dwell), and a repeated "take a station" in the same still
+//! period sends that frame again (the host's resend after a lost reply).
+
+use super::{Navigator, Phase, Station};
+use crate::conventions::{wrap_pi, DEG};
+use crate::probe::still::DETECTION_DELAY_SAMPLES;
+use crate::protocol::frame::station_flags;
+use crate::protocol::uplink::IndexingProcedure;
+use crate::protocol::StationSurvey;
+use crate::timing::SAMPLE_INTERVAL_S;
+
+/// The fewest fine-alignment samples after which "start surveying" ends
+/// the fine alignment: 1 s, one still-detector window of zero-velocity
+/// updates, so the filter has been aided before it runs free. The tilt
+/// needs no more: the coarse levelling already sits on the
+/// accelerometer-bias floor (derivation section 3b; measured on the
+/// navigator's still samples, roll sigma 0.0610 deg at the first fine
+/// cycle, 0.0650 deg at 1 s, 0.0674 deg at 60 s; the test below). What the
+/// rest would add is the gyrocompassed heading's refinement, which the
+/// frames' azimuth sigma reports (undetermined beyond 10 deg): ending
+/// early costs azimuth accuracy, honestly shown, not honesty.
+pub const MIN_FINE_ALIGNMENT_SAMPLES: u32 = 20;
+
+/// The smallest toolface change (rad) that makes a still period a new
+/// indexing dwell: 5 deg, half the finest spacing the command allows (36
+/// positions, 10 deg apart) and some 50 times a station's toolface sigma
+/// (~0.1 deg), so a pause at the same position is never counted twice and
+/// every position the surface turns to is.
+pub const INDEX_MIN_TURN_RAD: f64 = 5.0 * DEG;
+
+/// Why the navigator refused a command (the NAK reasons of
+/// `protocol::uplink::NakReason` of the same names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refusal {
+    /// Still aligning (or not long enough to end the alignment).
+    NotReady,
+    /// Not still: moving, or still for less than the detector's delay.
+    NotStill,
+}
+
+/// A toolface-indexing procedure in progress.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Indexing {
+    pub procedure: IndexingProcedure,
+    /// Dwells reported so far.
+    pub reported: u8,
+    /// The last reported dwell's toolface (rad).
+    last_toolface: Option<f32>,
+    /// The current still period was judged (reported or not a new
+    /// position).
+    judged: bool,
+}
+
+impl Indexing {
+    /// Zero-velocity updates (still cycles) by which a still period has
+    /// lasted the dwell time: the first comes after the detector's delay.
+    fn dwell_epochs(&self) -> u32 {
+        let samples = (f64::from(self.procedure.dwell_s) / SAMPLE_INTERVAL_S) as u32;
+        samples.saturating_sub(DETECTION_DELAY_SAMPLES - 1).max(1)
+    }
+}
+
+/// What the commands keep between cycles.
+#[derive(Default)]
+pub(super) struct CommandState {
+    /// The station frame the current still period already sent.
+    sent: Option<StationSurvey>,
+    indexing: Option<Indexing>,
+}
+
+impl Station {
+    /// The survey a station sends: the older of its last two checkpoints,
+    /// or its last still cycle when it has fewer (`SURVEY_SETTLE_EPOCHS`).
+    pub(super) fn to_send(&self) -> StationSurvey {
+        self.settled.unwrap_or(self.survey)
+    }
+}
+
+impl Navigator {
+    /// Uplink "start surveying": ends the fine alignment now (see the
+    /// module's notes). `Ok` when the probe navigates after it.
+    pub fn start_surveying(&mut self) -> Result<(), Refusal> {
+        match self.phase {
+            Phase::Coarse(_) => Err(Refusal::NotReady),
+            Phase::Fine { samples } if samples < MIN_FINE_ALIGNMENT_SAMPLES => {
+                Err(Refusal::NotReady)
+            }
+            Phase::Fine { .. } => {
+                self.enter_navigation();
+                Ok(())
+            }
+            Phase::Navigating => Ok(()),
+        }
+    }
+
+    /// From the fine alignment to navigation, at its full length or by
+    /// [`start_surveying`](Self::start_surveying).
+    pub(super) fn enter_navigation(&mut self) {
+        self.filter.start_navigation();
+        // The roll-derived tool-axis rate starts from the next sample on.
+        self.input = crate::mechanization::ProbeInput::new();
+        self.phase = Phase::Navigating;
+    }
+
+    /// Uplink "take a station now": the current still period's station,
+    /// flagged `REQUESTED`, for the caller to send now (see the module's
+    /// notes); the same frame again when this still period already sent
+    /// one.
+    pub fn take_station_now(&mut self) -> Result<StationSurvey, Refusal> {
+        if !self.is_navigating() {
+            return Err(Refusal::NotReady);
+        }
+        let mut survey = match (self.commands.sent, &self.station) {
+            (Some(sent), _) => sent,
+            (None, Some(station)) => station.to_send(),
+            (None, None) => return Err(Refusal::NotStill),
+        };
+        survey.flags |= station_flags::REQUESTED;
+        self.commands.sent = Some(survey);
+        Ok(survey)
+    }
+
+    /// Uplink "toolface indexing": starts the procedure (see the module's
+    /// notes); the same procedure already running goes on unchanged (a
+    /// resend), another replaces it.
+    pub fn index_toolface(&mut self, procedure: IndexingProcedure) -> Result<(), Refusal> {
+        if !self.is_navigating() {
+            return Err(Refusal::NotReady);
+        }
+        if self.commands.indexing.map(|i| i.procedure) != Some(procedure) {
+            self.commands.indexing = Some(Indexing {
+                procedure,
+                reported: 0,
+                last_toolface: None,
+                // A still period already sent cannot be a dwell.
+                judged: self.commands.sent.is_some(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The toolface-indexing procedure in progress, if any.
+    pub fn indexing(&self) -> Option<&Indexing> {
+        self.commands.indexing.as_ref()
+    }
+
+    /// After each navigation cycle's station tracking: keeps the one-frame
+    /// rule and reports indexing dwells.
+    pub(super) fn follow_commands(&mut self, still: bool) {
+        // A frame the station tracking finished (never one of ours, which
+        // carry these bits).
+        let ours = station_flags::REQUESTED | station_flags::INDEXING_DWELL;
+        if let Some(finished) = self.finished_station.filter(|f| f.flags & ours == 0) {
+            match self.commands.sent {
+                // Already sent by request or as a dwell.
+                Some(sent) if sent.station == finished.station => self.finished_station = None,
+                // Sent at the longest station: a request repeats it.
+                _ if still => self.commands.sent = Some(finished),
+                _ => {}
+            }
+        }
+        if !still {
+            self.commands.sent = None;
+            if let Some(indexing) = self.commands.indexing.as_mut() {
+                indexing.judged = false;
+            }
+            return;
+        }
+        let (Some(indexing), Some(station)) = (self.commands.indexing.as_mut(), &self.station)
+        else {
+            return;
+        };
+        if indexing.judged || station.epochs < indexing.dwell_epochs() {
+            return;
+        }
+        if self.commands.sent.is_some() {
+            // Sent on request before the dwell time: not a dwell.
+            indexing.judged = true;
+            return;
+        }
+        indexing.judged = true;
+        let mut survey = station.to_send();
+        let toolface = survey.angles[2];
+        let turned = indexing.last_toolface.is_none_or(|last| {
+            wrap_pi(f64::from(toolface) - f64::from(last)).abs() >= INDEX_MIN_TURN_RAD
+        });
+        if !turned {
+            return;
+        }
+        survey.flags |= station_flags::INDEXING_DWELL;
+        indexing.reported += 1;
+        indexing.last_toolface = Some(toolface);
+        if indexing.reported >= indexing.procedure.positions {
+            self.commands.indexing = None;
+        }
+        self.commands.sent = Some(survey);
+        self.finished_station = Some(survey);
+    }
+}
+
+#[cfg(test)]
+#[path = "commands_tests.rs"]
+mod tests;
