@@ -28,6 +28,7 @@ cargo build -p firmware --profile probe --target thumbv7em-none-eabihf
 # tests/tests/qemu_probe.rs builds and runs it again on its own).
 cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features qemu-fault-demo --bin probe-qemu -- -D warnings
 cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features qemu-drilling --bin probe-qemu -- -D warnings
+cargo clippy -p firmware --profile probe --target thumbv7em-none-eabihf --features board-qemu,power-cut-test --bin probe-qemu -- -D warnings
 cargo build -p firmware --profile probe --target thumbv7em-none-eabihf --features board-qemu --bin probe-qemu
 # The real board (STM32F411): linted and linked against the top-level
 # memory.x, so a build that outgrows the probe's budget fails here.
@@ -50,8 +51,11 @@ cargo test --release -p system-tests --test navigator_long_run -- --ignored
 # attitude class (19,200 seeded runs; release).
 cargo test --release -p system-tests --test alignment_classes -- --ignored
 # The bad-input matrix: host-sim over 138 bad files and arguments (and good
-# controls); fails on any panic, silent acceptance or flood of stderr.
-cargo build -p host-sim
+# controls); fails on any panic, silent acceptance or flood of stderr. The
+# binary is the one `cargo test` built for host-sim's own CLI tests (a
+# `cargo build -p host-sim` here would build it again with the features
+# unified differently: 1.5 min of CI for the same program).
+test -x target/debug/host-sim
 bash scripts/bad-input-matrix.sh target/debug/host-sim
 # The dashboard in headless Chromium (installs Debian's chromium if absent):
 # DOM checks against `host-sim decode` of the same capture, and a screenshot.

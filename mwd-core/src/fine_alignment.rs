@@ -939,10 +939,16 @@ mod tests {
             specific_force: g,
         };
         let bias_variance = |fa: &FineAlignment<f64, STATES_WITH_BIASES>| {
-            [fa.filter.p[(GYRO_BIAS, GYRO_BIAS)], fa.filter.p[(ACCEL_BIAS, ACCEL_BIAS)]]
+            [
+                fa.filter.p[(GYRO_BIAS, GYRO_BIAS)],
+                fa.filter.p[(ACCEL_BIAS, ACCEL_BIAS)],
+            ]
         };
         let steps = 3600.0 / dt;
-        let (sigma_g, sigma_a) = (noise.gyro[0].bias_instability, noise.accel[0].bias_instability);
+        let (sigma_g, sigma_a) = (
+            noise.gyro[0].bias_instability,
+            noise.accel[0].bias_instability,
+        );
         let tau = noise.gyro[0].correlation_time;
         let bounded = |sigma: f64, t: f64| 2.0 * sigma * sigma * (1.0 - libm::exp(-t / tau));
 
@@ -953,7 +959,10 @@ mod tests {
         }
         let hour = bias_variance(&fa);
         let added = [hour[0] - start[0], hour[1] - start[1]];
-        for (got, want) in added.iter().zip([bounded(sigma_g, 3600.0), bounded(sigma_a, 3600.0)]) {
+        for (got, want) in added
+            .iter()
+            .zip([bounded(sigma_g, 3600.0), bounded(sigma_a, 3600.0)])
+        {
             assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}");
         }
         assert!(added[0] < 2.0 * sigma_g * sigma_g);

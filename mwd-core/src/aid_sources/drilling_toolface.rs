@@ -172,7 +172,11 @@ mod tests {
         // var(f) = 40/39 per axis, /40 for the mean, / g_cross^2
         let g_cross2 = g.x * g.x + g.z * g.z;
         let want = (40.0 / 39.0) / 40.0 / g_cross2;
-        assert!((m.variance / want - 1.0).abs() < 1e-9, "{} {want}", m.variance);
+        assert!(
+            (m.variance / want - 1.0).abs() < 1e-9,
+            "{} {want}",
+            m.variance
+        );
         // the row turns the attitude about the tool axis
         let row = Vector3::from(m.attitude_row);
         assert!(row.norm() > 0.99 && row.norm() < 1.01, "{row:?}");

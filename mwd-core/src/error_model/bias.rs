@@ -21,7 +21,7 @@
 //! 2 sigma^2 in variance: `step_correlation` lets the filter add the walk
 //! as the geometric series q a^k, which sums to exactly that increment's
 //! variance 2 sigma^2 (1 - exp(-T/tau)) over T unobserved
-//! (`fine_alignment::BiasWalk`, derivation section 3b).
+//! (`fine_alignment::BiasWalk`, derivation section 4g).
 
 use crate::sensor_noise::{AxisNoise, ImuNoise};
 

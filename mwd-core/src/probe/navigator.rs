@@ -59,7 +59,7 @@ use crate::earth::earth_rate_n;
 use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
 use crate::fine_alignment::{
-    AccelBiasSnapshot, BiasWalk, FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior,
+    AccelBiasSnapshot, FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior,
 };
 use crate::kalman::UpdateReport;
 use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
@@ -626,15 +626,6 @@ impl Navigator {
                     extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
                 }
                 filter.linearize_at_gravity(drilling || still);
-                // Between stations nothing observes the biases for hours:
-                // their walk is bounded by the instability's own variance
-                // (`BiasWalk`); at a station it is added every step again,
-                // as in the alignment the walk was tuned for.
-                filter.set_bias_walk(if update {
-                    BiasWalk::EveryStep
-                } else {
-                    BiasWalk::BoundedSinceObserved
-                });
                 let report = filter.step_with(&imu, &extra);
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
