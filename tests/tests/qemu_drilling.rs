@@ -127,6 +127,15 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
     let stdout = String::from_utf8_lossy(&output.stdout).into_owned()
         + &String::from_utf8_lossy(&output.stderr);
     assert!(status.success(), "probe-qemu failed: {status}\n{stdout}");
+    // The probe's budget figures for this run (its semihosting summary
+    // line: worst and mean cycle, stack high-water mark, overruns);
+    // docs/budgets.md quotes them.
+    for line in stdout
+        .lines()
+        .filter(|l| l.contains("cycle_instructions_worst"))
+    {
+        eprintln!("{line}");
+    }
     let uart = std::fs::read(&serial).expect("QEMU's serial capture");
     let stream = std::fs::read(dir.join("sensor-stream.bin")).expect("the stream");
     let host_capture = std::fs::read(dir.join("host.bin")).expect("the host's capture");
