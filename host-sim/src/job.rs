@@ -28,9 +28,14 @@
 //! error model (a capture survey, `--depth`, has the probe's own model
 //! and refuses another); `replay` takes the site and the calibration (its
 //! navigator has no tie-in: a capture made with one is compared as
-//! post-processing). Command-line flags override the job. Every number is checked when the file is read,
-//! by the rules the probe applies (`probe::TieIn::new`, and the uplink's
-//! own decoding of each command), so a job the host accepts the probe
+//! post-processing). Command-line flags override the job. A station
+//! survey's first MD must equal the tie-on MD exactly: give the job's
+//! tie-on in the station file's unit (converted from the other unit, an MD
+//! may miss it by a rounding).
+//!
+//! Every number is checked when the file is read, by the rules the probe
+//! applies (`probe::TieIn::new`, and the uplink's own decoding of each
+//! command, and `survey`'s ranges), so a job the host accepts the probe
 //! does not refuse.
 
 use crate::analysis::calibration_file::CalibrationFile;
