@@ -1,6 +1,7 @@
-//! The job file: what one run needs on the probe, in one JSON file that
-//! `host-sim probe configure` sends (and, later, `survey` and `replay`
-//! read, so one file describes a run end to end).
+//! The job file: what one run needs, in one JSON file that
+//! `host-sim probe configure` sends to the probe and that `host-sim survey`
+//! and `host-sim replay` read (`--job`), so one file describes a run end to
+//! end.
 //!
 //! ```json
 //! {
@@ -9,18 +10,37 @@
 //!   "tie_in": { "inclination_deg": 88.0, "azimuth_deg": 271.0, "toolface_deg": 15.0,
 //!               "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 1.5,
 //!               "toolface_sigma_deg": 0.3 },
-//!   "calibration_file": "probe-cal.json"
+//!   "calibration_file": "probe-cal.json",
+//!   "survey": { "length_unit": "ft", "error_model": "PROBE-SCC1300",
+//!               "tie_on": { "md": 1500.0, "tvd": 1480.0, "north": 12.0, "east": -3.5 } }
 //! }
 //! ```
 //! `tie_in` and `calibration_file` are optional (absent: the static
 //! alignment, no correction); a relative calibration path is taken from
-//! the job file's folder. Every number is checked when the file is read,
-//! by the rules the probe applies (`probe::TieIn::new`, and the uplink's
-//! own decoding of each command), so a job the host accepts the probe
+//! the job file's folder. `survey` is optional and only the host reads it:
+//! the tie-on (the well's position where the survey starts, in
+//! `length_unit`, "m" or "ft", default "m"; every part optional, as the
+//! `--tie-on-*` flags) and the tool's error model (a name `survey
+//! --error-model` takes).
+//!
+//! Who reads what: `probe configure` sends the site, tie-in and
+//! calibration; `survey` takes the site's latitude, the tie-on and the
+//! error model (a capture survey, `--depth`, has the probe's own model
+//! and refuses another); `replay` takes the site and the calibration (its
+//! navigator has no tie-in: a capture made with one is compared as
+//! post-processing). Command-line flags override the job. A station
+//! survey's first MD must equal the tie-on MD exactly: give the job's
+//! tie-on in the station file's unit (converted from the other unit, an MD
+//! may miss it by a rounding).
+//!
+//! Every number is checked when the file is read, by the rules the probe
+//! applies (`probe::TieIn::new`, and the uplink's own decoding of each
+//! command, and `survey`'s ranges), so a job the host accepts the probe
 //! does not refuse.
 
 use crate::analysis::calibration_file::CalibrationFile;
 use crate::analysis::text_records::read_small_file;
+use crate::survey_listing::{self, LengthUnit};
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{DrillingAngles, DEG};
@@ -54,6 +74,23 @@ struct TieInEntry {
     toolface_sigma_deg: f64,
 }
 
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TieOnEntry {
+    md: Option<f64>,
+    tvd: Option<f64>,
+    north: Option<f64>,
+    east: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SurveyEntry {
+    length_unit: Option<String>,
+    tie_on: Option<TieOnEntry>,
+    error_model: Option<String>,
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct JobEntry {
@@ -62,6 +99,61 @@ struct JobEntry {
     site: SiteEntry,
     tie_in: Option<TieInEntry>,
     calibration_file: Option<PathBuf>,
+    survey: Option<SurveyEntry>,
+}
+
+/// The survey's tie-on from a job, in the job's length unit (true north);
+/// each part as optional as its `--tie-on-*` flag.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JobTieOn {
+    pub unit: LengthUnit,
+    pub md: Option<f64>,
+    pub tvd: Option<f64>,
+    pub north: Option<f64>,
+    pub east: Option<f64>,
+}
+
+impl Default for JobTieOn {
+    fn default() -> Self {
+        Self {
+            unit: LengthUnit::Metre,
+            md: None,
+            tvd: None,
+            north: None,
+            east: None,
+        }
+    }
+}
+
+impl JobTieOn {
+    /// The tie-on in `unit`; the same unit keeps the numbers to the bit
+    /// (a station file's first MD must equal the tie-on MD exactly).
+    pub fn in_unit(&self, unit: LengthUnit) -> Self {
+        let convert = |v: Option<f64>| {
+            v.map(|v| {
+                if unit == self.unit {
+                    v
+                } else {
+                    v * self.unit.to_m() / unit.to_m()
+                }
+            })
+        };
+        Self {
+            unit,
+            md: convert(self.md),
+            tvd: convert(self.tvd),
+            north: convert(self.north),
+            east: convert(self.east),
+        }
+    }
+}
+
+/// What `host-sim survey` takes from a job.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurveyJob {
+    pub tie_on: JobTieOn,
+    /// A name `survey_listing::model` knows (checked when read).
+    pub error_model: Option<String>,
 }
 
 /// A checked job.
@@ -71,6 +163,43 @@ pub struct Job {
     pub tie_in: Option<TieIn>,
     /// With the file it came from, if any.
     pub calibration: Option<(PathBuf, ProbeCalibration)>,
+    pub survey: SurveyJob,
+}
+
+/// The range `survey --tie-on-*` takes, in the length unit given.
+const TIE_ON_LIMIT: f64 = 1e6;
+
+impl SurveyEntry {
+    fn checked(self) -> Result<SurveyJob> {
+        let unit = match self.length_unit.as_deref() {
+            None | Some("m") => LengthUnit::Metre,
+            Some("ft") => LengthUnit::Foot,
+            Some(other) => bail!("survey.length_unit {other:?}: expected \"m\" or \"ft\""),
+        };
+        let t = self.tie_on.unwrap_or_default();
+        let checked = |name: &str, v: Option<f64>| -> Result<Option<f64>> {
+            match v {
+                Some(v) if !(v.is_finite() && v.abs() <= TIE_ON_LIMIT) => bail!(
+                    "survey.tie_on.{name} = {v}: expected a finite number within +-{TIE_ON_LIMIT}"
+                ),
+                v => Ok(v),
+            }
+        };
+        let tie_on = JobTieOn {
+            unit,
+            md: checked("md", t.md)?,
+            tvd: checked("tvd", t.tvd)?,
+            north: checked("north", t.north)?,
+            east: checked("east", t.east)?,
+        };
+        if let Some(name) = &self.error_model {
+            survey_listing::model(name).context("survey.error_model")?;
+        }
+        Ok(SurveyJob {
+            tie_on,
+            error_model: self.error_model,
+        })
+    }
 }
 
 /// Longitude in (-180, 180] deg, as the uplink carries it (the host also
@@ -134,10 +263,16 @@ impl Job {
                 CalibrationFile::load(&path).map(|c| (path, c.to_probe()))
             })
             .transpose()?;
+        let survey = entry
+            .survey
+            .map(SurveyEntry::checked)
+            .transpose()?
+            .unwrap_or_default();
         let job = Self {
             site,
             tie_in,
             calibration,
+            survey,
         };
         for (label, command) in job.commands() {
             probe_accepts(&command).with_context(|| format!("the probe would refuse: {label}"))?;
@@ -268,5 +403,39 @@ mod tests {
             &JOB.replace("}}", "}, \"calibration_file\": \"/nonexistent/cal.json\"}"),
             "cal.json",
         );
+        let with_survey = |survey: &str| JOB.replace("}}", &format!("}}, \"survey\": {survey}}}"));
+        refused(&with_survey(r#"{"length_unit": "yd"}"#), "\"yd\"");
+        refused(&with_survey(r#"{"tie_on": {"md": 1e7}}"#), "tie_on.md");
+        refused(
+            &with_survey(r#"{"error_model": "NOPE"}"#),
+            "unknown error model",
+        );
+        refused(&with_survey(r#"{"tie_on": {"mdd": 1}}"#), "mdd");
+    }
+
+    #[test]
+    fn the_survey_part_is_read_in_its_unit_and_converted() {
+        let job = Job::parse(
+            &JOB.replace(
+                "}}",
+                r#"}, "survey": {"length_unit": "ft", "error_model": "gyro-mwd",
+                      "tie_on": {"md": 1000.0, "north": -10.0}}}"#,
+            ),
+            Path::new("."),
+        )
+        .unwrap();
+        let t = job.survey.tie_on;
+        assert_eq!(
+            (t.unit, t.md, t.north),
+            (LengthUnit::Foot, Some(1000.0), Some(-10.0))
+        );
+        assert_eq!((t.tvd, t.east), (None, None));
+        let m = t.in_unit(LengthUnit::Metre);
+        assert!((m.md.unwrap() - 304.8).abs() < 1e-12, "{m:?}");
+        assert!((m.north.unwrap() + 3.048).abs() < 1e-12, "{m:?}");
+        assert_eq!(t.in_unit(LengthUnit::Foot), t);
+        assert_eq!(job.survey.error_model.as_deref(), Some("gyro-mwd"));
+        let plain = Job::parse(JOB, Path::new(".")).unwrap();
+        assert_eq!(plain.survey, SurveyJob::default());
     }
 }

@@ -44,6 +44,12 @@ pub fn start_parts<G: SpiDevice, A: SpiDevice>(
                     break;
                 }
                 Err(error) => {
+                    #[cfg(feature = "defmt")]
+                    defmt::warn!(
+                        "part {=usize} start-up attempt {=u32} failed",
+                        index,
+                        attempt
+                    );
                     *result = Some(error);
                     report(&sensor_fault_event(0, index as u8, &error, attempt));
                 }

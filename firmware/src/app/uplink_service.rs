@@ -69,6 +69,13 @@ impl<F: NorFlash> UplinkService<F> {
             },
             None => (ProbeConfig::default(), ConfigSource::Defaults),
         };
+        #[cfg(feature = "defmt")]
+        match source {
+            ConfigSource::Flash => {
+                defmt::info!("configuration v{=u32} from flash", config.version)
+            }
+            _ => defmt::info!("configuration: the defaults (no valid flash record)"),
+        }
         Self {
             receiver: UplinkReceiver::new(),
             config,
@@ -148,6 +155,20 @@ impl<F: NorFlash> UplinkService<F> {
             };
             if let Err(refusal) = done {
                 outcome.reply.status = ReplyStatus::Nak(nak_reason(refusal));
+            }
+            #[cfg(feature = "defmt")]
+            if let ReplyStatus::Nak(reason) = outcome.reply.status {
+                let s = self.receiver.stats();
+                defmt::warn!(
+                    "uplink NAK, reason {=u8}; refused so far: {=u32} CRC, {=u32} malformed, \
+                     {=u32} oversized, {=u32} unknown, {=u32} out of range",
+                    reason.to_byte(),
+                    s.crc_failures,
+                    s.malformed,
+                    s.oversized,
+                    s.unknown,
+                    s.out_of_range
+                );
             }
             let action = match outcome.action {
                 Some(Action::Realign) => Some(BoardAction::Realign),

@@ -158,6 +158,12 @@ impl<G: SpiDevice, A: SpiDevice> Part<G, A> {
             self.accel.start(delay)?;
             report.accel_restarted = true;
         }
+        #[cfg(feature = "defmt")]
+        defmt::warn!(
+            "SCC1300 recovered: gyro soft reset {=bool}, accelerometer restarted {=bool}",
+            report.gyro == Some(super::gyro::GyroRecovery::SoftReset),
+            report.accel_restarted
+        );
         Ok(report)
     }
 }

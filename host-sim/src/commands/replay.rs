@@ -18,6 +18,7 @@ use anyhow::Context;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::capture::{self, Capture};
 use host_sim::display;
+use host_sim::job::Job;
 use host_sim::live::{self, LiveOptions, LiveSinks};
 use host_sim::replay::{
     self, ReplayRow, ReplaySummary, Replayer, StationRow, StationSummary, StepLoss,
@@ -95,6 +96,12 @@ pub struct Args {
     /// uncalibrated).
     #[arg(long, value_name = "PATH")]
     pub calibration_file: Option<PathBuf>,
+    /// A job file (host-sim/src/job.rs): its site and calibration, as
+    /// `probe configure` sent them; --site and --calibration-file override
+    /// it (its site: with --site, not --lat/--lon/--height). The replay
+    /// has no tie-in: the job's is not applied.
+    #[arg(long, value_name = "JOB.json", conflicts_with_all = ["lat", "lon", "height"])]
+    pub job: Option<PathBuf>,
 }
 
 /// A replayed capture: where it came from, the capture, the replayed
@@ -113,13 +120,17 @@ struct Replayed {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let site = match args.site_numbers.as_deref() {
-        Some(&[lat, lon, height]) => super::site::checked_position(lat, lon, height)?,
+    let job = args.job.as_deref().map(Job::load).transpose()?;
+    let site = match (args.site_numbers.as_deref(), &job) {
+        (Some(&[lat, lon, height]), _) => super::site::checked_position(lat, lon, height)?,
+        (_, Some(job)) => job.site,
         _ => args.site.position(),
     };
-    let calibration = match &args.calibration_file {
-        Some(path) => CalibrationFile::load(path)?.to_probe(),
-        None => ProbeCalibration::default(),
+    let job_calibration = job.as_ref().and_then(|j| j.calibration.as_ref());
+    let calibration = match (&args.calibration_file, job_calibration) {
+        (Some(path), _) => CalibrationFile::load(path)?.to_probe(),
+        (None, Some((_, calibration))) => *calibration,
+        (None, None) => ProbeCalibration::default(),
     };
     let replayed = match (&args.port, &args.file) {
         (Some(port), _) => replay_live(&args, port, site, calibration)?,
@@ -129,7 +140,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // Another calibration or site than the QEMU probe's (none, the
     // paper's site; the site defaults are the paper's to the bit) is
     // post-processing, not a parity check.
-    let post_processed = args.calibration_file.is_some() || site != Position::paper_site();
+    // A job's tie-in is the probe's, which the replay does not apply.
+    let post_processed = args.calibration_file.is_some()
+        || job_calibration.is_some()
+        || site != Position::paper_site()
+        || job.as_ref().is_some_and(|j| j.tie_in.is_some());
     report(&replayed, args.csv.as_ref(), post_processed)
 }
 

@@ -4,6 +4,7 @@
 use super::limits::number_in;
 use super::site::SiteArgs;
 use anyhow::{bail, Context, Result};
+use host_sim::job::{Job, SurveyJob};
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::separation as sep;
 use host_sim::survey_listing::{
@@ -64,6 +65,16 @@ pub struct Args {
     pub capture: Box<super::survey_capture::CaptureArgs>,
     #[command(flatten)]
     pub site: SiteArgs,
+    /// The site as three numbers, the same as --lat --lon --height (and
+    /// the way to override a job's site).
+    #[arg(long = "site", num_args = 3, value_names = ["LAT", "LON", "HEIGHT"],
+          allow_negative_numbers = true, conflicts_with_all = ["lat", "lon", "height"])]
+    pub site_numbers: Option<Vec<f64>>,
+    /// A job file (host-sim/src/job.rs): its site, survey tie-on (in its
+    /// length unit, converted to the file's) and error model; the flags
+    /// given override it (its site: with --site, not --lat/--lon/--height).
+    #[arg(long, value_name = "JOB.json", conflicts_with_all = ["lat", "lon", "height"])]
+    pub job: Option<PathBuf>,
     /// North reference of the azimuths (grid: give --convergence-deg).
     #[arg(long, value_enum, default_value_t = Reference::True)]
     pub azimuth_reference: Reference,
@@ -74,14 +85,14 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_md: Option<f64>,
     /// TVD of the tie-on (file's unit).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
-    pub tie_on_tvd: f64,
+    #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
+    pub tie_on_tvd: Option<f64>,
     /// North of the tie-on (file's unit, true north).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
-    pub tie_on_north: f64,
+    #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
+    pub tie_on_north: Option<f64>,
     /// East of the tie-on (file's unit, true north).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = tie_on)]
-    pub tie_on_east: f64,
+    #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
+    pub tie_on_east: Option<f64>,
     /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS",
     /// "PROBE-SCC1300" (this probe, through 90 deg; at the SCC1300's noise
     /// every station is beyond its first-order limit: docs/probe-tool-model.md).
@@ -189,7 +200,52 @@ struct Survey {
     offset: Option<Offset>,
 }
 
+/// The survey's inputs that a job file may give (flags override it).
+pub struct Resolved {
+    /// Latitude of the site, rad.
+    pub latitude: f64,
+    pub job: SurveyJob,
+}
+
+impl Resolved {
+    fn new(args: &Args) -> Result<Self> {
+        let job = args.job.as_deref().map(Job::load).transpose()?;
+        let site = match (args.site_numbers.as_deref(), &job) {
+            (Some(&[lat, lon, height]), _) => super::site::checked_position(lat, lon, height)?,
+            (_, Some(job)) => job.site,
+            _ => args.site.position(),
+        };
+        Ok(Self {
+            latitude: site.lat,
+            job: job.map(|j| j.survey).unwrap_or_default(),
+        })
+    }
+
+    /// The tie-on in `unit` (the input file's): each flag given, else the
+    /// job's (converted to `unit`), else the surface (MD: the first
+    /// station's).
+    pub fn tie_on(&self, args: &Args, unit: LengthUnit) -> TieOnInput {
+        let job = self.job.tie_on.in_unit(unit);
+        TieOnInput {
+            md: args.tie_on_md.or(job.md),
+            tvd: args.tie_on_tvd.or(job.tvd).unwrap_or(0.0),
+            north: args.tie_on_north.or(job.north).unwrap_or(0.0),
+            east: args.tie_on_east.or(job.east).unwrap_or(0.0),
+        }
+    }
+
+    /// `--error-model`, else the job's (not with `--error-model-file`).
+    fn error_model<'a>(&'a self, args: &'a Args) -> Option<&'a str> {
+        match (&args.error_model, &args.error_model_file) {
+            (Some(name), _) => Some(name),
+            (None, Some(_)) => None,
+            (None, None) => self.job.error_model.as_deref(),
+        }
+    }
+}
+
 pub fn run(args: Args) -> Result<()> {
+    let resolved = Resolved::new(&args)?;
     let o = &args.sep;
     if o.offset.is_none() {
         let given = [
@@ -203,16 +259,16 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     if args.capture.depth.is_some() {
-        return super::survey_capture::run(&args);
+        return super::survey_capture::run(&args, &resolved);
     }
     if let Some(dir) = &args.plot {
         // refused before any work: a file in the way is the user's mistake
         plot::prepare_dir(dir)?;
     }
     let file = read(&args.stations)?;
-    let mut survey = compute(&args, &file)?;
+    let mut survey = compute(&args, &resolved, &file)?;
     if let Some(path) = &args.sep.offset {
-        survey.offset = Some(offset(&args, path, &file, &survey)?);
+        survey.offset = Some(offset(&args, &resolved, path, &file, &survey)?);
     }
     report(&survey);
     write_outputs(&args, &survey)
@@ -223,7 +279,7 @@ fn read(path: &Path) -> Result<StationFile> {
     listing::read_stations(input).with_context(|| format!("{}", path.display()))
 }
 
-fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
+fn compute(args: &Args, resolved: &Resolved, file: &StationFile) -> Result<Survey> {
     let reference = match (args.azimuth_reference, args.convergence_deg) {
         (Reference::True, None) => AzimuthReference::True,
         (Reference::True, Some(_)) => {
@@ -232,26 +288,18 @@ fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
         (Reference::Grid, Some(c)) => AzimuthReference::Grid(c.to_radians()),
         (Reference::Grid, None) => bail!("--azimuth-reference grid needs --convergence-deg"),
     };
-    let tie = TieOnInput {
-        md: args.tie_on_md,
-        tvd: args.tie_on_tvd,
-        north: args.tie_on_north,
-        east: args.tie_on_east,
-    };
+    let tie = resolved.tie_on(args, file.unit);
     let vsec = args.vsec_azimuth_deg.map(f64::to_radians);
     let (mut rows, direction) = listing::compute(file, reference, tie, vsec)?;
     let model = match &args.error_model_file {
         Some(path) => Some(listing::model_from_file(path)?),
-        None => args
-            .error_model
-            .as_deref()
-            .map(listing::model)
-            .transpose()?,
+        None => resolved.error_model(args).map(listing::model).transpose()?,
     };
     let mut invalid_from = None;
     if let Some(m) = model {
         let terms = listing::terms(m)?;
-        invalid_from = listing::apply_model(&mut rows, m, &terms, &model_site(args, m)?)?;
+        let site = model_site(args, resolved, m)?;
+        invalid_from = listing::apply_model(&mut rows, m, &terms, &site)?;
     }
     Ok(Survey {
         rows,
@@ -266,7 +314,13 @@ fn compute(args: &Args, file: &StationFile) -> Result<Survey> {
 
 /// The offset well positioned and given its covariance, and its separation
 /// from every reference station.
-fn offset(args: &Args, path: &Path, reference: &StationFile, s: &Survey) -> Result<Offset> {
+fn offset(
+    args: &Args,
+    resolved: &Resolved,
+    path: &Path,
+    reference: &StationFile,
+    s: &Survey,
+) -> Result<Offset> {
     let (Some(ref_radius_m), Some(offset_radius_m)) =
         (args.sep.hole_radius_m, args.sep.offset_hole_radius_m)
     else {
@@ -298,7 +352,7 @@ fn offset(args: &Args, path: &Path, reference: &StationFile, s: &Survey) -> Resu
     };
     if let Some(m) = model {
         let terms = listing::terms(m)?;
-        listing::apply_model(&mut rows, m, &terms, &model_site(args, m)?)
+        listing::apply_model(&mut rows, m, &terms, &model_site(args, resolved, m)?)
             .with_context(|| format!("offset well {}", path.display()))?;
     }
     let rule = sep::Rule {
@@ -375,7 +429,7 @@ fn separation_summary(s: &Survey) -> Vec<String> {
     out
 }
 
-fn model_site(args: &Args, model: &KnownModel) -> Result<Site> {
+fn model_site(args: &Args, resolved: &Resolved, model: &KnownModel) -> Result<Site> {
     let magnetic = |v: Option<f64>, flag: &str| match v {
         Some(v) => Ok(v),
         None if model.magnetic => bail!("--error-model {} needs {flag}", model.name),
@@ -387,7 +441,7 @@ fn model_site(args: &Args, model: &KnownModel) -> Result<Site> {
         dip: magnetic(args.dip_deg, "--dip-deg")?.to_radians(),
         declination: magnetic(args.declination_deg, "--declination-deg")?.to_radians(),
         vertical_limit: 0.0001_f64.to_radians(),
-        latitude: args.site.lat.to_radians(),
+        latitude: resolved.latitude,
         gyro_noise_reduction: 1.0,
     })
 }

@@ -4,12 +4,12 @@
 //! continuous trajectory from the 20 Hz solutions. docs/drilling-survey.md.
 
 use super::limits::number_in;
-use super::survey::Args;
+use super::survey::{Args, Resolved};
 use anyhow::{bail, Context, Result};
 use host_sim::capture::read_probe_capture;
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::depth_log::DepthLog;
-use host_sim::survey_listing::{drilling, drilling_text, TieOnInput};
+use host_sim::survey_listing::{drilling, drilling_text, LengthUnit};
 use mwd_core::protocol::Payload;
 use std::path::PathBuf;
 
@@ -37,7 +37,7 @@ pub struct CaptureArgs {
     pub trajectory_step_m: f64,
 }
 
-pub fn run(args: &Args) -> Result<()> {
+pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
     let unsupported = [
         ("--json", args.json.is_some()),
         ("--witsml", args.witsml.is_some()),
@@ -52,6 +52,17 @@ pub fn run(args: &Args) -> Result<()> {
             "{flag} is not available for a capture survey (--depth): its uncertainty is the \
              probe's own (docs/drilling-survey.md)"
         );
+    }
+    // The capture's uncertainty is the probe's own model: a job naming
+    // another is a job for another tool.
+    if let Some(name) = &resolved.job.error_model {
+        let probe = drilling::MODEL_NAME;
+        if host_sim::survey_listing::model(name)?.name != probe {
+            bail!(
+                "the job's error model {name} is not the probe's ({probe}): a capture survey \
+                 (--depth) has the probe's own uncertainty"
+            );
+        }
     }
     let Some(depth_path) = &args.capture.depth else {
         bail!("a capture survey needs --depth");
@@ -68,19 +79,15 @@ pub fn run(args: &Args) -> Result<()> {
             _ => None,
         })
         .collect();
-    let tie = TieOnInput {
-        md: args.tie_on_md,
-        tvd: args.tie_on_tvd,
-        north: args.tie_on_north,
-        east: args.tie_on_east,
-    };
+    // The depth log is in metres.
+    let tie = resolved.tie_on(args, LengthUnit::Metre);
     let site = Site {
         gravity: 9.806_65,
         b_total: 0.0,
         dip: 0.0,
         declination: 0.0,
         vertical_limit: 0.0001_f64.to_radians(),
-        latitude: args.site.lat.to_radians(),
+        latitude: resolved.latitude,
         gyro_noise_reduction: 1.0,
     };
     let terms = drilling::depth_terms()?;

@@ -53,10 +53,13 @@ pub struct DrillingSurvey {
     pub md_offset_m: f64,
 }
 
+/// The probe's tool model (docs/probe-tool-model.md): a capture survey's.
+pub const MODEL_NAME: &str = "PROBE-SCC1300";
+
 /// The depth terms of the probe's tool model (DSFS, DSTG): the depth log's
 /// scale and stretch errors, one place for their magnitudes.
 pub fn depth_terms() -> Result<Vec<ErrorTerm>> {
-    let model = super::model("PROBE-SCC1300")?;
+    let model = super::model(MODEL_NAME)?;
     let terms: Vec<ErrorTerm> = super::terms(model)?
         .into_iter()
         .filter(|t| t.weighting == "DSF" || t.weighting == "DST")
