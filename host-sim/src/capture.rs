@@ -12,6 +12,8 @@ use anyhow::Context;
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
+use mwd_core::protocol::uplink::reply::decode_reply_body;
+use mwd_core::protocol::uplink::Reply;
 use mwd_core::protocol::{Decoder, DecoderStats, Frame, FrameEncoder, MAX_WIRE_LEN};
 use mwd_core::protocol::{Event, EventKind};
 use mwd_core::sensor_units::{
@@ -117,6 +119,19 @@ impl<W: Write> CaptureWriter<W> {
         Ok(())
     }
 
+    /// Encodes and writes a reply to an uplink command (kind 5), numbered
+    /// in the same sequence as the frames, as the probe numbers it.
+    pub fn write_reply(&mut self, reply: &Reply) -> io::Result<()> {
+        let mut buf = [0u8; MAX_WIRE_LEN];
+        let n = self
+            .encoder
+            .encode_reply(reply, &mut buf)
+            .map_err(|_| io::Error::other("reply larger than MAX_WIRE_LEN"))?;
+        self.out.write_all(&buf[..n])?;
+        self.bytes += n as u64;
+        Ok(())
+    }
+
     /// Writes a simulated sample as a raw-sample frame.
     pub fn write_si_sample(&mut self, sample: &SiSample) -> io::Result<()> {
         self.write(&Payload::Raw(raw_sample_from_si(sample)))
@@ -185,6 +200,66 @@ pub fn write_simulated_probe<W: Write>(
 pub struct Capture {
     pub frames: Vec<Frame>,
     pub stats: DecoderStats,
+    /// The replies to uplink commands (downlink kind 5, outside
+    /// [`Payload`]: `mwd_core::protocol::uplink::reply`), each with its
+    /// place among `frames`.
+    pub replies: Vec<CapturedReply>,
+}
+
+/// A reply to an uplink command as the capture holds it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CapturedReply {
+    /// How many of the capture's frames came before it.
+    pub after_frames: usize,
+    /// Its downlink sequence number (the one counter of all kinds).
+    pub seq: u16,
+    pub reply: Reply,
+}
+
+/// One good frame of the downlink: a telemetry frame or a reply.
+#[derive(Debug, Clone, Copy)]
+pub enum Received<'a> {
+    Frame(&'a Frame),
+    Reply { seq: u16, reply: &'a Reply },
+}
+
+impl Capture {
+    /// Every good frame in the order it came, replies included.
+    pub fn in_order(&self) -> impl Iterator<Item = Received<'_>> {
+        let (mut next_reply, mut next_frame) = (0, 0);
+        std::iter::from_fn(move || match self.replies.get(next_reply) {
+            Some(r) if r.after_frames <= next_frame || next_frame >= self.frames.len() => {
+                next_reply += 1;
+                Some(Received::Reply {
+                    seq: r.seq,
+                    reply: &r.reply,
+                })
+            }
+            _ => {
+                let frame = self.frames.get(next_frame)?;
+                next_frame += 1;
+                Some(Received::Frame(frame))
+            }
+        })
+    }
+
+    /// Feeds `bytes` to `decoder`, keeping its frames and replies (a live
+    /// session's capture grows this way); `on_new` sees each as it comes.
+    pub fn feed(&mut self, decoder: &mut Decoder, bytes: &[u8], mut on_new: impl FnMut(Received)) {
+        for &b in bytes {
+            if let Some(frame) = decoder.push(b) {
+                self.frames.push(frame);
+                on_new(Received::Frame(&frame));
+            } else if let Some(Ok((seq, reply))) = decoder.unknown_body().map(decode_reply_body) {
+                self.replies.push(CapturedReply {
+                    after_frames: self.frames.len(),
+                    seq,
+                    reply,
+                });
+                on_new(Received::Reply { seq, reply: &reply });
+            }
+        }
+    }
 }
 
 /// A capture's bytes with frame `index` (counting every frame in the
@@ -209,32 +284,28 @@ pub fn without_frame(bytes: &[u8], index: usize) -> Vec<u8> {
 /// Decodes a whole capture held in memory.
 pub fn decode_bytes(bytes: &[u8]) -> Capture {
     let mut decoder = Decoder::new();
-    let mut frames = Vec::new();
-    decoder.feed(bytes, |f| frames.push(f));
+    let mut capture = Capture::default();
+    capture.feed(&mut decoder, bytes, |_| {});
     decoder.finish();
-    Capture {
-        frames,
-        stats: *decoder.stats(),
-    }
+    capture.stats = *decoder.stats();
+    capture
 }
 
 /// Reads and decodes a capture from any reader, streaming.
 pub fn decode_reader(mut reader: impl Read) -> io::Result<Capture> {
     let mut decoder = Decoder::new();
-    let mut frames = Vec::new();
+    let mut capture = Capture::default();
     let mut buf = [0u8; 64 * 1024];
     loop {
         let n = reader.read(&mut buf)?;
         if n == 0 {
             break;
         }
-        decoder.feed(&buf[..n], |f| frames.push(f));
+        capture.feed(&mut decoder, &buf[..n], |_| {});
     }
     decoder.finish();
-    Ok(Capture {
-        frames,
-        stats: *decoder.stats(),
-    })
+    capture.stats = *decoder.stats();
+    Ok(capture)
 }
 
 /// Reads and decodes a `.bin` capture file.

@@ -22,10 +22,11 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::nav_mode;
-use mwd_core::protocol::{Decoder, DecoderStats, Frame, NavSolution};
+use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
 use crate::capture::Capture;
 use crate::display;
+use crate::replay::commands::CommandRow;
 use crate::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
 
 /// Why a live replay stopped.
@@ -162,6 +163,8 @@ pub struct LiveOutcome {
     pub rows: Vec<ReplayRow>,
     pub summary: ReplaySummary,
     pub step_losses: Vec<StepLoss>,
+    /// The replies to uplink commands and what the replay did with each.
+    pub commands: Vec<CommandRow>,
     pub end: StreamEnd,
 }
 
@@ -180,12 +183,12 @@ pub fn run(
     let mut last_shown: Option<Instant> = None;
     let mut decoder = Decoder::new();
     let mut replayer = Replayer::with_calibration(position, options.calibration);
-    let mut frames: Vec<Frame> = Vec::new();
+    let mut capture = Capture::default();
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];
     if let Some(csv) = sinks.csv.as_mut() {
         if let Err(e) = writeln!(csv, "{}", replay::CSV_HEADER).and_then(|()| csv.flush()) {
-            return outcome(decoder, frames, replayer, StreamEnd::OutputFailed(e));
+            return outcome(decoder, capture, replayer, StreamEnd::OutputFailed(e));
         }
     }
     let end = loop {
@@ -216,13 +219,11 @@ pub fn run(
                 break StreamEnd::OutputFailed(e);
             }
         }
-        let first_new = frames.len();
-        decoder.feed(&buf[..n], |frame| frames.push(frame));
-        for frame in &frames[first_new..] {
-            if let Some(solution) = replayer.push(frame) {
+        capture.feed(&mut decoder, &buf[..n], |received| {
+            if let Some(solution) = replayer.push_received(received) {
                 latest = Some(solution);
             }
-        }
+        });
         if let Err(e) = write_settled(&mut replayer, sinks.csv.as_mut(), false) {
             break StreamEnd::OutputFailed(e);
         }
@@ -236,11 +237,13 @@ pub fn run(
             last_shown = Some(Instant::now());
         }
     };
+    // Raw frames the replay held for their navigation frame are replayed.
+    replayer.end_of_stream();
     let end = match write_settled(&mut replayer, sinks.csv.as_mut(), true) {
         Err(e) if !matches!(end, StreamEnd::OutputFailed(_)) => StreamEnd::OutputFailed(e),
         _ => end,
     };
-    outcome(decoder, frames, replayer, end)
+    outcome(decoder, capture, replayer, end)
 }
 
 /// Writes the rows whose comparison is settled (all of them at the end).
@@ -261,19 +264,22 @@ fn write_settled(
 
 fn outcome(
     mut decoder: Decoder,
-    frames: Vec<Frame>,
-    replayer: Replayer,
+    mut capture: Capture,
+    mut replayer: Replayer,
     end: StreamEnd,
 ) -> LiveOutcome {
     decoder.finish();
-    let stats = *decoder.stats();
+    capture.stats = *decoder.stats();
+    replayer.end_of_stream();
     let step_losses = replayer.step_losses().to_vec();
+    let commands = replayer.commands().to_vec();
     let (rows, summary) = replayer.finish();
     LiveOutcome {
-        capture: Capture { frames, stats },
+        capture,
         rows,
         summary,
         step_losses,
+        commands,
         end,
     }
 }

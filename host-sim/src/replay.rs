@@ -17,8 +17,23 @@
 //! navigator finishes its stations at the same samples, and each is
 //! compared bit for bit with the probe's station of the same number
 //! ([`Replayer::stations`]).
+//!
+//! The probe's replies to uplink commands (kind 5) tell the replay which
+//! commands changed the navigation and where ([`commands`]): an
+//! acknowledged start surveying, take a station, toolface indexing or
+//! re-align is carried out on the replay's navigator between the same two
+//! samples as on the probe. To know that place, a raw frame is replayed
+//! only once the probe's navigation frame of its sample (or a later one)
+//! has come, or [`SETTLE_AFTER_SAMPLES`] later raw frames did (a capture
+//! without navigation frames). What the replay cannot repeat (a command
+//! whose place was lost with frames, a re-align with settings the downlink
+//! does not carry) stops the comparison there; a reply lost altogether
+//! shows as the probe's navigation mode differing from the replay's, which
+//! stops it too and says so.
 
-use std::collections::HashMap;
+pub mod commands;
+
+use std::collections::{HashMap, VecDeque};
 use std::io::{self, Write};
 
 use mwd_core::calibration::ProbeCalibration;
@@ -27,9 +42,14 @@ use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::decoder::starts_a_run;
 use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
-use mwd_core::protocol::{encode_body, EventKind, Frame, NavSolution, Payload, StationSurvey};
+use mwd_core::protocol::uplink::{Reply, ReplyStatus};
+use mwd_core::protocol::{
+    encode_body, EventKind, Frame, NavSolution, Payload, RawSample, StationSurvey,
+};
 
+use crate::capture::{Capture, Received};
 use crate::display;
+use commands::{CommandOutcome, CommandRow, Effect};
 
 /// One replayed solution and how it compares with the probe's own.
 #[derive(Debug, Clone, Copy)]
@@ -103,14 +123,84 @@ pub enum StepLossReason {
     StartsMidRun,
     /// The probe's navigation dropped samples (a samples-dropped event).
     ProbeDroppedSamples,
+    /// Frames were lost between a command's reply and the navigation frame
+    /// before it: the sample at which the command took effect is not known.
+    CommandPlaceUnknown { command_seq: u16 },
+    /// The probe re-aligned or restarted with a configuration the replay
+    /// does not have (settings acknowledged since the run began, or a
+    /// configuration version other than the capture's first).
+    ConfigurationChanged,
+    /// The replay's navigator refused a command the probe acknowledged.
+    ReplayRefusedCommand { command_seq: u16 },
+    /// An acknowledged command of a kind this replay does not know.
+    UnknownCommand { command_seq: u16 },
+    /// The probe's navigation mode differs from the replay's: a command
+    /// the replay did not carry out, its reply lost when `frames_lost`.
+    ModeDiffers {
+        probe_mode: u8,
+        replay_mode: u8,
+        frames_lost: bool,
+    },
+    /// Toolface indexing without its parameters: the station surveys (not
+    /// the navigation) are not compared until the run re-aligns or ends.
+    IndexingUnknown { command_seq: u16 },
+}
+
+impl StepLossReason {
+    /// Whether this loss means the replay and the probe differ (rather than
+    /// the capture missing something).
+    pub fn is_a_difference(&self) -> bool {
+        matches!(
+            self,
+            Self::ReplayRefusedCommand { .. }
+                | Self::ModeDiffers {
+                    frames_lost: false,
+                    ..
+                }
+        )
+    }
 }
 
 impl std::fmt::Display for StepLoss {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let why = match self.reason {
-            StepLossReason::RawFramesLost => "raw frames lost before it",
-            StepLossReason::StartsMidRun => "the capture starts after the probe's first sample",
-            StepLossReason::ProbeDroppedSamples => "the probe's navigation dropped samples",
+            StepLossReason::RawFramesLost => "raw frames lost before it".to_string(),
+            StepLossReason::StartsMidRun => {
+                "the capture starts after the probe's first sample".to_string()
+            }
+            StepLossReason::ProbeDroppedSamples => {
+                "the probe's navigation dropped samples".to_string()
+            }
+            StepLossReason::CommandPlaceUnknown { command_seq } => format!(
+                "frames lost before the reply to command {command_seq}: the sample at which \
+                 it took effect is not known"
+            ),
+            StepLossReason::ConfigurationChanged => "the probe re-aligned or restarted with \
+                 settings the downlink does not carry (replay it with those settings)"
+                .to_string(),
+            StepLossReason::ReplayRefusedCommand { command_seq } => format!(
+                "the replay's navigator refused command {command_seq}, which the probe \
+                 acknowledged: they DIFFER"
+            ),
+            StepLossReason::UnknownCommand { command_seq } => {
+                format!("command {command_seq} is of a kind this replay does not know")
+            }
+            StepLossReason::ModeDiffers {
+                probe_mode,
+                replay_mode,
+                frames_lost,
+            } => {
+                let cause = if frames_lost {
+                    "frames were lost: most likely the reply to a start surveying or re-align"
+                } else {
+                    "no frame was lost: the replay DIFFERS from the probe"
+                };
+                format!("the probe's navigation mode is {probe_mode}, the replay's {replay_mode}; {cause}")
+            }
+            StepLossReason::IndexingUnknown { command_seq } => format!(
+                "station surveys only: toolface indexing (command {command_seq}) without its \
+                 parameters (give the uplink log)"
+            ),
         };
         write!(
             f,
@@ -140,10 +230,24 @@ pub fn replay_with(
     replayer.finish()
 }
 
+/// Replays a decoded capture, its replies to uplink commands included.
+pub fn replay_capture(
+    capture: &Capture,
+    position: Position,
+    calibration: ProbeCalibration,
+) -> (Vec<ReplayRow>, ReplaySummary) {
+    let mut replayer = Replayer::with_calibration(position, calibration);
+    for received in capture.in_order() {
+        replayer.push_received(received);
+    }
+    replayer.finish()
+}
+
 /// Rows of a live replay still waiting for the probe's solution after this
 /// many later samples are written without it: more than the probe's
-/// navigation inbox can hold back (32 samples).
-const SETTLE_AFTER_SAMPLES: usize = 64;
+/// navigation inbox can hold back (32 samples). Also how many raw frames
+/// wait for their navigation frame before they are replayed without it.
+pub const SETTLE_AFTER_SAMPLES: usize = 64;
 
 /// The replay one frame at a time, for a live stream: a raw frame is
 /// replayed as soon as it arrives. The probe sends a sample's navigation
@@ -170,6 +274,60 @@ pub struct Replayer {
     /// The probe's stations the replay has not finished yet.
     early_station: HashMap<u16, StationSurvey>,
     station_summary: StationSummary,
+    /// Raw frames waiting for the place of any command before them, with
+    /// whether the replay was in step when each came.
+    held: VecDeque<(RawSample, bool)>,
+    /// Acknowledged commands not carried out yet: (index into
+    /// `command_rows`, what to do).
+    scheduled: VecDeque<(usize, Effect)>,
+    command_rows: Vec<CommandRow>,
+    /// The toolface-indexing procedures the host sent, by command sequence
+    /// number ([`Replayer::knows_sent_command`]).
+    sent_indexing: HashMap<u16, mwd_core::protocol::uplink::IndexingProcedure>,
+    run: RunState,
+    /// The configuration version of the capture's first boot event that
+    /// reported one: the configuration the replay is taken to have.
+    first_config_version: Option<u32>,
+}
+
+/// What the commands need to know of the current run.
+#[derive(Debug, Clone, Copy)]
+struct RunState {
+    /// The sample of the probe's last navigation frame.
+    last_probe_nav: Option<u32>,
+    /// A frame was lost since that navigation frame (or since the boot).
+    lost_since_nav: bool,
+    /// A frame was lost in this run.
+    lost_in_run: bool,
+    raw_seen: bool,
+    /// The last sample the replay's navigator stepped.
+    stepped_through: Option<u32>,
+    /// Settings were acknowledged in this run (a re-align then uses values
+    /// the replay does not have).
+    settings_changed: bool,
+    /// The configuration version of this run's boot event.
+    boot_version: Option<u32>,
+    /// Samples from this one on are not compared (a command's loss).
+    unchecked_from: Option<u32>,
+    /// Station surveys are compared (not while indexing without its
+    /// parameters).
+    stations_in_step: bool,
+}
+
+impl Default for RunState {
+    fn default() -> Self {
+        Self {
+            last_probe_nav: None,
+            lost_since_nav: false,
+            lost_in_run: false,
+            raw_seen: false,
+            stepped_through: None,
+            settings_changed: false,
+            boot_version: None,
+            unchecked_from: None,
+            stations_in_step: true,
+        }
+    }
 }
 
 /// Whether the replay has seen what the probe's navigation saw.
@@ -211,23 +369,187 @@ impl Replayer {
             awaiting_station: HashMap::new(),
             early_station: HashMap::new(),
             station_summary: StationSummary::default(),
+            held: VecDeque::new(),
+            scheduled: VecDeque::new(),
+            command_rows: Vec::new(),
+            sent_indexing: HashMap::new(),
+            run: RunState::default(),
+            first_config_version: None,
         }
     }
 
-    /// Takes one decoded frame; returns the replayed solution if it was a
-    /// raw sample.
-    pub fn push(&mut self, frame: &Frame) -> Option<NavSolution> {
-        if let Some(expected) = self.step.expected_seq {
-            self.step.gap_since_raw |= frame.seq != expected;
+    /// Tells the replay a command the host sent (its uplink log), for what
+    /// the reply does not carry: toolface indexing's parameters. Commands
+    /// of other kinds need nothing more.
+    pub fn knows_sent_command(&mut self, seq: u16, command: &mwd_core::protocol::uplink::Command) {
+        if let mwd_core::protocol::uplink::Command::IndexToolface(p) = command {
+            self.sent_indexing.insert(seq, *p);
         }
-        self.step.expected_seq = Some(frame.seq.wrapping_add(1));
+    }
+
+    /// Takes one good frame of the downlink, telemetry or reply.
+    pub fn push_received(&mut self, received: Received) -> Option<NavSolution> {
+        match received {
+            Received::Frame(frame) => self.push(frame),
+            Received::Reply { seq, reply } => {
+                self.push_reply(seq, reply);
+                None
+            }
+        }
+    }
+
+    /// Notes a frame's sequence number: a gap is a loss.
+    fn note_seq(&mut self, seq: u16) {
+        if let Some(expected) = self.step.expected_seq {
+            if seq != expected {
+                self.step.gap_since_raw = true;
+                self.run.lost_since_nav = true;
+                self.run.lost_in_run = true;
+            }
+        }
+        self.step.expected_seq = Some(seq.wrapping_add(1));
+    }
+
+    /// Takes a reply to an uplink command: an acknowledged command that
+    /// changes the navigator is carried out after the sample of the last
+    /// navigation frame before it ([`commands`]).
+    pub fn push_reply(&mut self, seq: u16, reply: &Reply) {
+        self.note_seq(seq);
+        self.step.seen_any = true;
+        let run = self.run;
+        let late = run
+            .stepped_through
+            .is_some_and(|stepped| run.last_probe_nav.is_none_or(|after| after < stepped));
+        let place_known =
+            !run.lost_since_nav && (run.last_probe_nav.is_some() || !run.raw_seen) && !late;
+        let mut row = CommandRow {
+            run: self.summary.restarts,
+            command_seq: reply.command_seq,
+            command_kind: reply.command_kind,
+            status: reply.status,
+            after_sample: run.last_probe_nav,
+            place_known,
+            outcome: CommandOutcome::NoEffect,
+        };
+        let from_sample = run.last_probe_nav.map_or(0, |n| n.wrapping_add(1));
+        if reply.status != ReplyStatus::Ack {
+            row.outcome = CommandOutcome::Refused;
+        } else if commands::is_setting(reply.command_kind) {
+            self.run.settings_changed = true;
+        } else if mwd_core::protocol::uplink::CommandKind::from_byte(reply.command_kind).is_none() {
+            row.outcome = CommandOutcome::UnknownKind;
+            let command_seq = reply.command_seq;
+            self.lose_from(from_sample, StepLossReason::UnknownCommand { command_seq });
+        } else if let Some(effect) = commands::effect(
+            reply.command_kind,
+            reply.config_version,
+            self.sent_indexing.get(&reply.command_seq).copied(),
+        ) {
+            row.outcome = CommandOutcome::Pending;
+            if !place_known {
+                let command_seq = reply.command_seq;
+                self.lose_from(
+                    from_sample,
+                    StepLossReason::CommandPlaceUnknown { command_seq },
+                );
+            }
+            self.scheduled.push_back((self.command_rows.len(), effect));
+        }
+        self.command_rows.push(row);
+    }
+
+    /// The replies seen so far and what the replay did with each.
+    pub fn commands(&self) -> &[CommandRow] {
+        &self.command_rows
+    }
+
+    /// Stops the comparison of this run's samples from `from_sample` on.
+    fn lose_from(&mut self, from_sample: u32, reason: StepLossReason) {
+        let stations_only = matches!(reason, StepLossReason::IndexingUnknown { .. });
+        if stations_only {
+            self.run.stations_in_step = false;
+        } else {
+            if self.run.unchecked_from.is_some_and(|f| f <= from_sample) {
+                return;
+            }
+            self.run.unchecked_from = Some(from_sample);
+        }
+        self.step_losses.push(StepLoss {
+            run: self.summary.restarts,
+            from_sample,
+            reason,
+        });
+    }
+
+    /// Carries out the scheduled commands due before sample `counter`.
+    fn apply_due_commands(&mut self, counter: u32) {
+        while let Some(&(index, effect)) = self.scheduled.front() {
+            let after = self.command_rows.get(index).and_then(|r| r.after_sample);
+            if after.is_some_and(|a| a >= counter) {
+                return;
+            }
+            self.scheduled.pop_front();
+            let outcome = self.apply(index, effect, counter);
+            if let Some(row) = self.command_rows.get_mut(index) {
+                row.outcome = outcome;
+            }
+        }
+    }
+
+    fn apply(&mut self, index: usize, effect: Effect, counter: u32) -> CommandOutcome {
+        let command_seq = self.command_rows.get(index).map_or(0, |r| r.command_seq);
+        let done = match effect {
+            Effect::StartSurveying => self.navigator.start_surveying(),
+            Effect::TakeStation => self.navigator.take_station_now().map(|station| {
+                self.replayed_station(station, counter);
+            }),
+            Effect::IndexToolface(Some(procedure)) => self.navigator.index_toolface(procedure),
+            Effect::IndexToolface(None) => {
+                self.lose_from(counter, StepLossReason::IndexingUnknown { command_seq });
+                return CommandOutcome::Incomplete;
+            }
+            Effect::Realign { config_version } => {
+                self.navigator = Navigator::with_calibration(self.position, self.calibration);
+                // The new navigator numbers its stations from 1 again.
+                self.forget_station_partners();
+                self.run.stations_in_step = true;
+                let changed = self.run.settings_changed
+                    || self.run.boot_version.is_some_and(|v| v != config_version);
+                if changed {
+                    self.lose_from(counter, StepLossReason::ConfigurationChanged);
+                    return CommandOutcome::Incomplete;
+                }
+                Ok(())
+            }
+        };
+        match done {
+            Ok(()) => CommandOutcome::Replayed,
+            Err(refusal) => {
+                self.lose_from(
+                    counter,
+                    StepLossReason::ReplayRefusedCommand { command_seq },
+                );
+                CommandOutcome::ReplayRefused(refusal)
+            }
+        }
+    }
+
+    /// Takes one decoded frame; returns the newest solution it let the
+    /// replay step (a raw frame waits for its sample's navigation frame).
+    pub fn push(&mut self, frame: &Frame) -> Option<NavSolution> {
+        self.note_seq(frame.seq);
         let seen_before = std::mem::replace(&mut self.step.seen_any, true);
         match frame.payload {
             _ if starts_a_run(frame.seq, &frame.payload) => {
+                // The last run's held samples, as its navigator would have.
+                self.end_of_stream();
                 if seen_before {
                     self.summary.restarts += 1;
                 }
                 self.restart_navigation();
+                if let Payload::Event(boot) = frame.payload {
+                    self.note_boot_configuration(boot.value);
+                }
                 None
             }
             Payload::Event(e) if e.kind == EventKind::SamplesDropped => {
@@ -236,37 +558,22 @@ impl Replayer {
             }
             Payload::Nav(on_board) => {
                 self.summary.probe_solutions += 1;
+                self.run.last_probe_nav = Some(on_board.sample_counter);
+                self.run.lost_since_nav = false;
                 match self.awaiting_probe.remove(&on_board.sample_counter) {
                     Some(index) => self.compare(index, &on_board),
                     None => {
                         self.early_probe.insert(on_board.sample_counter, on_board);
                     }
                 }
-                None
+                self.step_held(false)
             }
             Payload::Raw(raw) => {
                 self.summary.raw_frames += 1;
+                self.run.raw_seen = true;
                 self.check_step(raw.sample_counter);
-                let solution = self.navigator.step(&raw);
-                if solution.flags & nav_flags::SENSOR_DEGRADED != 0 {
-                    self.summary.degraded += 1;
-                }
-                let index = self.rows.len();
-                self.rows.push(ReplayRow {
-                    solution,
-                    matches_probe: None,
-                    in_step: self.step.in_step,
-                });
-                match self.early_probe.remove(&raw.sample_counter) {
-                    Some(on_board) => self.compare(index, &on_board),
-                    None => {
-                        self.awaiting_probe.insert(raw.sample_counter, index);
-                    }
-                }
-                if let Some(station) = self.navigator.take_station() {
-                    self.replayed_station(station);
-                }
-                Some(solution)
+                self.held.push_back((raw, self.step.in_step));
+                self.step_held(false)
             }
             Payload::Station(on_board) => {
                 self.station_summary.probe += 1;
@@ -282,13 +589,89 @@ impl Replayer {
         }
     }
 
-    fn replayed_station(&mut self, station: StationSurvey) {
+    /// Replays the held raw frames whose place among the commands is known
+    /// (all of them at the end of the stream): those up to the sample of
+    /// the probe's latest navigation frame, and any beyond
+    /// [`SETTLE_AFTER_SAMPLES`] held.
+    fn step_held(&mut self, all: bool) -> Option<NavSolution> {
+        let mut newest = None;
+        while let Some(&(raw, in_step)) = self.held.front() {
+            let placed = self
+                .run
+                .last_probe_nav
+                .is_some_and(|n| raw.sample_counter <= n);
+            if !(all || placed || self.held.len() > SETTLE_AFTER_SAMPLES) {
+                break;
+            }
+            self.held.pop_front();
+            newest = Some(self.step_raw(raw, in_step));
+        }
+        newest
+    }
+
+    /// Replays every held raw frame: the stream ended (or a new run began).
+    pub fn end_of_stream(&mut self) {
+        self.step_held(true);
+    }
+
+    fn step_raw(&mut self, raw: RawSample, arrived_in_step: bool) -> NavSolution {
+        let counter = raw.sample_counter;
+        self.apply_due_commands(counter);
+        let solution = self.navigator.step(&raw);
+        self.run.stepped_through = Some(counter);
+        if solution.flags & nav_flags::SENSOR_DEGRADED != 0 {
+            self.summary.degraded += 1;
+        }
+        let index = self.rows.len();
+        self.rows.push(ReplayRow {
+            solution,
+            matches_probe: None,
+            in_step: arrived_in_step && self.compared(counter),
+        });
+        match self.early_probe.remove(&counter) {
+            Some(on_board) => self.compare(index, &on_board),
+            None => {
+                self.awaiting_probe.insert(counter, index);
+            }
+        }
+        if let Some(station) = self.navigator.take_station() {
+            self.replayed_station(station, counter);
+        }
+        solution
+    }
+
+    /// Whether no command's loss stops the comparison at sample `counter`.
+    fn compared(&self, counter: u32) -> bool {
+        self.run.unchecked_from.is_none_or(|from| counter < from)
+    }
+
+    /// A boot event's configuration version (bits 16-31 of its value,
+    /// docs/protocol.md "Event codes"; 0: not reported): a run with
+    /// another configuration than the capture's first is not compared.
+    fn note_boot_configuration(&mut self, boot_value: u32) {
+        if boot_value == 0 {
+            return;
+        }
+        let version = boot_value >> 16;
+        self.run.boot_version = Some(version);
+        match self.first_config_version {
+            None => self.first_config_version = Some(version),
+            Some(first) if first != version => {
+                self.lose_from(0, StepLossReason::ConfigurationChanged)
+            }
+            Some(_) => {}
+        }
+    }
+
+    fn replayed_station(&mut self, station: StationSurvey, counter: u32) {
         self.station_summary.replayed += 1;
         let index = self.station_rows.len();
+        // In step as the newest replayed sample was.
+        let arrived_in_step = self.rows.last().is_none_or(|r| r.in_step);
         self.station_rows.push(StationRow {
             station,
             matches_probe: None,
-            in_step: self.step.in_step,
+            in_step: arrived_in_step && self.compared(counter) && self.run.stations_in_step,
         });
         match self.early_station.remove(&station.station) {
             Some(on_board) => self.compare_station(index, &on_board),
@@ -316,13 +699,22 @@ impl Replayer {
         }
     }
 
-    /// The replayed stations so far (in order) and their comparison; a
-    /// probe station whose partner has not been replayed counts as
-    /// unchecked.
-    pub fn stations(&self) -> (&[StationRow], StationSummary) {
+    /// The replayed stations (in order) and their comparison, at the end of
+    /// the stream: the held raw frames are replayed first. A probe station
+    /// whose partner has not been replayed counts as unchecked.
+    pub fn stations(&mut self) -> (&[StationRow], StationSummary) {
+        self.end_of_stream();
         let mut summary = self.station_summary;
         summary.unchecked += self.early_station.len() as u64;
         (&self.station_rows, summary)
+    }
+
+    /// Station numbers start again at 1 (a boot, a re-align): older
+    /// partners can never match.
+    fn forget_station_partners(&mut self) {
+        self.station_summary.unchecked += self.early_station.len() as u64;
+        self.awaiting_station.clear();
+        self.early_station.clear();
     }
 
     /// A boot event: the probe started again, so does the replay.
@@ -333,10 +725,10 @@ impl Replayer {
         self.summary.unchecked += self.early_probe.len() as u64;
         self.awaiting_probe.clear();
         self.early_probe.clear();
-        // Station numbers start again at 1.
-        self.station_summary.unchecked += self.early_station.len() as u64;
-        self.awaiting_station.clear();
-        self.early_station.clear();
+        self.forget_station_partners();
+        // Commands the last run never reached are dropped with it.
+        self.scheduled.clear();
+        self.run = RunState::default();
         self.step = StepTracker {
             seen_any: true,
             expected_seq: self.step.expected_seq,
@@ -379,14 +771,40 @@ impl Replayer {
     }
 
     fn compare(&mut self, index: usize, on_board: &NavSolution) {
+        let compared = self.compared(on_board.sample_counter);
+        let lost_in_run = self.run.lost_in_run;
         let Some(row) = self.rows.get_mut(index) else {
             return;
         };
+        row.in_step &= compared;
         if !row.in_step {
             self.summary.unchecked += 1;
             return;
         }
         let same = encoded(on_board) == encoded(&row.solution);
+        let replay_mode = row.solution.mode;
+        if on_board.mode != replay_mode {
+            // A navigation phase the replay is not in: a command it did not
+            // carry out. After a loss, most likely a lost reply: not
+            // compared; with nothing lost, a difference.
+            if lost_in_run {
+                row.in_step = false;
+                self.summary.unchecked += 1;
+            } else {
+                row.matches_probe = Some(false);
+                self.summary.mismatched += 1;
+            }
+            let reason = StepLossReason::ModeDiffers {
+                probe_mode: on_board.mode,
+                replay_mode,
+                frames_lost: lost_in_run,
+            };
+            let from = on_board
+                .sample_counter
+                .wrapping_add(u32::from(!lost_in_run));
+            self.lose_from(from, reason);
+            return;
+        }
         row.matches_probe = Some(same);
         if same {
             self.summary.matched += 1;
@@ -411,7 +829,8 @@ impl Replayer {
     /// write now. `all` settles every row (the stream ended).
     pub fn settled_rows(&mut self, all: bool) -> &[ReplayRow] {
         let from = self.settled;
-        let newest = self.rows.len();
+        // Held raw frames count as later samples.
+        let newest = self.rows.len() + self.held.len();
         let settled = self.rows[from..]
             .iter()
             .enumerate()
@@ -429,6 +848,7 @@ impl Replayer {
     /// summary (probe solutions whose raw frame never came count as
     /// unchecked).
     pub fn finish(mut self) -> (Vec<ReplayRow>, ReplaySummary) {
+        self.end_of_stream();
         self.summary.unchecked += self.early_probe.len() as u64;
         (self.rows, self.summary)
     }

@@ -4,7 +4,10 @@
 //! output) or of a live stream from a serial port (a real probe, or QEMU's
 //! `-serial pty`), and checks the replayed solutions against the probe's
 //! own navigation frames. Live mode shows a running status line and, when
-//! the stream ends, prints the same summary as a file replay.
+//! the stream ends, prints the same summary as a file replay. The probe's
+//! replies to uplink commands in the capture are carried out at the
+//! probe's sample (`host_sim::replay::commands`); `--uplink LOG` gives what
+//! the replies do not carry (toolface indexing's parameters).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -20,11 +23,13 @@ use host_sim::capture::{self, Capture};
 use host_sim::display;
 use host_sim::job::Job;
 use host_sim::live::{self, LiveOptions, LiveSinks};
+use host_sim::replay::commands::{decode_uplink_log, CommandRow};
 use host_sim::replay::{
     self, ReplayRow, ReplaySummary, Replayer, StationRow, StationSummary, StepLoss,
 };
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
+use mwd_core::protocol::uplink::Command as UplinkCommand;
 
 use super::site::SiteArgs;
 
@@ -48,7 +53,11 @@ replay was post-processed with --calibration-file or a site option: differences 
 expected and reported, not a failure); 1 error (unreadable file, not a probe capture, bad \
 argument); 2 bad command line; 3 replayed solutions or station surveys differ from the probe's; 4 all compared \
 solutions identical but some could not be compared (frames lost: the replay stops comparing \
-from the first sample after the loss and starts again at the probe's next boot event)."
+from the first sample after the loss and starts again at the probe's next boot event; or a \
+command the replay cannot repeat: its place lost with frames, a re-align with new settings, \
+a lost reply that shows as the probe's navigation mode differing from the replay's). A \
+command the replay's navigator refuses though the probe acknowledged it, or a navigation \
+mode that differs with no frame lost, is a difference (3)."
 )]
 pub struct Args {
     /// Capture of the probe's UART bytes (`.bin`).
@@ -102,6 +111,11 @@ pub struct Args {
     /// has no tie-in: the job's is not applied.
     #[arg(long, value_name = "JOB.json", conflicts_with_all = ["lat", "lon", "height"])]
     pub job: Option<PathBuf>,
+    /// The bytes the host sent the probe during the capture (its uplink
+    /// commands): what the probe's replies do not carry, toolface
+    /// indexing's parameters, so that its dwell stations are compared too.
+    #[arg(long, value_name = "LOG", conflicts_with = "port")]
+    pub uplink: Option<PathBuf>,
 }
 
 /// A replayed capture: where it came from, the capture, the replayed
@@ -112,6 +126,8 @@ struct Replayed {
     rows: Vec<ReplayRow>,
     summary: ReplaySummary,
     step_losses: Vec<StepLoss>,
+    /// The replies to uplink commands and what the replay did with each.
+    commands: Vec<CommandRow>,
     /// Live: the CSV was written while streaming.
     csv_written: bool,
     /// Replayed station surveys and their comparison; `None` for a live
@@ -134,7 +150,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let replayed = match (&args.port, &args.file) {
         (Some(port), _) => replay_live(&args, port, site, calibration)?,
-        (None, Some(file)) => replay_file(file, site, calibration)?,
+        (None, Some(file)) => {
+            let sent = match &args.uplink {
+                Some(log) => {
+                    let bytes = std::fs::read(log)
+                        .with_context(|| format!("reading the uplink log {}", log.display()))?;
+                    decode_uplink_log(&bytes)
+                }
+                None => Vec::new(),
+            };
+            replay_file(file, site, calibration, &sent)?
+        }
         (None, None) => anyhow::bail!("give a capture file or --port"),
     };
     // Another calibration or site than the QEMU probe's (none, the
@@ -153,15 +179,20 @@ fn replay_file(
     file: &Path,
     site: Position,
     calibration: ProbeCalibration,
+    sent: &[(u16, UplinkCommand)],
 ) -> anyhow::Result<Replayed> {
     let capture = capture::read_probe_capture(file)?;
     let mut replayer = Replayer::with_calibration(site, calibration);
-    for frame in &capture.frames {
-        replayer.push(frame);
+    for (seq, command) in sent {
+        replayer.knows_sent_command(*seq, command);
     }
-    let step_losses = replayer.step_losses().to_vec();
+    for received in capture.in_order() {
+        replayer.push_received(received);
+    }
     let (station_rows, station_summary) = replayer.stations();
     let stations = Some((station_rows.to_vec(), station_summary));
+    let step_losses = replayer.step_losses().to_vec();
+    let commands = replayer.commands().to_vec();
     let (rows, summary) = replayer.finish();
     Ok(Replayed {
         source: file.display().to_string(),
@@ -169,6 +200,7 @@ fn replay_file(
         rows,
         summary,
         step_losses,
+        commands,
         csv_written: false,
         stations,
     })
@@ -243,6 +275,7 @@ fn replay_live(
         rows: outcome.rows,
         summary: outcome.summary,
         step_losses: outcome.step_losses,
+        commands: outcome.commands,
         csv_written: args.csv.is_some(),
         stations: None,
     })
@@ -260,6 +293,7 @@ fn report(
         rows,
         summary,
         step_losses,
+        commands,
         csv_written,
         stations,
     } = replayed;
@@ -278,6 +312,9 @@ fn report(
         summary.mismatched,
         summary.unchecked
     );
+    for command in commands {
+        outln!("uplink           {command}");
+    }
     for loss in step_losses {
         outln!("out of step      {loss}");
     }
@@ -339,9 +376,14 @@ fn report(
         }
         return Ok(ExitCode::from(status::PARITY));
     }
-    if summary.mismatched > 0 || stations_differ > 0 {
+    let differences = step_losses
+        .iter()
+        .filter(|l| l.reason.is_a_difference())
+        .count();
+    if summary.mismatched > 0 || stations_differ > 0 || differences > 0 {
         eprintln!(
-            "error: {} replayed solutions and {stations_differ} station surveys differ from the probe's",
+            "error: {} replayed solutions and {stations_differ} station surveys differ from the \
+             probe's; {differences} commands or navigation modes differ (see \"out of step\")",
             summary.mismatched
         );
         return Ok(ExitCode::from(status::DIFFERENT));
