@@ -269,10 +269,12 @@ pub struct Replayer {
     /// Rows already handed out by [`Replayer::settled_rows`].
     settled: usize,
     station_rows: Vec<StationRow>,
-    /// Replayed stations waiting for the probe's, by station number.
-    awaiting_station: HashMap<u16, usize>,
+    /// Replayed stations waiting for the probe's, by station number, in
+    /// order (a still period's frame may be sent twice: a dwell, then on
+    /// request).
+    awaiting_station: Partners<usize>,
     /// The probe's stations the replay has not finished yet.
-    early_station: HashMap<u16, StationSurvey>,
+    early_station: Partners<StationSurvey>,
     station_summary: StationSummary,
     /// Raw frames waiting for the place of any command before them, with
     /// whether the replay was in step when each came.
@@ -330,6 +332,30 @@ impl Default for RunState {
     }
 }
 
+/// Station frames (or replayed stations) waiting for their partner, by
+/// station number, oldest first.
+struct Partners<T>(HashMap<u16, VecDeque<T>>);
+
+impl<T> Default for Partners<T> {
+    fn default() -> Self {
+        Self(HashMap::new())
+    }
+}
+
+impl<T> Partners<T> {
+    fn add(&mut self, station: u16, item: T) {
+        self.0.entry(station).or_default().push_back(item);
+    }
+
+    fn take(&mut self, station: u16) -> Option<T> {
+        self.0.get_mut(&station)?.pop_front()
+    }
+
+    fn len(&self) -> u64 {
+        self.0.values().map(|q| q.len() as u64).sum()
+    }
+}
+
 /// Whether the replay has seen what the probe's navigation saw.
 #[derive(Debug, Clone, Copy, Default)]
 struct StepTracker {
@@ -366,8 +392,8 @@ impl Replayer {
             step_losses: Vec::new(),
             settled: 0,
             station_rows: Vec::new(),
-            awaiting_station: HashMap::new(),
-            early_station: HashMap::new(),
+            awaiting_station: Partners::default(),
+            early_station: Partners::default(),
             station_summary: StationSummary::default(),
             held: VecDeque::new(),
             scheduled: VecDeque::new(),
@@ -577,11 +603,9 @@ impl Replayer {
             }
             Payload::Station(on_board) => {
                 self.station_summary.probe += 1;
-                match self.awaiting_station.remove(&on_board.station) {
+                match self.awaiting_station.take(on_board.station) {
                     Some(index) => self.compare_station(index, &on_board),
-                    None => {
-                        self.early_station.insert(on_board.station, on_board);
-                    }
+                    None => self.early_station.add(on_board.station, on_board),
                 }
                 None
             }
@@ -673,11 +697,9 @@ impl Replayer {
             matches_probe: None,
             in_step: arrived_in_step && self.compared(counter) && self.run.stations_in_step,
         });
-        match self.early_station.remove(&station.station) {
+        match self.early_station.take(station.station) {
             Some(on_board) => self.compare_station(index, &on_board),
-            None => {
-                self.awaiting_station.insert(station.station, index);
-            }
+            None => self.awaiting_station.add(station.station, index),
         }
     }
 
@@ -705,16 +727,16 @@ impl Replayer {
     pub fn stations(&mut self) -> (&[StationRow], StationSummary) {
         self.end_of_stream();
         let mut summary = self.station_summary;
-        summary.unchecked += self.early_station.len() as u64;
+        summary.unchecked += self.early_station.len();
         (&self.station_rows, summary)
     }
 
     /// Station numbers start again at 1 (a boot, a re-align): older
     /// partners can never match.
     fn forget_station_partners(&mut self) {
-        self.station_summary.unchecked += self.early_station.len() as u64;
-        self.awaiting_station.clear();
-        self.early_station.clear();
+        self.station_summary.unchecked += self.early_station.len();
+        self.awaiting_station = Partners::default();
+        self.early_station = Partners::default();
     }
 
     /// A boot event: the probe started again, so does the replay.
