@@ -12,6 +12,10 @@
 //!    flagged "indexing dwell" once the probe has been still for 3 s.
 //! 4. Take a station now: ACK, and right after it the same still period's
 //!    frame again, now also flagged "requested".
+//! 5. The whole downlink, replayed on the host (`host_sim::replay`, with
+//!    the commands the test sent as the uplink log): every navigation
+//!    frame and every station frame identical bit for bit, each command
+//!    carried out at the probe's sample.
 //!
 //! The probe runs at its real pace (`-icount shift=0,sleep=on`), so the
 //! run takes [`RUN_SECONDS`]. qemu-system-arm must be installed: without it
@@ -22,10 +26,15 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Command, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use hil_mock::StillProbe;
+use host_sim::capture;
+use host_sim::replay::commands::CommandOutcome;
+use host_sim::replay::{self, Replayer};
 use mwd_core::conventions::{wrap_pi, DrillingAngles};
+use mwd_core::earth::Position;
 use mwd_core::protocol::frame::{nav_mode, station_flags};
 use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::{
@@ -56,14 +65,17 @@ enum Seen {
     Reply(Reply),
 }
 
-fn read_downlink(mut pty: File, to: mpsc::Sender<Seen>) {
+/// Reads the downlink until the pty closes; returns every byte read.
+fn read_downlink(mut pty: File, to: mpsc::Sender<Seen>) -> JoinHandle<Vec<u8>> {
     std::thread::spawn(move || {
         let mut decoder = Decoder::new();
+        let mut bytes = Vec::new();
         let mut buf = [0u8; 512];
         while let Ok(n) = pty.read(&mut buf) {
             if n == 0 {
                 break;
             }
+            bytes.extend_from_slice(&buf[..n]);
             for &b in &buf[..n] {
                 let seen = match decoder.push(b).map(|f| f.payload) {
                     Some(Payload::Raw(r)) => Seen::Raw(r.sample_counter),
@@ -78,18 +90,20 @@ fn read_downlink(mut pty: File, to: mpsc::Sender<Seen>) {
                         _ => continue,
                     },
                 };
-                if to.send(seen).is_err() {
-                    return;
-                }
+                // The test may have stopped listening: keep the bytes.
+                let _ = to.send(seen);
             }
         }
-    });
+        bytes
+    })
 }
 
 struct Link {
     pty: File,
     seen: Receiver<Seen>,
     next_seq: u16,
+    /// Every command byte sent: the uplink log of the replay.
+    uplink: Vec<u8>,
 }
 
 impl Link {
@@ -117,6 +131,7 @@ impl Link {
         self.next_seq += 1;
         let mut wire = [0u8; MAX_COMMAND_WIRE_LEN];
         let n = encode_command(seq, command, &mut wire).expect("encode a command");
+        self.uplink.extend_from_slice(&wire[..n]);
         self.pty
             .write_all(&wire[..n])
             .and_then(|()| self.pty.flush())
@@ -182,11 +197,12 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
         .open(&pty_path)
         .expect("open QEMU's pty");
     let (seen_tx, seen) = mpsc::channel();
-    read_downlink(pty.try_clone().expect("a second handle"), seen_tx);
+    let downlink = read_downlink(pty.try_clone().expect("a second handle"), seen_tx);
     let mut link = Link {
         pty,
         seen,
         next_seq: 1,
+        uplink: Vec::new(),
     };
     let mut monitor = qemu.stdin.take().expect("piped");
     monitor
@@ -271,6 +287,10 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
         qemu_out.push('\n');
     }
     assert!(status.success(), "probe-qemu failed: {qemu_out}");
+    // QEMU closed its end of the pty: the reader has every byte.
+    drop(link.pty);
+    let bytes = downlink.join().expect("the downlink reader");
+    let replayed = replay_on_the_host(&bytes, &link.uplink);
     println!(
         "qemu commands: surveying from sample {counter}; dwell station {} samples {}..{}, \
          inclination error {:.3} deg (sigma {:.3}), toolface error {:.3} deg (sigma {:.3})",
@@ -282,4 +302,73 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
         errors[1].to_degrees(),
         sigmas[1].to_degrees()
     );
+    println!("{replayed}");
+}
+
+/// Replays the probe's downlink on the host with the commands sent:
+/// every navigation and station frame must be identical bit for bit.
+fn replay_on_the_host(bytes: &[u8], uplink: &[u8]) -> String {
+    let capture = capture::decode_bytes(bytes);
+    assert_eq!(
+        (capture.stats.lost, capture.stats.corrupt()),
+        (0, 0),
+        "{:?}",
+        capture.stats
+    );
+    let mut replayer = Replayer::new(Position::paper_site());
+    for (seq, command) in replay::commands::decode_uplink_log(uplink) {
+        replayer.knows_sent_command(seq, &command);
+    }
+    for received in capture.in_order() {
+        replayer.push_received(received);
+    }
+    let outcomes: Vec<_> = replayer.commands().iter().map(|c| c.outcome).collect();
+    assert_eq!(
+        outcomes,
+        [
+            CommandOutcome::Refused,
+            CommandOutcome::Replayed,
+            CommandOutcome::Replayed,
+            CommandOutcome::Replayed
+        ],
+        "{:?}",
+        replayer.commands()
+    );
+    assert!(
+        replayer.step_losses().is_empty(),
+        "{:?}",
+        replayer.step_losses()
+    );
+    let surveying_after = replayer.commands()[1]
+        .after_sample
+        .expect("start surveying came after a navigated sample");
+    let (_, st) = replayer.stations();
+    assert_eq!(
+        (
+            st.replayed,
+            st.probe,
+            st.matched,
+            st.mismatched,
+            st.unchecked
+        ),
+        (2, 2, 2, 0, 0),
+        "{st:?}"
+    );
+    let (_, summary) = replayer.finish();
+    assert_eq!(
+        (summary.mismatched, summary.unchecked),
+        (0, 0),
+        "{summary:?}"
+    );
+    assert_eq!(summary.matched, summary.probe_solutions, "{summary:?}");
+    assert_eq!(
+        summary.raw_frames,
+        u64::from(RUN_SECONDS) * 20,
+        "{summary:?}"
+    );
+    format!(
+        "host replay: {} navigation frames and {} station frames identical bit for bit; \
+         start surveying replayed after sample {surveying_after}",
+        summary.matched, st.matched
+    )
 }
