@@ -1,0 +1,329 @@
+//! The replay's unit tests (frames without commands).
+
+use super::*;
+use mwd_core::protocol::frame::raw_flags;
+use mwd_core::protocol::{RawPart, RawSample};
+use mwd_core::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+
+fn raw(n: u32) -> Frame {
+    let parts = PART_MOUNTINGS.map(|m| RawPart {
+        accel: m
+            .body_to_sensor([0.0, 0.0, STANDARD_GRAVITY_M_S2])
+            .map(m_s2_to_accel_count),
+        flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
+        ..RawPart::default()
+    });
+    Frame {
+        seq: n as u16,
+        payload: Payload::Raw(RawSample {
+            time_us: u64::from(n) * 50_000,
+            sample_counter: n,
+            parts,
+        }),
+    }
+}
+
+#[test]
+fn replay_matches_the_same_code_and_catches_a_changed_solution() {
+    let site = Position::paper_site();
+    let raws: Vec<Frame> = (0..150).map(raw).collect();
+    // The "probe's" solutions: the same navigation run once already.
+    let (first, _) = replay(&raws, site);
+    let mut capture = Vec::new();
+    for (frame, row) in raws.iter().zip(&first) {
+        let mut nav = row.solution;
+        if nav.sample_counter == 120 {
+            nav.attitude[2] += 1e-6;
+        }
+        capture.extend(numbered(capture.len(), [frame.payload, Payload::Nav(nav)]));
+    }
+    let (rows, summary) = replay(&capture, site);
+    assert_eq!(rows.len(), 150);
+    assert_eq!(
+        summary,
+        ReplaySummary {
+            raw_frames: 150,
+            probe_solutions: 150,
+            matched: 149,
+            mismatched: 1,
+            unchecked: 0,
+            degraded: 0,
+            restarts: 0,
+        }
+    );
+    let mut csv = Vec::new();
+    write_csv(&rows, &mut csv).unwrap();
+    let text = String::from_utf8(csv).unwrap();
+    assert_eq!(text.lines().count(), 151);
+    assert!(text.lines().nth(121).unwrap().ends_with(",no"));
+}
+
+/// Frames numbered from `first` on, as the probe numbers them.
+fn numbered(first: usize, payloads: impl IntoIterator<Item = Payload>) -> Vec<Frame> {
+    (first..)
+        .zip(payloads)
+        .map(|(seq, payload)| Frame {
+            seq: seq as u16,
+            payload,
+        })
+        .collect()
+}
+
+/// A probe run as the probe sends it: boot event, then per sample the
+/// raw frame and its navigation frame, numbered from 0.
+fn probe_run(samples: u32) -> Vec<Frame> {
+    let site = Position::paper_site();
+    let mut navigator = Navigator::new(site);
+    let boot = Payload::Event(mwd_core::protocol::Event {
+        time_us: 0,
+        kind: EventKind::Boot,
+        part: mwd_core::protocol::frame::NO_PART,
+        code: 1,
+        value: 0,
+    });
+    let payloads = std::iter::once(boot).chain((0..samples).flat_map(|n| {
+        let Payload::Raw(r) = raw(n).payload else {
+            unreachable!()
+        };
+        [Payload::Raw(r), Payload::Nav(navigator.step(&r))]
+    }));
+    numbered(0, payloads.collect::<Vec<_>>())
+}
+
+#[test]
+fn a_lost_raw_frame_stops_the_comparison_there_and_a_boot_restarts_it() {
+    let site = Position::paper_site();
+    // Raw frame of sample 69 lost (frame 139: boot, then two per sample).
+    let mut capture = probe_run(130);
+    capture.remove(139);
+    // The probe reboots and runs again.
+    capture.extend(probe_run(130));
+    let mut replayer = Replayer::new(site);
+    for frame in &capture {
+        replayer.push(frame);
+    }
+    assert_eq!(
+        replayer.step_losses(),
+        &[StepLoss {
+            run: 0,
+            from_sample: 70,
+            reason: StepLossReason::RawFramesLost
+        }]
+    );
+    let (rows, summary) = replayer.finish();
+    assert_eq!(
+        summary,
+        ReplaySummary {
+            raw_frames: 129 + 130,
+            probe_solutions: 260,
+            // 0..=68 of the first run, all 130 of the second.
+            matched: 69 + 130,
+            mismatched: 0,
+            // 70..130 of the first run, and sample 69's own.
+            unchecked: 60 + 1,
+            degraded: 0,
+            restarts: 1,
+        }
+    );
+    assert!(rows[69..129]
+        .iter()
+        .all(|r| !r.in_step && r.matches_probe.is_none()));
+    assert!(rows[129..]
+        .iter()
+        .all(|r| r.in_step && r.matches_probe == Some(true)));
+}
+
+#[test]
+fn samples_the_probe_skipped_itself_keep_the_replay_in_step() {
+    // A resynchronisation: no raw frame for samples 51 and 52, no
+    // frame lost (the numbers run on).
+    let mut navigator = Navigator::new(Position::paper_site());
+    let payloads = (0..100u32).filter(|n| !(51..53).contains(n)).flat_map(|n| {
+        let Payload::Raw(r) = raw(n).payload else {
+            unreachable!()
+        };
+        [Payload::Raw(r), Payload::Nav(navigator.step(&r))]
+    });
+    let capture = numbered(0, payloads.collect::<Vec<_>>());
+    let mut replayer = Replayer::new(Position::paper_site());
+    for frame in &capture {
+        replayer.push(frame);
+    }
+    assert!(replayer.step_losses().is_empty());
+    let (_, summary) = replayer.finish();
+    assert_eq!((summary.matched, summary.unchecked), (98, 0));
+}
+
+#[test]
+fn a_capture_that_starts_mid_run_is_not_compared() {
+    let capture = probe_run(120);
+    let mut replayer = Replayer::new(Position::paper_site());
+    for frame in &capture[21..] {
+        replayer.push(frame);
+    }
+    assert_eq!(replayer.step_losses()[0].from_sample, 10);
+    let (_, summary) = replayer.finish();
+    assert_eq!((summary.matched, summary.mismatched), (0, 0));
+}
+
+#[test]
+fn lost_navigation_frames_alone_keep_the_replay_in_step() {
+    let mut capture = probe_run(120);
+    capture.retain(|f| f.seq % 10 != 4);
+    let mut replayer = Replayer::new(Position::paper_site());
+    for frame in &capture {
+        replayer.push(frame);
+    }
+    assert!(replayer.step_losses().is_empty());
+    let (_, summary) = replayer.finish();
+    assert_eq!(
+        (summary.matched, summary.mismatched, summary.unchecked),
+        (96, 0, 0)
+    );
+}
+
+#[test]
+fn the_csv_never_shows_an_undetermined_azimuth_and_reads_0_to_360() {
+    let solution = NavSolution {
+        attitude: [-0.5, 0.1, -1.0],
+        attitude_std: [0.01, 0.01, f32::INFINITY],
+        ..NavSolution::default()
+    };
+    let row = ReplayRow {
+        solution,
+        matches_probe: Some(true),
+        in_step: true,
+    };
+    let mut determined = row;
+    determined.solution.attitude_std[2] = 0.01;
+    let mut placeholder = row;
+    placeholder.solution.attitude = [f32::NAN; 3];
+    let mut csv = Vec::new();
+    write_csv(&[row, determined, placeholder], &mut csv).unwrap();
+    let text = String::from_utf8(csv).unwrap();
+    let cells: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+    let col = |name: &str| cells[0].iter().position(|c| *c == name).unwrap();
+    let (az, status, tf) = (
+        col("azimuth_deg"),
+        col("azimuth_status"),
+        col("toolface_deg"),
+    );
+    assert_eq!((cells[1][az], cells[1][status]), ("", "undetermined"));
+    assert_eq!(cells[2][status], "determined");
+    let azimuth: f64 = cells[2][az].parse().unwrap();
+    assert!(
+        (azimuth - (360.0 - 1f64.to_degrees())).abs() < 1e-4,
+        "{azimuth}"
+    );
+    let toolface: f64 = cells[1][tf].parse().unwrap();
+    assert!(
+        (toolface - (360.0 - 0.5f64.to_degrees())).abs() < 1e-4,
+        "{toolface}"
+    );
+    assert_eq!(
+        (cells[3][az], cells[3][status], cells[3][tf]),
+        ("", "n/a", "NaN")
+    );
+}
+
+#[test]
+fn a_replay_applies_the_probes_calibration() {
+    use mwd_core::calibration::{ProbeCalibration, TriadCalibration};
+    // The same still, level samples; a calibration claiming a body-x
+    // accelerometer bias of 10 counts tilts the replayed roll by
+    // atan(bias / g), as the probe with that calibration would.
+    let site = Position::paper_site();
+    let raws: Vec<Frame> = (0..120).map(raw).collect();
+    let bias = 10.0 * f64::from(STANDARD_GRAVITY_M_S2) / 650.0;
+    let triad = TriadCalibration {
+        bias: [bias, 0.0, 0.0],
+        ..TriadCalibration::IDENTITY
+    };
+    let calibration = ProbeCalibration {
+        accel: [triad; 2],
+        ..ProbeCalibration::default()
+    };
+    let (plain, _) = replay(&raws, site);
+    let (calibrated, _) = replay_with(&raws, site, calibration);
+    let roll = |rows: &[ReplayRow]| f64::from(rows[110].solution.attitude[0]);
+    let expected = (bias / f64::from(STANDARD_GRAVITY_M_S2)).atan();
+    assert!(roll(&plain).abs() < 1e-3, "{}", roll(&plain));
+    assert!((roll(&calibrated).abs() - expected).abs() < 0.05 * expected);
+}
+
+/// A probe run that navigates, turns, stops for 30 s and turns again,
+/// as the probe sends it (the station frame after its cycle's
+/// navigation frame): the replay finishes the same station and finds it
+/// identical; a changed station is caught.
+#[test]
+fn station_surveys_are_replayed_and_compared_bit_for_bit() {
+    use mwd_core::sensor_units::rad_s_to_gyro_count;
+    let site = Position::paper_site();
+    let turning = |n: u32| {
+        let mut frame = raw(n);
+        if let Payload::Raw(r) = &mut frame.payload {
+            for (part, m) in r.parts.iter_mut().zip(PART_MOUNTINGS) {
+                part.gyro_rate = rad_s_to_gyro_count(m.gyro_rate_from_body([0.0, 0.0, 0.05]));
+            }
+        }
+        frame
+    };
+    let aligned = 1200;
+    let mut navigator = Navigator::new(site);
+    let mut payloads = Vec::new();
+    for n in 0..aligned + 1000 {
+        let moving = (aligned..aligned + 100).contains(&n) || n >= aligned + 700;
+        let frame = if moving { turning(n) } else { raw(n) };
+        let Payload::Raw(r) = frame.payload else {
+            unreachable!()
+        };
+        payloads.push(Payload::Raw(r));
+        payloads.push(Payload::Nav(navigator.step(&r)));
+        payloads.extend(navigator.take_station().map(Payload::Station));
+    }
+    let stations: Vec<StationSurvey> = payloads
+        .iter()
+        .filter_map(|p| match p {
+            Payload::Station(s) => Some(*s),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(stations.len(), 1, "{stations:?}");
+    // The settled survey: 40-80 still cycles before the last one,
+    // aligned + 699 (`SURVEY_SETTLE_EPOCHS`).
+    let before = aligned + 699 - stations[0].end_sample;
+    assert!((40..=80).contains(&before), "{before}");
+    let capture = numbered(0, payloads.clone());
+    let mut replayer = Replayer::new(site);
+    capture.iter().for_each(|f| {
+        replayer.push(f);
+    });
+    let (rows, summary) = replayer.stations();
+    assert_eq!(
+        summary,
+        StationSummary {
+            replayed: 1,
+            probe: 1,
+            matched: 1,
+            ..StationSummary::default()
+        }
+    );
+    assert_eq!(rows[0].matches_probe, Some(true));
+    // One bit of the probe's toolface sigma changed: caught.
+    let changed: Vec<Payload> = payloads
+        .into_iter()
+        .map(|p| match p {
+            Payload::Station(mut s) => {
+                s.angles_std[2] = f32::from_bits(s.angles_std[2].to_bits() ^ 1);
+                Payload::Station(s)
+            }
+            p => p,
+        })
+        .collect();
+    let mut replayer = Replayer::new(site);
+    numbered(0, changed).iter().for_each(|f| {
+        replayer.push(f);
+    });
+    let (_, summary) = replayer.stations();
+    assert_eq!((summary.matched, summary.mismatched), (0, 1));
+}
