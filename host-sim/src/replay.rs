@@ -41,7 +41,7 @@ use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::decoder::starts_a_run;
-use mwd_core::protocol::frame::{nav_flags, MAX_BODY_LEN};
+use mwd_core::protocol::frame::{nav_flags, station_flags, MAX_BODY_LEN};
 use mwd_core::protocol::uplink::IndexingProcedure;
 use mwd_core::protocol::{
     encode_body, EventKind, Frame, NavSolution, Payload, RawSample, StationSurvey,
@@ -144,6 +144,10 @@ pub enum StepLossReason {
     /// Toolface indexing without its parameters: the station surveys (not
     /// the navigation) are not compared until the run re-aligns or ends.
     IndexingUnknown { command_seq: u16 },
+    /// A station sent on request or as an indexing dwell by the probe or
+    /// the replay only, with frames lost: a lost reply. Station surveys
+    /// only, as for `IndexingUnknown`.
+    StationCommandLost { station: u16 },
 }
 
 impl StepLossReason {
@@ -197,6 +201,11 @@ impl std::fmt::Display for StepLoss {
                 };
                 format!("the probe's navigation mode is {probe_mode}, the replay's {replay_mode}; {cause}")
             }
+            StepLossReason::StationCommandLost { station } => format!(
+                "station surveys only: station {station} was sent on a command by one side \
+                 only, and frames were lost: most likely a reply to take a station or \
+                 toolface indexing"
+            ),
             StepLossReason::IndexingUnknown { command_seq } => format!(
                 "station surveys only: toolface indexing (command {command_seq}) without its \
                  parameters (give the uplink log)"
@@ -429,7 +438,10 @@ impl Replayer {
 
     /// Stops the comparison of this run's samples from `from_sample` on.
     fn lose_from(&mut self, from_sample: u32, reason: StepLossReason) {
-        let stations_only = matches!(reason, StepLossReason::IndexingUnknown { .. });
+        let stations_only = matches!(
+            reason,
+            StepLossReason::IndexingUnknown { .. } | StepLossReason::StationCommandLost { .. }
+        );
         if stations_only {
             self.run.stations_in_step = false;
         } else {
@@ -598,6 +610,17 @@ impl Replayer {
         }
         let same = encoded_payload(&Payload::Station(*on_board))
             == encoded_payload(&Payload::Station(row.station));
+        let by_command = station_flags::REQUESTED | station_flags::INDEXING_DWELL;
+        if !same && (on_board.flags ^ row.station.flags) & by_command != 0 && self.run.lost_in_run {
+            // Sent on a command on one side only, frames lost: most likely
+            // a lost reply, not a difference.
+            row.in_step = false;
+            self.station_summary.unchecked += 1;
+            let station = on_board.station;
+            let from = self.run.stepped_through.unwrap_or(0);
+            self.lose_from(from, StepLossReason::StationCommandLost { station });
+            return;
+        }
         row.matches_probe = Some(same);
         if same {
             self.station_summary.matched += 1;

@@ -20,7 +20,9 @@ use mwd_core::protocol::uplink::{
     encode_command, Command, IndexingProcedure, NakReason, Reply, ReplyStatus, MAX_COMMAND_WIRE_LEN,
 };
 use mwd_core::protocol::{Event, EventKind, Payload, RawPart, RawSample, StationSurvey};
-use mwd_core::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+use mwd_core::sensor_units::{
+    m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
+};
 
 /// A still, level probe's sample `n`.
 fn still(n: u32) -> RawSample {
@@ -58,6 +60,8 @@ struct Probe {
     sent: Vec<Sent>,
     out: CaptureWriter<Vec<u8>>,
     uplink: Vec<u8>,
+    /// The tool turns about its axis from this sample on.
+    turning_from: Option<u32>,
 }
 
 impl Probe {
@@ -69,6 +73,7 @@ impl Probe {
             sent: Vec::new(),
             out: CaptureWriter::new(Vec::new()),
             uplink: Vec::new(),
+            turning_from: None,
         };
         // Power-on, defaults, version 0 (docs/protocol.md "Event codes").
         probe.write(Payload::Event(Event {
@@ -92,6 +97,17 @@ impl Probe {
         });
     }
 
+    /// Sample `n`: still, or turning at 0.05 rad/s about the body z axis.
+    fn sample(&self, n: u32) -> RawSample {
+        let mut raw = still(n);
+        if self.turning_from.is_some_and(|from| n >= from) {
+            for (part, m) in raw.parts.iter_mut().zip(PART_MOUNTINGS) {
+                part.gyro_rate = rad_s_to_gyro_count(m.gyro_rate_from_body([0.0, 0.0, 0.05]));
+            }
+        }
+        raw
+    }
+
     /// Runs `samples` samples, the navigation `lag` samples behind the
     /// acquisition; each command of `commands` is served after the
     /// navigation of its sample, as the main loop does.
@@ -99,12 +115,12 @@ impl Probe {
         let mut seq = 1;
         for n in 0..samples + lag {
             if n < samples {
-                self.write(Payload::Raw(still(n)));
+                self.write(Payload::Raw(self.sample(n)));
             }
             let Some(navigated) = n.checked_sub(lag) else {
                 continue;
             };
-            let solution = self.navigator.step(&still(navigated));
+            let solution = self.navigator.step(&self.sample(navigated));
             self.write(Payload::Nav(solution));
             if let Some(station) = self.navigator.take_station() {
                 self.write(Payload::Station(station));
@@ -343,6 +359,44 @@ fn a_lost_reply_shows_as_a_mode_the_replay_is_not_in_never_as_silent_parity() {
         (summary.matched, summary.mismatched, summary.unchecked),
         (131, 0, 369)
     );
+}
+
+#[test]
+fn a_lost_reply_to_take_a_station_is_not_called_a_difference() {
+    let mut probe = Probe::new();
+    // Still until sample 600, then turning: the still period's station is
+    // sent on request at 400, and its end sends nothing more.
+    probe.turning_from = Some(600);
+    let commands = [(130, Command::StartSurveying), (400, Command::TakeStation)];
+    probe.run(700, 1, &commands);
+    let (bytes, sent, _) = probe.bytes();
+    let mut whole = replayed(&bytes, None);
+    let (_, st) = whole.stations();
+    assert_eq!((st.replayed, st.probe, st.matched), (1, 1, 1), "{st:?}");
+
+    // The ACK (command 2) lost: the replay ends the station at the turn,
+    // unflagged, against the probe's requested frame.
+    let mut replayer = replayed(&capture::without_frame(&bytes, reply_index(&sent, 2)), None);
+    let (rows, st) = replayer.stations();
+    assert_eq!(rows[0].station.flags & station_flags::REQUESTED, 0);
+    assert_eq!(
+        (
+            st.replayed,
+            st.probe,
+            st.matched,
+            st.mismatched,
+            st.unchecked
+        ),
+        (1, 1, 0, 0, 1),
+        "{st:?}"
+    );
+    assert_eq!(
+        replayer.step_losses()[0].reason,
+        StepLossReason::StationCommandLost { station: 1 }
+    );
+    // The navigation is untouched by the command: still compared.
+    let (_, summary) = replayer.finish();
+    assert_eq!((summary.mismatched, summary.unchecked), (0, 0));
 }
 
 #[test]
