@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{run, s, scratch};
+use common::{refused, run, s, scratch};
 use host_sim::capture::{self, CaptureWriter};
 use host_sim::replay::commands::CommandOutcome;
 use host_sim::replay::{self, Replayer, StepLossReason};
@@ -65,7 +65,13 @@ struct Probe {
 }
 
 impl Probe {
+    /// Power-on, defaults, version 0 (docs/protocol.md "Event codes").
     fn new() -> Self {
+        Self::booted(0x0101)
+    }
+
+    /// A probe whose boot event's value is `boot_value`.
+    fn booted(boot_value: u32) -> Self {
         let mut probe = Self {
             navigator: Navigator::new(Position::paper_site()),
             site: Position::paper_site(),
@@ -75,13 +81,12 @@ impl Probe {
             uplink: Vec::new(),
             turning_from: None,
         };
-        // Power-on, defaults, version 0 (docs/protocol.md "Event codes").
         probe.write(Payload::Event(Event {
             time_us: 0,
             kind: EventKind::Boot,
             part: NO_PART,
             code: 1,
-            value: 0x0101,
+            value: boot_value,
         }));
         probe.sent.push(Sent::Boot);
         probe
@@ -323,6 +328,30 @@ fn a_realign_replays_and_one_with_a_new_site_is_not_compared_after_it() {
     );
 }
 
+#[test]
+fn a_reboot_into_another_configuration_is_not_compared() {
+    let mut first = Probe::new();
+    first.run(150, 1, &[]);
+    // Software reset, configuration 2 from flash: settings the capture
+    // does not carry.
+    let mut second = Probe::booted(0x0002_0203);
+    second.run(150, 1, &[]);
+    let mut bytes = first.bytes().0;
+    bytes.extend(second.bytes().0);
+    let replayer = replayed(&bytes, None);
+    let losses: Vec<_> = replayer
+        .step_losses()
+        .iter()
+        .map(|l| (l.run, l.from_sample, l.reason))
+        .collect();
+    assert_eq!(losses, [(1, 0, StepLossReason::ConfigurationChanged)]);
+    let (_, summary) = replayer.finish();
+    assert_eq!(
+        (summary.matched, summary.unchecked, summary.restarts),
+        (150, 150, 1)
+    );
+}
+
 /// The frame index of the reply to `command_seq`.
 fn reply_index(sent: &[Sent], command_seq: u16) -> usize {
     sent.iter()
@@ -509,5 +538,8 @@ fn the_cli_replays_the_commands_and_exits_by_what_it_could_compare() {
         "{}",
         lost_reply.stdout
     );
+    let missing = dir.join("no-such-log.bin");
+    let bad_log = run(&["replay", s(&capture), "--uplink", s(&missing)]);
+    refused(&bad_log, "uplink log");
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -42,7 +42,7 @@ mod status {
     pub const DIFFERENT: u8 = 3;
     /// Everything compared was identical, but some probe solutions could
     /// not be compared (frames lost, the capture starts mid-run, the probe
-    /// dropped samples).
+    /// dropped samples, a command the replay cannot repeat).
     pub const INCOMPLETE: u8 = 4;
 }
 
