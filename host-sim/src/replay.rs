@@ -199,7 +199,13 @@ impl std::fmt::Display for StepLoss {
                 } else {
                     "no frame was lost: the replay DIFFERS from the probe"
                 };
-                format!("the probe's navigation mode is {probe_mode}, the replay's {replay_mode}; {cause}")
+                let name = |mode| crate::live::mode_name(mode).trim_end();
+                format!(
+                    "the probe's navigation mode is {} ({probe_mode}), the replay's {} \
+                     ({replay_mode}); {cause}",
+                    name(probe_mode),
+                    name(replay_mode)
+                )
             }
             StepLossReason::StationCommandLost { station } => format!(
                 "station surveys only: station {station} was sent on a command by one side \
@@ -259,8 +265,10 @@ pub fn replay_capture(
 pub const SETTLE_AFTER_SAMPLES: usize = 64;
 
 /// The replay one frame at a time, for a live stream: a raw frame is
-/// replayed as soon as it arrives. The probe sends a sample's navigation
-/// frame after its raw frame, but nothing here relies on that order: a
+/// replayed as soon as the probe's navigation frame of its sample (or a
+/// later one) has come, which places it among the commands' replies (see
+/// the module's notes). The probe sends a sample's navigation frame after
+/// its raw frame, but the comparison does not rely on that order: a
 /// solution waits for its partner on either side.
 pub struct Replayer {
     position: Position,

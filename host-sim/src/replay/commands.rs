@@ -197,7 +197,7 @@ impl Replayer {
 
     /// Takes a reply to an uplink command: an acknowledged command that
     /// changes the navigator is carried out after the sample of the last
-    /// navigation frame before it ([`commands`]).
+    /// navigation frame before it (the module's notes).
     pub fn push_reply(&mut self, seq: u16, reply: &Reply) {
         self.note_seq(seq);
         self.step.seen_any = true;
