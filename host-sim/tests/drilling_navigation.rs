@@ -45,6 +45,10 @@ struct Run {
     /// The filter's x and z rate-bias 1-sigma (rad/s) when tied in and
     /// after each station.
     bias_std: Vec<[f32; 2]>,
+    /// Per connection turn: the heading error's change (rad) from the last
+    /// still sample before the orienter turns to 3 s into the drilling
+    /// after it, and the heading sigma then.
+    turn_heading_changes: Vec<(f64, f64)>,
 }
 
 fn run(plan_json: &str, seed: u64) -> Run {
@@ -63,7 +67,11 @@ fn run(plan_json: &str, seed: u64) -> Run {
         max_speed: 0.0,
         max_tilt_std: 0.0,
         bias_std: Vec::new(),
+        turn_heading_changes: Vec::new(),
     };
+    // (heading error at the last still sample, drilling samples since).
+    let mut turn: Option<(f64, u32)> = None;
+    let mut last_still_heading_error = None;
     let bias_std = |n: &Navigator| {
         let k = n.filter().filter();
         [k.std_dev(GYRO_BIAS), k.std_dev(GYRO_BIAS + 2)]
@@ -106,6 +114,28 @@ fn run(plan_json: &str, seed: u64) -> Run {
             out.max_tilt_std = out
                 .max_tilt_std
                 .max(f64::from(frame.attitude_std[0].max(frame.attitude_std[1])));
+        }
+        if tied {
+            let heading_error = wrap_pi(f64::from(frame.attitude[2]) - s.truth.euler().heading);
+            match s.truth.state {
+                DrillState::Still => last_still_heading_error = Some(heading_error),
+                DrillState::Connection => {
+                    if let Some(e) = last_still_heading_error.take() {
+                        turn = Some((e, 0));
+                    }
+                }
+                DrillState::Drilling => {
+                    if let Some((e, k)) = turn.as_mut() {
+                        *k += 1;
+                        if *k == 60 {
+                            let sigma = navigator.filter().euler_std().z;
+                            out.turn_heading_changes
+                                .push((wrap_pi(heading_error - *e), sigma));
+                            turn = None;
+                        }
+                    }
+                }
+            }
         }
         if std::env::var("DIAG").is_ok() && tied && index % 600 == 0 {
             let e = s.truth.euler();
@@ -252,4 +282,18 @@ fn drilling_keeps_velocity_and_tilt_bounded_and_stations_come() {
         r.max_tilt_std / DEG
     );
     assert!(r.stations.len() >= 2, "{} stations", r.stations.len());
+    // A connection's toolface turn leaves the heading where it was: the
+    // still detector sees the turn a few samples late and the vibration
+    // comes before the jitter window holds it, and both went, unmodelled,
+    // through the non-holonomic updates into the heading (up to 8 deg per
+    // connection against a 7 deg sigma before; derivation section 4h).
+    assert!(!r.turn_heading_changes.is_empty());
+    for (change, sigma) in &r.turn_heading_changes {
+        eprintln!(
+            "connection turn: heading error moved {:.3} deg (sigma {:.2} deg)",
+            change / DEG,
+            sigma / DEG
+        );
+        assert!(change.abs() < 0.5 * DEG, "{} deg", change / DEG);
+    }
 }

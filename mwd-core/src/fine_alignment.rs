@@ -215,20 +215,25 @@ impl StepNoise {
 /// How the bias states' random walk is added in the following steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BiasWalk {
-    /// The Gauss-Markov instability's one-step increment variance every
-    /// step (derivation section 3b): an alignment or a station, where the
-    /// biases are observed and the walk stays small against what the
-    /// updates learn.
+    /// The Gauss-Markov instability's one-step increment variance on every
+    /// bias state, every step (derivation section 3b): the alignment, about
+    /// a minute against tau = 100 s, where the walk stays small against
+    /// what the updates learn.
     EveryStep,
-    /// The same increments damped by exp(-dt/tau) per step since the last
-    /// [`EveryStep`](Self::EveryStep) step: over T unobserved they sum to
-    /// 2 sigma^2 (1 - exp(-T/tau)), the variance of the true instability's
-    /// change over T, never more than 2 sigma^2. A random walk over an hour
-    /// of drilling would add 72 sigma^2 (2 T / tau) for a change the
-    /// process cannot make. Conservative: the estimate's own error is
-    /// positively correlated with the instability it has absorbed, which
-    /// the change then partly undoes (derivation section 4g).
-    BoundedSinceObserved,
+    /// Navigation, for hours: the gyro (x, z) bias states hold the residual
+    /// constant bias only, and the instability enters as white rate noise
+    /// at its zero-frequency density 2 sigma^2 tau. A first-order
+    /// Gauss-Markov spectrum 2 sigma^2 tau / (1 + (2 pi f tau)^2) never
+    /// exceeds that, so every linear function of the noise (a heading
+    /// drift, a station's bias mean) has at most the variance the filter
+    /// computes, at every time scale. A random walk on the bias state
+    /// instead would add 72 sigma^2 per hour (2 T / tau) for a change the
+    /// process cannot make, and one bounded by the instability's own
+    /// increment makes the filter carry a station's instability into the
+    /// next hour's heading drift, which it has forgotten after ~tau
+    /// (derivation section 4h). The accelerometer and tool-axis biases walk
+    /// as in [`EveryStep`](Self::EveryStep).
+    InstabilityAsRateNoise,
 }
 
 /// The accelerometer biases' estimate (m/s^2, body axes) and covariance
@@ -272,10 +277,8 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     /// see [`hold_tool_axis`](Self::hold_tool_axis).
     held_tool_axis: bool,
     bias_walk: BiasWalk,
-    /// Per bias state (accelerometers x, y, z then rates): the factor on
-    /// its random-walk variance this step (1 while
-    /// [`BiasWalk::EveryStep`]), and the variance added since the start.
-    bias_walk_factor: [f64; 6],
+    /// Per bias state (accelerometers x, y, z then rates): the random-walk
+    /// variance added since the start.
     bias_walk_added: [f64; 6],
 }
 
@@ -294,7 +297,6 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             rejected_samples: 0,
             held_tool_axis: false,
             bias_walk: BiasWalk::EveryStep,
-            bias_walk_factor: [1.0; 6],
             bias_walk_added: [0.0; 6],
         };
         alignment.restart(initial, reference, config);
@@ -341,7 +343,6 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.rejected_samples = 0;
         self.held_tool_axis = false;
         self.bias_walk = BiasWalk::EveryStep;
-        self.bias_walk_factor = [1.0; 6];
         self.bias_walk_added = [0.0; 6];
     }
 
@@ -407,6 +408,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         } else {
             self.filter.predict(&phi, &q);
         }
+        self.add_gyro_instability_noise(&c_bn);
 
         let zero_velocity = match self.config.zero_velocity_variance {
             Some(_) if extra.skip_updates => UpdateReport::default(),
@@ -435,8 +437,8 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
     }
 
-    /// Applies this step's bias-walk factors to `q` and moves them on
-    /// ([`BiasWalk`]); keeps the total added per bias.
+    /// Sets this step's bias random walk in `q` ([`BiasWalk`]); keeps the
+    /// total added per bias.
     fn scale_bias_walk(&mut self, q: &mut SVector<T, N>) {
         if N != STATES_WITH_BIASES {
             return;
@@ -445,20 +447,52 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         let states = biases.accel.iter().chain(biases.gyro.iter());
         for (k, bias) in states.enumerate() {
             let i = ACCEL_BIAS + k; // the rate biases follow the accelerometers'
-            let factor = match self.bias_walk {
-                BiasWalk::EveryStep => 1.0,
-                BiasWalk::BoundedSinceObserved => self.bias_walk_factor[k],
+            let constant = self.bias_walk == BiasWalk::InstabilityAsRateNoise
+                && (i == GYRO_BIAS || i == GYRO_BIAS + 2);
+            let walk = if constant {
+                0.0
+            } else {
+                bias.variance_per_step
             };
-            q[i] = T::of(bias.variance_per_step * factor);
-            self.bias_walk_added[k] += bias.variance_per_step * factor;
-            self.bias_walk_factor[k] = factor * bias.step_correlation;
+            q[i] = T::of(walk);
+            self.bias_walk_added[k] += walk;
         }
     }
 
     /// How the bias random walk is added from the next step on
-    /// ([`BiasWalk`]); switching to `EveryStep` restarts the bound.
+    /// ([`BiasWalk`]). Switching a filter that has run to
+    /// [`BiasWalk::InstabilityAsRateNoise`] adds sigma^2 of the instability
+    /// to the gyro bias variances: the estimate has absorbed the
+    /// instability's value of the alignment, which from now on is not part
+    /// of the constant it stands for. A fresh filter's initial variance
+    /// already holds it.
     pub fn set_bias_walk(&mut self, walk: BiasWalk) {
+        let switching = walk == BiasWalk::InstabilityAsRateNoise && self.bias_walk != walk;
+        if switching && self.steps > 0 && N == STATES_WITH_BIASES {
+            for axis in [0, 2] {
+                let sigma = self.config.model.biases.gyro[axis].instability_sigma;
+                let i = GYRO_BIAS + axis;
+                self.filter.p[(i, i)] += T::of(sigma * sigma);
+            }
+        }
         self.bias_walk = walk;
+    }
+
+    /// The gyros' instability as white rate noise (x and z body axes,
+    /// [`BiasWalk::InstabilityAsRateNoise`]): C_b^n diag(S_x, 0, S_z) C_n^b
+    /// dt on the attitude error, S = 2 sigma^2 tau.
+    fn add_gyro_instability_noise(&mut self, c_bn: &Matrix3<f64>) {
+        if self.bias_walk != BiasWalk::InstabilityAsRateNoise || N != STATES_WITH_BIASES {
+            return;
+        }
+        let gyro = &self.config.model.biases.gyro;
+        let dt = self.config.model.dt;
+        // The sum of the two gyro axes' outer products (columns x and z of
+        // C_b^n): a third of the multiplies of C D C^T.
+        let (x, z) = (c_bn.column(0), c_bn.column(2));
+        let q = x * x.transpose() * (gyro[0].instability_density * dt)
+            + z * z.transpose() * (gyro[2].instability_density * dt);
+        self.add_attitude_noise(&q);
     }
 
     /// The time update when the tool-axis rate is held: the rate fed to the
@@ -554,11 +588,14 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// Ends the alignment: no more zero-velocity or zero-position updates,
     /// and F21 takes the measured specific force (the tool may now move).
     /// The filter goes on propagating, so the estimated biases keep being
-    /// compensated and the covariance grows as the errors do.
+    /// compensated and the covariance grows as the errors do; from here the
+    /// gyro biases are constants and their instability rate noise
+    /// ([`BiasWalk::InstabilityAsRateNoise`]): navigation lasts hours.
     pub fn start_navigation(&mut self) {
         self.config.zero_velocity_variance = None;
         self.config.zero_position_variance = None;
         self.config.specific_force = SpecificForceInModel::MeasuredSample;
+        self.set_bias_walk(BiasWalk::InstabilityAsRateNoise);
     }
 
     /// Linearises F21 (the velocity error's f^n x phi) at the gravity
@@ -916,63 +953,68 @@ mod tests {
     /// under 2 sigma^2, where the walk has added 2 sigma^2 T/tau = 72
     /// sigma^2. Switching back to every-step restarts the bound.
     #[test]
-    fn the_bounded_bias_walk_adds_the_instabilitys_increment() {
+    fn navigation_keeps_the_gyro_bias_constant_and_adds_the_instability_as_rate_noise() {
         let site = Position::paper_site();
-        let noise = ImuNoise::scc1300();
+        // The instability alone drives the heading: no white or AR gyro
+        // noise, a small heading sigma (its large-angle drift term off).
+        let mut noise = ImuNoise::scc1300();
+        for g in &mut noise.gyro {
+            g.white_density = 0.0;
+        }
         let mut config = FineAlignmentConfig::<STATES_WITH_BIASES>::physical(
             AugmentedModel::paper(),
             &noise,
-            &[0.01, 0.01, 0.1],
+            &[0.01, 0.01, 0.01],
             site.lat,
         );
         config.zero_velocity_variance = None;
         config.zero_position_variance = None;
+        config.ar_noise_scale = 0.0;
         let dt = config.model.dt;
         let mut fa = FineAlignment::<f64, STATES_WITH_BIASES>::new(
             NavState::at_rest(UnitQuaternion::identity(), site),
             site,
             config,
         );
-        let g = -gravity_n(&site);
         let at_rest = ImuSample {
             rate: earth_rate_n(site.lat),
-            specific_force: g,
+            specific_force: -gravity_n(&site),
         };
-        let bias_variance = |fa: &FineAlignment<f64, STATES_WITH_BIASES>| {
-            [
-                fa.filter.p[(GYRO_BIAS, GYRO_BIAS)],
-                fa.filter.p[(ACCEL_BIAS, ACCEL_BIAS)],
-            ]
-        };
-        let steps = 3600.0 / dt;
-        let (sigma_g, sigma_a) = (
-            noise.gyro[0].bias_instability,
-            noise.accel[0].bias_instability,
-        );
-        let tau = noise.gyro[0].correlation_time;
-        let bounded = |sigma: f64, t: f64| 2.0 * sigma * sigma * (1.0 - libm::exp(-t / tau));
+        let p =
+            |fa: &FineAlignment<f64, STATES_WITH_BIASES>, i: usize, j: usize| fa.filter.p[(i, j)];
+        fa.step(&at_rest);
+        let before = [GYRO_BIAS, GYRO_BIAS + 1, GYRO_BIAS + 2].map(|i| p(&fa, i, i));
+        fa.set_bias_walk(BiasWalk::InstabilityAsRateNoise);
+        let sigma = noise.gyro[2].bias_instability;
+        // A filter that has run: the absorbed instability, once.
+        let switched = p(&fa, GYRO_BIAS + 2, GYRO_BIAS + 2);
+        assert!((switched - before[2] - sigma * sigma).abs() < 1e-9 * sigma * sigma);
+        fa.set_bias_walk(BiasWalk::InstabilityAsRateNoise);
+        assert_eq!(p(&fa, GYRO_BIAS + 2, GYRO_BIAS + 2), switched);
 
-        let start = bias_variance(&fa);
-        fa.set_bias_walk(BiasWalk::BoundedSinceObserved);
-        for _ in 0..steps as usize {
+        let psi = ATT + 2;
+        let (h0, c0) = (p(&fa, psi, psi), p(&fa, psi, GYRO_BIAS + 2));
+        let steps = 600;
+        for _ in 0..steps {
             fa.step(&at_rest);
         }
-        let hour = bias_variance(&fa);
-        let added = [hour[0] - start[0], hour[1] - start[1]];
-        for (got, want) in added
-            .iter()
-            .zip([bounded(sigma_g, 3600.0), bounded(sigma_a, 3600.0)])
-        {
-            assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}");
-        }
-        assert!(added[0] < 2.0 * sigma_g * sigma_g);
-
-        // Observed again: one step adds the full increment once more.
-        fa.set_bias_walk(BiasWalk::EveryStep);
-        fa.step(&at_rest);
-        let step = fa.config.model.biases.gyro[0].variance_per_step;
-        assert!((bias_variance(&fa)[0] - hour[0] - step).abs() < 1e-9 * step);
-        // The unbounded walk over the same hour: 2 sigma^2 T / tau.
-        assert!(steps * step > 30.0 * added[0]);
+        // The x and z biases are constants now; the tool-axis rate's walks.
+        let relative = |a: f64, b: f64| (a / b - 1.0).abs();
+        assert!(relative(p(&fa, GYRO_BIAS, GYRO_BIAS), before[0] + sigma * sigma) < 1e-9);
+        assert!(relative(p(&fa, GYRO_BIAS + 2, GYRO_BIAS + 2), switched) < 1e-9);
+        let y_walk = fa.config.model.biases.gyro[1].variance_per_step;
+        assert!(p(&fa, GYRO_BIAS + 1, GYRO_BIAS + 1) > before[1] + 0.9 * steps as f64 * y_walk);
+        // Level tool, body z down: psi' = -b_z + w, w the instability as
+        // white noise of density 2 sigma^2 tau, so over t the heading
+        // variance grows by t^2 P_bb - 2 t P_psi,b + 2 sigma^2 tau t.
+        let tau = noise.gyro[2].correlation_time;
+        let t = steps as f64 * dt;
+        let white = 2.0 * sigma * sigma * tau * t;
+        let expected = t * t * switched - 2.0 * t * c0 + white;
+        let grown = p(&fa, psi, psi) - h0;
+        assert!(
+            relative(grown, expected) < 0.02,
+            "{grown} vs {expected} (white {white})"
+        );
     }
 }

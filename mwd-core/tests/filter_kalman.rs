@@ -40,7 +40,7 @@ prop_compose! {
         for axis in 0..3 {
             m.accel[axis] = ar_from_reflections(ks[axis], vars[axis]);
             m.gyro[axis] = ar_from_reflections(ks[axis + 3], vars[axis + 3]);
-            let bias = |k: usize| BiasState { initial_sigma: bias_sigmas[k], variance_per_step: bias_walks[k], step_correlation: 1.0 };
+            let bias = |k: usize| BiasState { initial_sigma: bias_sigmas[k], variance_per_step: bias_walks[k], instability_sigma: 0.0, instability_density: 0.0 };
             m.biases.accel[axis] = bias(axis);
             m.biases.gyro[axis] = bias(axis + 3);
         }

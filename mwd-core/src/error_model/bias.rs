@@ -17,11 +17,12 @@
 //! (45 in all) would be exact and cost about 30 % more in the time update.
 //!
 //! Over hours (a drilling probe between stations) the random walk would
-//! grow without bound, while the Gauss-Markov increment never exceeds
-//! 2 sigma^2 in variance: `step_correlation` lets the filter add the walk
-//! as the geometric series q a^k, which sums to exactly that increment's
-//! variance 2 sigma^2 (1 - exp(-T/tau)) over T unobserved
-//! (`fine_alignment::BiasWalk`, derivation section 4g).
+//! grow without bound, while the Gauss-Markov process stays within sigma:
+//! navigating, the gyro bias states keep the residual constant only and
+//! the instability is white rate noise at its zero-frequency density
+//! `instability_density` = 2 sigma^2 tau, which bounds its spectrum
+//! (`fine_alignment::BiasWalk::InstabilityAsRateNoise`, derivation section
+//! 4h).
 
 use crate::sensor_noise::{AxisNoise, ImuNoise};
 
@@ -33,10 +34,12 @@ pub struct BiasState {
     pub initial_sigma: f64,
     /// Random-walk variance added per step (SI units squared).
     pub variance_per_step: f64,
-    /// exp(-dt/tau) of the Gauss-Markov instability: the ratio of one
-    /// step's increment variance to the previous one's when the walk is
-    /// bounded (`fine_alignment::BiasWalk::BoundedSinceObserved`).
-    pub step_correlation: f64,
+    /// The Gauss-Markov instability's stationary sigma (SI units).
+    pub instability_sigma: f64,
+    /// Its spectral density at zero frequency, 2 sigma^2 tau (SI units
+    /// squared times seconds): the white noise whose spectrum bounds the
+    /// instability's at every frequency.
+    pub instability_density: f64,
 }
 
 impl BiasState {
@@ -53,7 +56,8 @@ impl BiasState {
         Self {
             initial_sigma: libm::sqrt(axis.residual_bias * axis.residual_bias + gm * gm),
             variance_per_step: step_increment,
-            step_correlation,
+            instability_sigma: gm,
+            instability_density: 2.0 * gm * gm * axis.correlation_time.max(0.0),
         }
     }
 }

@@ -262,6 +262,13 @@ pub struct Navigator {
     vertical_residual: Option<(f64, [f64; 2])>,
     /// The roll was held for drilling since the last still cycle.
     drilled_since_station: bool,
+    /// The last navigation cycle was still (its roll held).
+    was_still: bool,
+    /// Consecutive drilling cycles up to this one.
+    drilling_cycles: u32,
+    /// The turn about the tool axis (rad) in the last navigation cycle when
+    /// it followed the accelerometer roll; `None` when the roll was held.
+    last_roll_turn: Option<f64>,
     /// The accelerometer-bias estimate and covariance at the last still
     /// cycle of the last station: put back at the next station after
     /// drilling
@@ -306,6 +313,9 @@ impl Navigator {
             finished_station: None,
             vertical_residual: None,
             drilled_since_station: false,
+            was_still: false,
+            drilling_cycles: 0,
+            last_roll_turn: None,
             rest_accel_bias: None,
             toolface_block: ForceBlock::default(),
             time_us: 0,
@@ -605,12 +615,10 @@ impl Navigator {
                 } else {
                     ToolAxisSource::AccelerometerRoll
                 };
-                let (imu, tool_axis) = self.input.imu_sample(
-                    &filter.frame_rate_in_body(),
-                    &sample,
-                    source,
-                    SAMPLE_INTERVAL_S,
-                );
+                let frame_rate = filter.frame_rate_in_body();
+                let (imu, tool_axis) =
+                    self.input
+                        .imu_sample(&frame_rate, &sample, source, SAMPLE_INTERVAL_S);
                 filter.hold_tool_axis(source == ToolAxisSource::AtRest);
                 if tool_axis == ToolAxisRate::Unavailable || drilling {
                     self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
@@ -620,10 +628,16 @@ impl Navigator {
                 let update = still && !self.station_capped;
                 filter.set_zero_velocity(update.then_some(STATION_ZUPT_VARIANCE));
                 let mut extra = extra;
+                self.drilling_cycles = if drilling {
+                    self.drilling_cycles.saturating_add(1)
+                } else {
+                    0
+                };
                 if drilling {
                     // The measured lateral jitter is the vibration's force
                     // noise per sample: white, a velocity random walk.
-                    extra.velocity += square(jitter * SAMPLE_INTERVAL_S);
+                    let onset = vibration_onset_factor(self.drilling_cycles);
+                    extra.velocity += square(jitter * SAMPLE_INTERVAL_S) * onset;
                 }
                 filter.linearize_at_gravity(drilling || still);
                 let report = filter.step_with(&imu, &extra);
@@ -666,10 +680,8 @@ impl Navigator {
                     // goes into the variance about the tool axis, and the
                     // station's zero-velocity updates re-level it.
                     let offset = roll_offset(filter.state(), &sample);
-                    let c_bn = dcm_from_quat(&filter.state().attitude);
-                    let t: Vector3<f64> = c_bn.column(1).into_owned();
                     let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
-                    filter.add_attitude_noise(&(t * t.transpose() * variance));
+                    add_tool_axis_variance(filter, variance);
                     // The accelerometer biases as the last station (at rest)
                     // left them: while drilling the filter read the
                     // vibration's rectified force as bias, and at rest
@@ -683,6 +695,39 @@ impl Navigator {
                     }
                     self.drilled_since_station = false;
                 }
+                if !still && !drilling && self.was_still && report.sample_used {
+                    // The first moving cycle after a still period: the
+                    // roll was held through the still detector's delay
+                    // while the orienter may already have been turning the
+                    // tool (0.5 deg in the simulated connections, 15 times
+                    // the station's roll sigma), and from here the roll
+                    // follows the accelerometer roll's differences, so its
+                    // error stays that offset plus the difference of two
+                    // samples' roll noise. Unmodelled, the velocity it
+                    // makes went through the non-holonomic updates into
+                    // the heading (up to 8 deg per connection in the
+                    // drilling study; derivation section 4h).
+                    let offset = roll_offset(filter.state(), &sample);
+                    let variance = square(offset) + 2.0 * square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+                    add_tool_axis_variance(filter, variance);
+                }
+                if let (true, Some(turn)) = (drilling, self.last_roll_turn) {
+                    // The first drilling cycle after the roll followed the
+                    // accelerometers: the roll is held from here, and the
+                    // vibration that made this a drilling cycle may have
+                    // begun before the orienter's turn ended. The turn of
+                    // one cycle is estimated by the last one's (noisy by
+                    // the two samples' roll noise, which is added too).
+                    let variance = square(turn) + 2.0 * square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+                    add_tool_axis_variance(filter, variance);
+                }
+                self.last_roll_turn = match (source, tool_axis) {
+                    (ToolAxisSource::AccelerometerRoll, ToolAxisRate::Valid(rate)) => {
+                        Some((rate - frame_rate.y) * SAMPLE_INTERVAL_S)
+                    }
+                    _ => None,
+                };
+                self.was_still = still;
                 self.drilled_since_station |= drilling;
                 if still && !self.drilled_since_station {
                     self.rest_accel_bias = filter.accel_bias();
@@ -769,6 +814,9 @@ impl Navigator {
         self.covariance_invalid = false;
         self.coasting = false;
         self.drilled_since_station = false;
+        self.was_still = false;
+        self.drilling_cycles = 0;
+        self.last_roll_turn = None;
         self.rest_accel_bias = None;
         self.toolface_block.clear();
         self.phase = Phase::Fine { samples: 0 };
@@ -908,6 +956,9 @@ impl Navigator {
         self.coasting = false;
         self.coarse_single_part = false;
         self.drilled_since_station = false;
+        self.was_still = false;
+        self.drilling_cycles = 0;
+        self.last_roll_turn = None;
         self.rest_accel_bias = None;
         self.toolface_block.clear();
     }
@@ -932,6 +983,9 @@ impl Navigator {
         self.covariance_invalid = false;
         self.coarse_single_part = false;
         self.drilled_since_station = false;
+        self.was_still = false;
+        self.drilling_cycles = 0;
+        self.last_roll_turn = None;
         self.rest_accel_bias = None;
         self.toolface_block.clear();
         self.phase = Phase::Navigating;
@@ -982,6 +1036,23 @@ impl Navigator {
     }
 }
 
+/// How much the still detector's jitter (the RMS of the successive force
+/// differences over its window, `StillStatistics::lateral_jitter`)
+/// understates the vibration in the `k`-th drilling cycle after it began:
+/// the window's WINDOW - 1 differences then hold k - 1 between vibrating
+/// samples and one half-vibrating (the first one), k - 1/2 in all; the
+/// variance is scaled up by their share. Unscaled, the first drilling
+/// samples' vibration (0.36 m/s per sample at the moderate level) went
+/// into the velocity with a twentieth of its variance, and the
+/// non-holonomic updates turned it into heading through the velocity's
+/// correlation with it (1.3 deg in 0.3 s in the simulated lateral;
+/// derivation section 4h).
+fn vibration_onset_factor(k: u32) -> f64 {
+    let differences = (super::still::WINDOW - 1) as f64;
+    let vibrating = f64::from(k.max(1)) - 0.5;
+    (differences / vibrating).max(1.0)
+}
+
 fn square(v: f64) -> f64 {
     v * v
 }
@@ -1019,12 +1090,19 @@ fn aid_drilling_toolface(filter: &mut Filter, block: &ForceBlock) {
     let innovation_variance = h.dot(&(filter.attitude_error_covariance() * h)) + variance;
     if square(f64::from(m.toolface_residual)) > GROSS_TOOLFACE_CHI2 * innovation_variance {
         filter.set_roll(m.block_toolface);
-        let c_bn = dcm_from_quat(&filter.state().attitude);
-        let t: Vector3<f64> = c_bn.column(1).into_owned();
-        filter.add_attitude_noise(&(t * t.transpose() * variance));
+        add_tool_axis_variance(filter, variance);
     } else {
         filter.aid(&m);
     }
+}
+
+/// Adds `variance` (rad^2) to the attitude error about the tool axis (the
+/// roll): the roll the filter holds or follows may be off by more than its
+/// covariance says (an orienter's turn not sensed, a re-roll).
+fn add_tool_axis_variance(filter: &mut Filter, variance: f64) {
+    let c_bn = dcm_from_quat(&filter.state().attitude);
+    let t: Vector3<f64> = c_bn.column(1).into_owned();
+    filter.add_attitude_noise(&(t * t.transpose() * variance));
 }
 
 /// One still cycle's vertical-earth-rate residual m = d_x (g_x - w_x) +
@@ -1053,8 +1131,12 @@ fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
 }
 
 /// A gyro's long-run variance per sample, (rad/s)^2: white density^2 /
-/// dt plus its AR model's zero-frequency share sigma_e^2 / (1 + sum
-/// a_i)^2 (the variance of an n-sample mean is this over n for large n).
+/// dt, its AR model's zero-frequency share sigma_e^2 / (1 + sum a_i)^2 and
+/// the bias instability's 2 sigma^2 tau / dt (the variance of an n-sample
+/// mean is this over n for large n). The instability is in: navigating,
+/// the filter's rate-bias states are the constant part only
+/// (`fine_alignment::BiasWalk::InstabilityAsRateNoise`), and a station's
+/// means hold its value of the moment.
 fn gyro_long_run_variance(axis: usize) -> f64 {
     let noise = ImuNoise::scc1300().gyro[axis];
     let white = square(noise.white_density) / SAMPLE_INTERVAL_S;
@@ -1062,7 +1144,9 @@ fn gyro_long_run_variance(axis: usize) -> f64 {
         let gain = 1.0 + ar.coefficients.iter().sum::<f64>();
         ar.noise_variance / square(gain)
     });
-    white + coloured
+    let instability =
+        2.0 * square(noise.bias_instability) * noise.correlation_time / SAMPLE_INTERVAL_S;
+    white + coloured + instability
 }
 
 #[cfg(test)]
