@@ -99,8 +99,15 @@ fn synthetic_stations_are_positioned_with_the_random_walk_and_depth_uncertainty(
     // (the frame's sigmas are f32: 1e-7 relative)
     assert!((c[0] - var_n).abs() < 1e-6 * var_n, "{} vs {var_n}", c[0]);
     // east (along the hole): depth scale and stretch on the 30 m drilled,
-    // MD counted from the tie-on (DSFS 560 ppm, DSTG 2.5e-7 /m)
-    let var_e = (560e-6 * 30.0f64).powi(2) + (2.5e-7 * 30.0 * 2000.0f64).powi(2);
+    // MD counted from the tie-on (DSFS 560 ppm, DSTG 2.5e-7 /m), and the
+    // angles' second order, systematic: each station's half legs shortened
+    // by sqrt(3)/2 (s_I^2 + s_A^2)
+    let inc2 = 0.05f64.to_radians().powi(2);
+    let shortening: f64 = (0..4)
+        .map(|k| h[k] * 0.5 * 3f64.sqrt() * (inc2 + s2[k]))
+        .sum();
+    let var_e =
+        (560e-6 * 30.0f64).powi(2) + (2.5e-7 * 30.0 * 2000.0f64).powi(2) + shortening.powi(2);
     assert!((c[1] - var_e).abs() < 1e-6 * var_e, "{} vs {var_e}", c[1]);
     // vertical: the inclination, random per station
     let var_v = 0.05f64.to_radians().powi(2) * h.iter().map(|x| x * x).sum::<f64>();
