@@ -669,7 +669,8 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
 
     /// Puts back an accelerometer-bias estimate and covariance taken
     /// earlier ([`accel_bias`](Self::accel_bias)), grown by the random walk
-    /// the filter has added since ([`BiasWalk`]), with no correlation to
+    /// the filter has added since ([`BiasWalk`]) up to the instability's
+    /// largest change, 2 sigma^2, with no correlation to
     /// the other states (which keeps P positive semi-definite: a principal
     /// block and a PSD block). The probe's stations use it: what the filter
     /// learns of the accelerometers while drilling is the bias plus the
@@ -691,7 +692,12 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             for j in 0..3 {
                 p[(ACCEL_BIAS + i, ACCEL_BIAS + j)] = T::of(snapshot.covariance[(i, j)]);
             }
-            let walk = (self.bias_walk_added[i] - snapshot.walk_added[i]).max(0.0);
+            // The instability changes by at most 2 sigma^2 in variance
+            // over any time (stationary Gauss-Markov: 2 sigma^2 (1 -
+            // exp(-T/tau))); the walk over an hour of drilling adds 72.
+            let sigma = self.config.model.biases.accel[i].instability_sigma;
+            let walk =
+                (self.bias_walk_added[i] - snapshot.walk_added[i]).clamp(0.0, 2.0 * sigma * sigma);
             p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] += T::of(walk);
         }
     }
@@ -952,6 +958,41 @@ mod tests {
     /// 2 sigma^2 (1 - exp(-T/tau)) when bounded: after an hour that is
     /// under 2 sigma^2, where the walk has added 2 sigma^2 T/tau = 72
     /// sigma^2. Switching back to every-step restarts the bound.
+    #[test]
+    fn a_restored_accelerometer_bias_grows_by_the_walk_up_to_the_instabilitys_largest_change() {
+        let site = Position::paper_site();
+        let noise = ImuNoise::scc1300();
+        let config = FineAlignmentConfig::<STATES_WITH_BIASES>::physical(
+            AugmentedModel::paper(),
+            &noise,
+            &[0.01, 0.01, 0.1],
+            site.lat,
+        );
+        let mut fa = FineAlignment::<f64, STATES_WITH_BIASES>::new(
+            NavState::at_rest(UnitQuaternion::identity(), site),
+            site,
+            config,
+        );
+        let at_rest = ImuSample {
+            rate: earth_rate_n(site.lat),
+            specific_force: -gravity_n(&site),
+        };
+        fa.step(&at_rest);
+        let snapshot = fa.accel_bias().unwrap();
+        let sigma = noise.accel[0].bias_instability;
+        // A short walk is added whole; an hour's (72 sigma^2) is capped.
+        for (walk, added) in [(0.5, 0.5), (72.0, 2.0)] {
+            fa.bias_walk_added[0] = snapshot.walk_added[0] + walk * sigma * sigma;
+            fa.restore_accel_bias(&snapshot);
+            let grown = fa.filter.p[(ACCEL_BIAS, ACCEL_BIAS)] - snapshot.covariance[(0, 0)];
+            assert!(
+                (grown / (added * sigma * sigma) - 1.0).abs() < 1e-9,
+                "{grown}"
+            );
+            assert_eq!(fa.filter.x[ACCEL_BIAS], snapshot.estimate[0]);
+        }
+    }
+
     #[test]
     fn navigation_keeps_the_gyro_bias_constant_and_adds_the_instability_as_rate_noise() {
         let site = Position::paper_site();
