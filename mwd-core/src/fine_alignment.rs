@@ -696,8 +696,11 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             // over any time (stationary Gauss-Markov: 2 sigma^2 (1 -
             // exp(-T/tau))); the walk over an hour of drilling adds 72.
             let sigma = self.config.model.biases.accel[i].instability_sigma;
-            let walk =
-                (self.bias_walk_added[i] - snapshot.walk_added[i]).clamp(0.0, 2.0 * sigma * sigma);
+            // (max and min, not clamp: clamp's check of its bounds panics
+            // with the floats formatted, 24 KiB of the probe's flash)
+            let walk = (self.bias_walk_added[i] - snapshot.walk_added[i])
+                .max(0.0)
+                .min(2.0 * sigma * sigma);
             p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] += T::of(walk);
         }
     }
