@@ -11,23 +11,28 @@
 //!               "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 1.5,
 //!               "toolface_sigma_deg": 0.3 },
 //!   "calibration_file": "probe-cal.json",
+//!   "still": { "z_enter": 3.09, "z_stay": 5.199, "enter_epochs": 20,
+//!              "max_station_samples": 6000, "zupt_velocity_sigma": 0.01 },
 //!   "survey": { "length_unit": "ft", "error_model": "PROBE-SCC1300",
 //!               "tie_on": { "md": 1500.0, "tvd": 1480.0, "north": 12.0, "east": -3.5 } }
 //! }
 //! ```
-//! `tie_in` and `calibration_file` are optional (absent: the static
-//! alignment, no correction); a relative calibration path is taken from
-//! the job file's folder. `survey` is optional and only the host reads it:
+//! `tie_in`, `calibration_file` and `still` are optional (absent: the
+//! static alignment, no correction, the probe's still settings left as
+//! they are); a relative calibration path is taken from the job file's
+//! folder. `still` is the still detector's and the station's settings
+//! (uplink command 0x44, `protocol::uplink::StillSettings`, all five
+//! fields, with its ranges; the defaults are the values above). `survey` is optional and only the host reads it:
 //! the tie-on (the well's position where the survey starts, in
 //! `length_unit`, "m" or "ft", default "m"; every part optional, as the
 //! `--tie-on-*` flags) and the tool's error model (a name `survey
 //! --error-model` takes).
 //!
-//! Who reads what: `probe configure` sends the site, tie-in and
-//! calibration; `survey` takes the site's latitude, the tie-on and the
-//! error model (a capture survey, `--depth`, has the probe's own model
-//! and refuses another); `replay` takes the site and the calibration (its
-//! navigator has no tie-in: a capture made with one is compared as
+//! Who reads what: `probe configure` sends the site, tie-in, calibration
+//! and still settings; `survey` takes the site's latitude, the tie-on and
+//! the error model (a capture survey, `--depth`, has the probe's own model
+//! and refuses another); `replay` takes the site, the calibration and the
+//! still settings (its navigator has no tie-in: a capture made with one is compared as
 //! post-processing). Command-line flags override the job. A station
 //! survey's first MD must equal the tie-on MD exactly: give the job's
 //! tie-on in the station file's unit (converted from the other unit, an MD
@@ -47,7 +52,7 @@ use mwd_core::conventions::{DrillingAngles, DEG};
 use mwd_core::earth::Position;
 use mwd_core::probe::TieIn;
 use mwd_core::protocol::uplink::{
-    decode_command, encode_command_body, Command, UplinkError, MAX_COMMAND_BODY_LEN,
+    decode_command, encode_command_body, Command, StillSettings, UplinkError, MAX_COMMAND_BODY_LEN,
 };
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -72,6 +77,34 @@ struct TieInEntry {
     inclination_sigma_deg: f64,
     azimuth_sigma_deg: f64,
     toolface_sigma_deg: f64,
+}
+
+/// The uplink's still settings. Read wide and narrowed to the wire's
+/// types (f32, u16, u32; saturating, far beyond every range) so that the
+/// probe's own range check (`probe_accepts`) names a field out of range
+/// whatever its size; the host sends and replays the narrowed values, what
+/// the probe keeps.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StillEntry {
+    z_enter: f64,
+    z_stay: f64,
+    enter_epochs: i64,
+    max_station_samples: i64,
+    zupt_velocity_sigma: f64,
+}
+
+impl StillEntry {
+    fn narrowed(&self) -> StillSettings {
+        let saturated = |v: i64, max: u32| u32::try_from(v.clamp(0, i64::from(max))).unwrap_or(max);
+        StillSettings {
+            z_enter: self.z_enter as f32,
+            z_stay: self.z_stay as f32,
+            enter_epochs: saturated(self.enter_epochs, u32::from(u16::MAX)) as u16,
+            max_station_samples: saturated(self.max_station_samples, u32::MAX),
+            zupt_velocity_sigma: self.zupt_velocity_sigma as f32,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -99,6 +132,7 @@ struct JobEntry {
     site: SiteEntry,
     tie_in: Option<TieInEntry>,
     calibration_file: Option<PathBuf>,
+    still: Option<StillEntry>,
     survey: Option<SurveyEntry>,
 }
 
@@ -163,6 +197,9 @@ pub struct Job {
     pub tie_in: Option<TieIn>,
     /// With the file it came from, if any.
     pub calibration: Option<(PathBuf, ProbeCalibration)>,
+    /// `None`: the probe's are left as they are (the replay takes the
+    /// defaults); its ranges are checked by the probe's decoding.
+    pub still: Option<StillSettings>,
     pub survey: SurveyJob,
 }
 
@@ -263,6 +300,7 @@ impl Job {
                 CalibrationFile::load(&path).map(|c| (path, c.to_probe()))
             })
             .transpose()?;
+        let still = entry.still.as_ref().map(StillEntry::narrowed);
         let survey = entry
             .survey
             .map(SurveyEntry::checked)
@@ -272,6 +310,7 @@ impl Job {
             site,
             tie_in,
             calibration,
+            still,
             survey,
         };
         for (label, command) in job.commands() {
@@ -334,6 +373,20 @@ impl Job {
                     accel: calibration.accel[i],
                     gyro: calibration.gyro[i],
                 },
+            ));
+        }
+        if let Some(s) = &self.still {
+            out.push((
+                format!(
+                    "set still settings z_enter {}, z_stay {}, enter_epochs {}, \
+                     max_station_samples {}, zupt_velocity_sigma {} m/s",
+                    s.z_enter,
+                    s.z_stay,
+                    s.enter_epochs,
+                    s.max_station_samples,
+                    s.zupt_velocity_sigma
+                ),
+                Command::SetStillSettings(*s),
             ));
         }
         out
@@ -411,6 +464,75 @@ mod tests {
             "unknown error model",
         );
         refused(&with_survey(r#"{"tie_on": {"mdd": 1}}"#), "mdd");
+    }
+
+    const STILL: &str = r#"{"z_enter": 3.5, "z_stay": 6.0, "enter_epochs": 40,
+        "max_station_samples": 1200, "zupt_velocity_sigma": 0.02}"#;
+
+    fn with_still(still: &str) -> String {
+        JOB.replace("}}", &format!("}}, \"still\": {still}}}"))
+    }
+
+    #[test]
+    fn a_jobs_still_settings_are_sent_last_and_only_if_given() {
+        let job = Job::parse(&with_still(STILL), Path::new(".")).unwrap();
+        let expected = StillSettings {
+            z_enter: 3.5,
+            z_stay: 6.0,
+            enter_epochs: 40,
+            max_station_samples: 1200,
+            zupt_velocity_sigma: 0.02,
+        };
+        assert_eq!(job.still, Some(expected));
+        let commands = job.commands();
+        assert_eq!(commands.len(), 5);
+        let (label, command) = &commands[4];
+        assert_eq!(*command, Command::SetStillSettings(expected));
+        assert!(label.contains("enter_epochs 40"), "{label}");
+        let plain = Job::parse(JOB, Path::new(".")).unwrap();
+        assert_eq!(plain.still, None);
+        assert!(plain
+            .commands()
+            .iter()
+            .all(|(_, c)| !matches!(c, Command::SetStillSettings(_))));
+    }
+
+    #[test]
+    fn still_settings_out_of_the_probes_ranges_are_refused_by_name() {
+        let refused = |from: &str, to: &str, needle: &str| {
+            let text = with_still(&STILL.replace(from, to));
+            let e = format!("{:#}", Job::parse(&text, Path::new(".")).unwrap_err());
+            assert!(e.contains(needle), "{from} -> {to}: {e}");
+        };
+        refused(
+            "\"z_enter\": 3.5",
+            "\"z_enter\": 1.5",
+            "still entering quantile",
+        );
+        // Staying must be easier than entering.
+        refused(
+            "\"z_stay\": 6.0",
+            "\"z_stay\": 3.0",
+            "still staying quantile",
+        );
+        refused(
+            "\"enter_epochs\": 40",
+            "\"enter_epochs\": 0",
+            "still entering epochs",
+        );
+        refused(
+            "\"enter_epochs\": 40",
+            "\"enter_epochs\": 70000",
+            "still entering epochs",
+        );
+        refused("1200", "-5", "longest station");
+        refused("1200", "5000000000", "longest station");
+        refused("1200", "100", "longest station");
+        refused("0.02", "2.0", "station ZUPT velocity sigma");
+        refused("0.02", "-0.02", "station ZUPT velocity sigma");
+        refused(", \"zupt_velocity_sigma\": 0.02", "", "zupt_velocity_sigma");
+        refused("\"z_enter\"", "\"z_entre\"", "z_entre");
+        refused("3.5", "\"3.5\"", "expected f64");
     }
 
     #[test]

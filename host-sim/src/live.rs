@@ -19,9 +19,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use mwd_core::calibration::ProbeCalibration;
+use mwd_core::config::default_still_settings;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::nav_mode;
+use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
 use crate::capture::Capture;
@@ -132,6 +134,8 @@ pub struct LiveOptions {
     pub display_interval: Duration,
     /// The probe's sensor calibration, for the replay (identity: none).
     pub calibration: ProbeCalibration,
+    /// The probe's still settings, for the replay (default: the constants).
+    pub still: StillSettings,
 }
 
 impl Default for LiveOptions {
@@ -141,6 +145,7 @@ impl Default for LiveOptions {
             silence: None,
             display_interval: Duration::from_millis(250),
             calibration: ProbeCalibration::default(),
+            still: default_still_settings(),
         }
     }
 }
@@ -182,7 +187,7 @@ pub fn run(
     let mut last_byte: Option<Instant> = None;
     let mut last_shown: Option<Instant> = None;
     let mut decoder = Decoder::new();
-    let mut replayer = Replayer::with_calibration(position, options.calibration);
+    let mut replayer = Replayer::with_settings(position, options.calibration, options.still);
     let mut capture = Capture::default();
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];

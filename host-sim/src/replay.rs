@@ -37,12 +37,14 @@ use std::collections::{HashMap, VecDeque};
 use std::io::{self, Write};
 
 use mwd_core::calibration::ProbeCalibration;
+use mwd_core::config::default_still_settings;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::decoder::starts_a_run;
 use mwd_core::protocol::frame::{nav_flags, station_flags, MAX_BODY_LEN};
 use mwd_core::protocol::uplink::IndexingProcedure;
+use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{
     encode_body, EventKind, Frame, NavSolution, Payload, RawSample, StationSurvey,
 };
@@ -273,6 +275,8 @@ pub const SETTLE_AFTER_SAMPLES: usize = 64;
 pub struct Replayer {
     position: Position,
     calibration: ProbeCalibration,
+    /// The probe's still settings (`Navigator::with_settings`).
+    still: StillSettings,
     navigator: Navigator,
     rows: Vec<ReplayRow>,
     /// Rows (index into `rows`) of replayed samples the probe's solution
@@ -394,10 +398,21 @@ impl Replayer {
     }
 
     pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
+        Self::with_settings(position, calibration, default_still_settings())
+    }
+
+    /// The same with the probe's still settings (a job's, as `probe
+    /// configure` sent them).
+    pub fn with_settings(
+        position: Position,
+        calibration: ProbeCalibration,
+        still: StillSettings,
+    ) -> Self {
         Self {
             position,
             calibration,
-            navigator: Navigator::with_calibration(position, calibration),
+            still,
+            navigator: Navigator::with_settings(position, calibration, &still),
             rows: Vec::new(),
             awaiting_probe: HashMap::new(),
             early_probe: HashMap::new(),
@@ -657,7 +672,7 @@ impl Replayer {
 
     /// A boot event: the probe started again, so does the replay.
     fn restart_navigation(&mut self) {
-        self.navigator = Navigator::with_calibration(self.position, self.calibration);
+        self.navigator = Navigator::with_settings(self.position, self.calibration, &self.still);
         // Sample counters start again at 0: older partners can never match;
         // a probe solution whose raw frame was lost was not compared.
         self.summary.unchecked += self.early_probe.len() as u64;

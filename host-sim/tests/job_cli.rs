@@ -215,3 +215,39 @@ fn a_replay_takes_the_jobs_site_and_calibration() {
     let (expected, _) = replay(&["--calibration-file", s(&cal)], "expected.csv");
     assert_eq!(overridden, expected);
 }
+
+/// A job's still settings reach the replay's navigator: the defaults
+/// written out give the same solutions as no settings (to the bit, as the
+/// probe's parity check needs), a longer entering delay others. 70 s: the
+/// 60 s alignment, then a still probe's first station.
+#[test]
+fn a_replay_takes_the_jobs_still_settings() {
+    let dir = scratch("still");
+    let capture = dir.join("run.bin");
+    ok(&["simulate", "--duration", "70", "-o", s(&capture)], 0);
+    let still = |epochs: u32| {
+        format!(
+            r#", "still": {{"z_enter": 3.09, "z_stay": 5.199, "enter_epochs": {epochs},
+                "max_station_samples": 6000, "zupt_velocity_sigma": 0.01}}"#
+        )
+    };
+    let replay = |job: &Path, name: &str| {
+        let csv = dir.join(name);
+        ok(
+            &["replay", s(&capture), "--job", s(job), "--csv", s(&csv)],
+            0,
+        );
+        std::fs::read_to_string(&csv).unwrap()
+    };
+    let plain = replay(&write_job(&dir, "plain.json", "{}", ""), "plain.csv");
+    let defaults = replay(
+        &write_job(&dir, "defaults.json", "{}", &still(20)),
+        "defaults.csv",
+    );
+    assert_eq!(plain, defaults);
+    let slower = replay(
+        &write_job(&dir, "slower.json", "{}", &still(60)),
+        "slower.csv",
+    );
+    assert_ne!(plain, slower);
+}

@@ -28,10 +28,10 @@ pub struct Args {
 
 #[derive(clap::Subcommand, Debug)]
 enum Action {
-    /// Send a job file's site, tie-in and calibration, then ask for the
-    /// configuration's version.
+    /// Send a job file's site, tie-in, calibration and still settings (if
+    /// it has them), then ask for the configuration's version.
     Configure {
-        /// The job file (JSON: site, tie-in, calibration file).
+        /// The job file (JSON: site, tie-in, calibration file, still settings).
         #[arg(long)]
         job: PathBuf,
         #[command(flatten)]

@@ -28,8 +28,9 @@ use host_sim::replay::{
     self, ReplayRow, ReplaySummary, Replayer, StationRow, StationSummary, StepLoss,
 };
 use mwd_core::calibration::ProbeCalibration;
+use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;
-use mwd_core::protocol::uplink::Command as UplinkCommand;
+use mwd_core::protocol::uplink::{Command as UplinkCommand, StillSettings};
 
 use super::site::SiteArgs;
 
@@ -105,8 +106,8 @@ pub struct Args {
     /// uncalibrated).
     #[arg(long, value_name = "PATH")]
     pub calibration_file: Option<PathBuf>,
-    /// A job file (host-sim/src/job.rs): its site and calibration, as
-    /// `probe configure` sent them; --site and --calibration-file override
+    /// A job file (host-sim/src/job.rs): its site, calibration and still
+    /// settings, as `probe configure` sent them; --site and --calibration-file override
     /// it (its site: with --site, not --lat/--lon/--height). The replay
     /// has no tie-in: the job's is not applied.
     #[arg(long, value_name = "JOB.json", conflicts_with_all = ["lat", "lon", "height"])]
@@ -148,8 +149,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         (None, Some((_, calibration))) => *calibration,
         (None, None) => ProbeCalibration::default(),
     };
+    // A configured probe's navigator uses the job's still settings after
+    // its next boot or re-align (docs/protocol.md): so does the replay.
+    let job_still = job.as_ref().and_then(|j| j.still);
+    let still = job_still.unwrap_or_else(default_still_settings);
     let replayed = match (&args.port, &args.file) {
-        (Some(port), _) => replay_live(&args, port, site, calibration)?,
+        (Some(port), _) => replay_live(&args, port, site, calibration, still)?,
         (None, Some(file)) => {
             let sent = match &args.uplink {
                 Some(log) => {
@@ -159,7 +164,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 }
                 None => Vec::new(),
             };
-            replay_file(file, site, calibration, &sent)?
+            replay_file(file, site, calibration, still, &sent)?
         }
         (None, None) => anyhow::bail!("give a capture file or --port"),
     };
@@ -167,8 +172,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // paper's site; the site defaults are the paper's to the bit) is
     // post-processing, not a parity check.
     // A job's tie-in is the probe's, which the replay does not apply.
+    // Still settings other than the defaults: as another calibration.
     let post_processed = args.calibration_file.is_some()
         || job_calibration.is_some()
+        || still != default_still_settings()
         || site != Position::paper_site()
         || job.as_ref().is_some_and(|j| j.tie_in.is_some());
     report(&replayed, args.csv.as_ref(), post_processed)
@@ -179,10 +186,11 @@ fn replay_file(
     file: &Path,
     site: Position,
     calibration: ProbeCalibration,
+    still: StillSettings,
     sent: &[(u16, UplinkCommand)],
 ) -> anyhow::Result<Replayed> {
     let capture = capture::read_probe_capture(file)?;
-    let mut replayer = Replayer::with_calibration(site, calibration);
+    let mut replayer = Replayer::with_settings(site, calibration, still);
     for (seq, command) in sent {
         replayer.knows_sent_command(*seq, command);
     }
@@ -228,6 +236,7 @@ fn replay_live(
     port: &str,
     site: Position,
     calibration: ProbeCalibration,
+    still: StillSettings,
 ) -> anyhow::Result<Replayed> {
     let duration = args.duration.map(|s| seconds("duration", s)).transpose()?;
     let silence = seconds("silence", args.silence)?;
@@ -250,6 +259,7 @@ fn replay_live(
         duration,
         silence: Some(silence),
         calibration,
+        still,
         ..LiveOptions::default()
     };
     let sinks = LiveSinks {

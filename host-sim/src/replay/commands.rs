@@ -276,7 +276,8 @@ impl Replayer {
                 return CommandOutcome::Incomplete;
             }
             Effect::Realign { config_version } => {
-                self.navigator = Navigator::with_calibration(self.position, self.calibration);
+                self.navigator =
+                    Navigator::with_settings(self.position, self.calibration, &self.still);
                 // The new navigator numbers its stations from 1 again.
                 self.forget_station_partners();
                 self.run.stations_in_step = true;

@@ -43,7 +43,7 @@ pub mod commands;
 
 use super::raw::{reading, Reading};
 use super::station::{angle_uncertainty, angles_and_jacobian};
-use super::still::StillDetector;
+use super::still::{Hysteresis, StillDetector};
 use super::tie_in::{TieIn, TieInTilt};
 use crate::aid_sources::{
     AxialSpeed, DrillingToolface, ForceBlock, NonHolonomic, VerticalEarthRate,
@@ -52,6 +52,7 @@ use crate::aid_sources::{
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
 use crate::calibration::ProbeCalibration;
+use crate::config::default_still_settings;
 use crate::conventions::{
     dcm_from_quat, euler_from_quat, quat_from_euler, DrillingAngles, Euler, DEG,
 };
@@ -67,6 +68,7 @@ use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
 use crate::protocol::frame::nav_mode;
 use crate::protocol::frame::station_flags;
+use crate::protocol::uplink::StillSettings;
 use crate::protocol::{NavSolution, RawSample, StationSurvey};
 use crate::sensor_noise::ImuNoise;
 use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
@@ -112,6 +114,19 @@ pub const UNMEASURED_FORCE_SIGMA: f64 = 0.1;
 /// that may still sway and creep a little (the still detector cannot see a
 /// steady creep: `super::still`).
 pub const STATION_ZUPT_VARIANCE: f64 = 1e-4;
+
+/// A station's zero-velocity update variance from the uplink's 1-sigma
+/// (f32, m/s). The default's f32 stands for [`STATION_ZUPT_VARIANCE`]
+/// itself (`still::widened_setting`: its square in f64 would not be the
+/// constant to the bit).
+fn station_zupt_variance(sigma: f32) -> f64 {
+    let default = default_still_settings().zupt_velocity_sigma;
+    if sigma == default {
+        STATION_ZUPT_VARIANCE
+    } else {
+        square(f64::from(sigma))
+    }
+}
 
 /// The longest station (samples): 5 minutes, longer than a connection
 /// usually takes. A station still going on then is sent (flag
@@ -254,8 +269,13 @@ pub struct Navigator {
     station: Option<Station>,
     /// Stations started since boot.
     stations: u16,
-    /// The current still period reached [`MAX_STATION_SAMPLES`].
+    /// The current still period reached `max_station_samples`.
     station_capped: bool,
+    /// The longest station (samples; default [`MAX_STATION_SAMPLES`]).
+    max_station_samples: u32,
+    /// A station's zero-velocity update noise variance, (m/s)^2 (default
+    /// [`STATION_ZUPT_VARIANCE`]).
+    station_zupt_variance: f64,
     /// A finished station, until taken.
     finished_station: Option<StationSurvey>,
     /// This still cycle's vertical-earth-rate residual and d_x, d_z.
@@ -292,6 +312,18 @@ impl Navigator {
 
     /// A navigator that corrects every sample with `calibration`.
     pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
+        Self::with_settings(position, calibration, &default_still_settings())
+    }
+
+    /// The same with the still detector's and the station's `settings`
+    /// (the uplink's, range-checked when decoded). The detector's
+    /// thresholds are derived here, once, not per sample.
+    pub fn with_settings(
+        position: Position,
+        calibration: ProbeCalibration,
+        settings: &StillSettings,
+    ) -> Self {
+        let gravity = normal_gravity(position.lat, position.height);
         let idle = NavState::at_rest(UnitQuaternion::identity(), position);
         Self {
             position,
@@ -306,10 +338,12 @@ impl Navigator {
             covariance_invalid: false,
             coarse_single_part: false,
             flags: 0,
-            still: StillDetector::scc1300(normal_gravity(position.lat, position.height)),
+            still: StillDetector::scc1300_with(gravity, &Hysteresis::from_settings(settings)),
             station: None,
             stations: 0,
             station_capped: false,
+            max_station_samples: settings.max_station_samples,
+            station_zupt_variance: station_zupt_variance(settings.zupt_velocity_sigma),
             finished_station: None,
             vertical_residual: None,
             drilled_since_station: false,
@@ -435,7 +469,7 @@ impl Navigator {
         if block_done {
             station.settled = station.checkpoint.replace(station.survey);
         }
-        if station.epochs >= MAX_STATION_SAMPLES {
+        if station.epochs >= self.max_station_samples {
             self.finish_station(station_flags::MAX_DURATION);
             self.station_capped = true;
         }
@@ -626,7 +660,7 @@ impl Navigator {
                 // No updates past the longest station (see
                 // `MAX_STATION_SAMPLES`): free navigation until it moves.
                 let update = still && !self.station_capped;
-                filter.set_zero_velocity(update.then_some(STATION_ZUPT_VARIANCE));
+                filter.set_zero_velocity(update.then_some(self.station_zupt_variance));
                 let mut extra = extra;
                 self.drilling_cycles = if drilling {
                     self.drilling_cycles.saturating_add(1)
@@ -1150,6 +1184,10 @@ fn gyro_long_run_variance(axis: usize) -> f64 {
 }
 
 #[cfg(test)]
+#[path = "navigator_settings_tests.rs"]
+mod settings_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     extern crate std;
@@ -1177,11 +1215,11 @@ mod tests {
     }
 
     /// Level: gravity's reaction on body +z.
-    fn level_sample(n: u32) -> RawSample {
+    pub(super) fn level_sample(n: u32) -> RawSample {
         still_sample(n, [0.0, 0.0, STANDARD_GRAVITY_M_S2])
     }
 
-    const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
+    pub(super) const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
 
     #[test]
     fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
@@ -1294,7 +1332,7 @@ mod tests {
     }
 
     /// A level probe turning about body z (up) at `deg_s`, samples `n`.
-    fn turning_sample(n: u32, deg_s: f32) -> RawSample {
+    pub(super) fn turning_sample(n: u32, deg_s: f32) -> RawSample {
         let mut raw = level_sample(n);
         for (part, mounting) in raw.parts.iter_mut().zip(PART_MOUNTINGS) {
             let rate = mounting.gyro_rate_from_body([0.0, 0.0, deg_s.to_radians()]);

@@ -40,7 +40,8 @@
 //! which the z accelerometer's (0.36 counts) does not. The bound is used:
 //! the still-failure probabilities below are then upper bounds.
 //!
-//! Hysteresis (two false-alarm probabilities per test and epoch):
+//! Hysteresis (two false-alarm probabilities per test and epoch; these are
+//! the defaults, the uplink can set others: [`Hysteresis`]):
 //! * enter: all three tests pass at [`Z_ENTER`] (one-sided 1e-3 each) on
 //!   [`ENTER_EPOCHS`] consecutive samples after a full window: the minimum
 //!   still duration is `WINDOW + ENTER_EPOCHS - 1` samples, 39 (1.95 s),
@@ -61,6 +62,7 @@
 //! gyro's axis would not be seen, and the navigator resets the detector.
 
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
+use crate::protocol::uplink::StillSettings;
 use crate::sensor_noise::{AxisNoise, ImuNoise};
 use crate::sensor_units::{ACCEL_LSB_PER_G, GYRO_LSB_PER_DEG_S, STANDARD_GRAVITY};
 use crate::timing::SAMPLE_INTERVAL_S;
@@ -78,6 +80,49 @@ pub const Z_ENTER: f64 = 3.090;
 /// Standard normal quantile of the staying tests' false-alarm probability
 /// (one-sided 1e-7).
 pub const Z_STAY: f64 = 5.199;
+
+/// The detector's hysteresis: the standard normal quantiles of the
+/// entering and staying tests' false-alarm probabilities and the passing
+/// epochs to enter. The defaults are the constants above; the uplink can
+/// set others (`protocol::uplink::StillSettings`, command 0x44).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hysteresis {
+    pub z_enter: f64,
+    pub z_stay: f64,
+    pub enter_epochs: u32,
+}
+
+impl Hysteresis {
+    pub const DEFAULT: Self = Self {
+        z_enter: Z_ENTER,
+        z_stay: Z_STAY,
+        enter_epochs: ENTER_EPOCHS,
+    };
+
+    /// The hysteresis the uplink's settings ask for (their ranges were
+    /// checked when decoded: `protocol::uplink::fields`).
+    pub fn from_settings(settings: &StillSettings) -> Self {
+        Self {
+            z_enter: widened_setting(settings.z_enter, Z_ENTER),
+            z_stay: widened_setting(settings.z_stay, Z_STAY),
+            enter_epochs: u32::from(settings.enter_epochs),
+        }
+    }
+}
+
+/// A setting the wire carries as f32, in f64. The wire's default is the
+/// f64 constant rounded to f32 (`config::default_still_settings`); that
+/// value stands for the constant itself, so a probe with the default
+/// settings computes with exactly the constants (bit-identical to a
+/// navigator built without settings: the capture replays and the QEMU
+/// drilling test compare bits). Any other value is taken as it is.
+pub fn widened_setting(wire: f32, constant: f64) -> f64 {
+    if wire == constant as f32 {
+        constant
+    } else {
+        f64::from(wire)
+    }
+}
 
 /// A statistic's threshold pair and its expected value under stillness.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -103,6 +148,8 @@ pub struct StillThresholds {
     pub force_variance: [f64; 3],
     /// The gravity the magnitude is compared with (m/s^2).
     pub gravity_m_s2: f64,
+    /// Consecutive passing epochs (after a full window) before "still".
+    pub enter_epochs: u32,
 }
 
 /// Wilson-Hilferty chi-square quantile at the standard normal quantile z.
@@ -162,22 +209,29 @@ fn mean_variance_ratio(g: &[f64; WINDOW]) -> f64 {
     sum / square(n as f64)
 }
 
-/// The quantiles of `c chi^2(nu)` with mean `e` and variance `v`.
-fn satterthwaite(e: f64, v: f64) -> Threshold {
+/// The quantiles of `c chi^2(nu)` with mean `e` and variance `v`, at the
+/// hysteresis' normal quantiles.
+fn satterthwaite(e: f64, v: f64, h: &Hysteresis) -> Threshold {
     let c = v / (2.0 * e);
     let nu = e / c;
     Threshold {
-        enter: c * chi_square_quantile(nu, Z_ENTER),
-        stay: c * chi_square_quantile(nu, Z_STAY),
+        enter: c * chi_square_quantile(nu, h.z_enter),
+        stay: c * chi_square_quantile(nu, h.z_stay),
         expected: e,
     }
 }
 
 impl StillThresholds {
     /// Thresholds for sensors with error budget `noise`, at a site whose
-    /// gravity is `gravity_m_s2`. Never inlined: it runs once, at boot.
-    #[inline(never)]
+    /// gravity is `gravity_m_s2`, with the default hysteresis.
     pub fn from_budget(noise: &ImuNoise, gravity_m_s2: f64) -> Self {
+        Self::with_hysteresis(noise, gravity_m_s2, &Hysteresis::DEFAULT)
+    }
+
+    /// The same with hysteresis `h`. Never inlined: it runs once, when the
+    /// navigator is built (boot, re-align), never per sample.
+    #[inline(never)]
+    pub fn with_hysteresis(noise: &ImuNoise, gravity_m_s2: f64, h: &Hysteresis) -> Self {
         let gyro_q = (1.0 / f64::from(GYRO_LSB_PER_DEG_S)).to_radians();
         let accel_q = STANDARD_GRAVITY / f64::from(ACCEL_LSB_PER_G);
         // One part per gyro; both parts' triads averaged per force axis
@@ -226,16 +280,17 @@ impl StillThresholds {
             .fold(0.0, f64::max);
         let gravity_sigma = libm::sqrt(mean_var + bias);
         Self {
-            rate: satterthwaite(rate_e, rate_v),
-            force: satterthwaite(force_e, force_v),
+            rate: satterthwaite(rate_e, rate_v, h),
+            force: satterthwaite(force_e, force_v, h),
             gravity: Threshold {
-                enter: Z_ENTER * gravity_sigma,
-                stay: Z_STAY * gravity_sigma,
+                enter: h.z_enter * gravity_sigma,
+                stay: h.z_stay * gravity_sigma,
                 expected: gravity_sigma,
             },
             rate_variance,
             force_variance,
             gravity_m_s2,
+            enter_epochs: h.enter_epochs,
         }
     }
 }
@@ -285,9 +340,15 @@ impl StillDetector {
 
     /// The SCC1300 budget's detector at a site of gravity `gravity_m_s2`.
     pub fn scc1300(gravity_m_s2: f64) -> Self {
-        Self::new(StillThresholds::from_budget(
+        Self::scc1300_with(gravity_m_s2, &Hysteresis::DEFAULT)
+    }
+
+    /// The same with hysteresis `h`.
+    pub fn scc1300_with(gravity_m_s2: f64, h: &Hysteresis) -> Self {
+        Self::new(StillThresholds::with_hysteresis(
             &ImuNoise::scc1300(),
             gravity_m_s2,
+            h,
         ))
     }
 
@@ -372,7 +433,7 @@ impl StillDetector {
             }
         } else if rate <= t.rate.enter && force <= t.force.enter && gravity <= t.gravity.enter {
             self.passes += 1;
-            self.still = self.passes >= ENTER_EPOCHS;
+            self.still = self.passes >= t.enter_epochs;
         } else {
             self.passes = 0;
         }
@@ -516,6 +577,30 @@ pub(crate) mod tests {
         assert!(s > 0.064 && s < 0.075, "{s}");
         // |f| - g: the 1 mg residual bias dominates: 3.09 sigma ~ 3.1 mg.
         assert!(t.gravity.enter > 0.025 && t.gravity.enter < 0.05, "{t:?}");
+    }
+
+    /// The uplink's default settings give the constants' thresholds to the
+    /// bit; a larger z_enter raises every entering threshold and leaves
+    /// the staying ones.
+    #[test]
+    fn the_hysteresis_settings_move_the_thresholds() {
+        let noise = ImuNoise::scc1300();
+        let defaults = crate::config::default_still_settings();
+        let from_settings =
+            StillThresholds::with_hysteresis(&noise, G, &Hysteresis::from_settings(&defaults));
+        assert_eq!(from_settings, StillThresholds::from_budget(&noise, G));
+        let strict = Hysteresis::from_settings(&StillSettings {
+            z_enter: 4.0,
+            enter_epochs: 7,
+            ..defaults
+        });
+        assert_eq!((strict.z_enter, strict.enter_epochs), (4.0, 7));
+        let t = StillThresholds::with_hysteresis(&noise, G, &strict);
+        let d = from_settings;
+        assert!(t.rate.enter > d.rate.enter && t.force.enter > d.force.enter);
+        assert!(t.gravity.enter > d.gravity.enter);
+        assert_eq!((t.rate.stay, t.force.stay), (d.rate.stay, d.force.stay));
+        assert_eq!(t.enter_epochs, 7);
     }
 
     /// Still samples from the budget at a few attitudes and seeds: still

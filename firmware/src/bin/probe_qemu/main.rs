@@ -172,10 +172,11 @@ pub fn on_uart_rx() {
     });
 }
 
-/// The navigator the configuration asks for (site and calibration; its
-/// tie-in is applied once the navigator levels, in the main loop).
+/// The navigator the configuration asks for (site, calibration and still
+/// settings; its tie-in is applied once the navigator levels, in the main
+/// loop).
 fn navigator_for(config: &ProbeConfig) -> Navigator {
-    Navigator::with_calibration(config.site, config.calibration)
+    Navigator::with_settings(config.site, config.calibration, &config.still)
 }
 
 /// Starts the navigation over from `config`. Not inlined: the new

@@ -151,10 +151,11 @@ fn USART1() {
     PROBE.with(|shared| shared.transmitter_ready());
 }
 
-/// The navigator the configuration asks for (site and calibration; its
-/// tie-in is applied once the navigator levels, in the main loop).
+/// The navigator the configuration asks for (site, calibration and still
+/// settings; its tie-in is applied once the navigator levels, in the main
+/// loop).
 fn navigator_for(config: &ProbeConfig) -> Navigator {
-    Navigator::with_calibration(config.site, config.calibration)
+    Navigator::with_settings(config.site, config.calibration, &config.still)
 }
 
 /// Starts the navigation over from `config`; not inlined, so the new
