@@ -310,20 +310,34 @@ impl Navigator {
         Self::with_calibration(position, ProbeCalibration::default())
     }
 
-    /// A navigator that corrects every sample with `calibration`.
-    pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
-        Self::with_settings(position, calibration, &default_still_settings())
-    }
-
     /// The same with the still detector's and the station's `settings`
-    /// (the uplink's, range-checked when decoded). The detector's
-    /// thresholds are derived here, once, not per sample.
+    /// (the uplink's, range-checked when decoded).
     pub fn with_settings(
         position: Position,
         calibration: ProbeCalibration,
         settings: &StillSettings,
     ) -> Self {
-        let gravity = normal_gravity(position.lat, position.height);
+        let mut navigator = Self::with_calibration(position, calibration);
+        navigator.apply_still_settings(settings);
+        navigator
+    }
+
+    /// Takes the still detector's and the station's `settings` (the
+    /// uplink's, range-checked when decoded): the detector's thresholds are
+    /// derived here, once, not per sample. For a navigator that has not
+    /// started (the probe's boot and re-align). In place, because the
+    /// probe's navigator is ~9 KiB: a constructor that took the settings
+    /// kept a second one in its frame (16 KiB) on top of `main`'s.
+    pub fn apply_still_settings(&mut self, settings: &StillSettings) {
+        let gravity = normal_gravity(self.position.lat, self.position.height);
+        self.still = StillDetector::scc1300_with(gravity, &Hysteresis::from_settings(settings));
+        self.max_station_samples = settings.max_station_samples;
+        self.station_zupt_variance = station_zupt_variance(settings.zupt_velocity_sigma);
+    }
+
+    /// A navigator that corrects every sample with `calibration`, with the
+    /// default still settings.
+    pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
         let idle = NavState::at_rest(UnitQuaternion::identity(), position);
         Self {
             position,
@@ -338,12 +352,12 @@ impl Navigator {
             covariance_invalid: false,
             coarse_single_part: false,
             flags: 0,
-            still: StillDetector::scc1300_with(gravity, &Hysteresis::from_settings(settings)),
+            still: StillDetector::scc1300(normal_gravity(position.lat, position.height)),
             station: None,
             stations: 0,
             station_capped: false,
-            max_station_samples: settings.max_station_samples,
-            station_zupt_variance: station_zupt_variance(settings.zupt_velocity_sigma),
+            max_station_samples: MAX_STATION_SAMPLES,
+            station_zupt_variance: STATION_ZUPT_VARIANCE,
             finished_station: None,
             vertical_residual: None,
             drilled_since_station: false,

@@ -176,7 +176,7 @@ pub fn on_uart_rx() {
 /// settings; its tie-in is applied once the navigator levels, in the main
 /// loop).
 fn navigator_for(config: &ProbeConfig) -> Navigator {
-    Navigator::with_settings(config.site, config.calibration, &config.still)
+    Navigator::with_calibration(config.site, config.calibration)
 }
 
 /// Starts the navigation over from `config`. Not inlined: the new
@@ -187,6 +187,7 @@ fn navigator_for(config: &ProbeConfig) -> Navigator {
 #[inline(never)]
 fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
     *navigator = navigator_for(config);
+    navigator.apply_still_settings(&config.still);
 }
 
 /// UART0 TX: the transmitter's buffer went empty.
@@ -256,6 +257,7 @@ fn main() -> ! {
     // The configured site and calibration (the defaults: the MGWD paper's
     // test site, uncorrected sensors).
     let mut navigator = navigator_for(uplink.config());
+    navigator.apply_still_settings(&uplink.config().still);
     let mut tie_in_pending = uplink.config().tie_in;
     let mut mode = nav_mode::INITIALISING;
     let mut last_pass_tick = None;

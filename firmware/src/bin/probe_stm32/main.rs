@@ -155,7 +155,7 @@ fn USART1() {
 /// settings; its tie-in is applied once the navigator levels, in the main
 /// loop).
 fn navigator_for(config: &ProbeConfig) -> Navigator {
-    Navigator::with_settings(config.site, config.calibration, &config.still)
+    Navigator::with_calibration(config.site, config.calibration)
 }
 
 /// Starts the navigation over from `config`; not inlined, so the new
@@ -164,6 +164,7 @@ fn navigator_for(config: &ProbeConfig) -> Navigator {
 #[inline(never)]
 fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
     *navigator = navigator_for(config);
+    navigator.apply_still_settings(&config.still);
 }
 
 #[entry]
@@ -232,6 +233,7 @@ fn main() -> ! {
     // The configured site and calibration (the defaults: the MGWD paper's
     // test site, uncorrected sensors).
     let mut navigator = navigator_for(uplink.config());
+    navigator.apply_still_settings(&uplink.config().still);
     let mut tie_in_pending = uplink.config().tie_in;
     let mut last_pass_tick = None;
     loop {
