@@ -46,9 +46,14 @@ fn files_of(module: &str) -> Vec<PathBuf> {
 }
 
 /// The code of a file without comments and without its test module
-/// (`tests.rs` files, and everything from a `#[cfg(test)]` on).
+/// (`tests.rs` and `*_tests.rs` files, and everything from a
+/// `#[cfg(test)]` on).
 fn code_of(path: &Path) -> String {
-    if path.file_name().is_some_and(|n| n == "tests.rs") {
+    let test_file = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.ends_with("tests.rs"));
+    if test_file {
         return String::new();
     }
     let text = fs::read_to_string(path).expect("source file");

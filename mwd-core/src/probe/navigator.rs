@@ -52,7 +52,6 @@ use crate::aid_sources::{
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
 use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
 use crate::calibration::ProbeCalibration;
-use crate::config::default_still_settings;
 use crate::conventions::{
     dcm_from_quat, euler_from_quat, quat_from_euler, DrillingAngles, Euler, DEG,
 };
@@ -120,7 +119,9 @@ pub const STATION_ZUPT_VARIANCE: f64 = 1e-4;
 /// itself (`still::widened_setting`: its square in f64 would not be the
 /// constant to the bit).
 fn station_zupt_variance(sigma: f32) -> f64 {
-    let default = default_still_settings().zupt_velocity_sigma;
+    // `config::default_still_settings`'s sigma (probe does not import
+    // config: config builds on probe's constants).
+    let default = libm::sqrt(STATION_ZUPT_VARIANCE) as f32;
     if sigma == default {
         STATION_ZUPT_VARIANCE
     } else {

@@ -5,6 +5,7 @@
 extern crate std;
 use super::tests::{level_sample, turning_sample, ALL_ALIGNMENT};
 use super::*;
+use crate::config::default_still_settings;
 use crate::probe::still::{Hysteresis, DETECTION_DELAY_SAMPLES};
 use std::format;
 use std::vec::Vec;
