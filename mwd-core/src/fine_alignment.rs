@@ -956,22 +956,23 @@ mod tests {
         assert!((along(&filter.p) - along(&p0) - q_along).abs() <= 1e-15);
     }
 
-    /// Unobserved (navigating, no updates), a bias state's variance grows
-    /// by q per step as a random walk, and by the Gauss-Markov increment
-    /// 2 sigma^2 (1 - exp(-T/tau)) when bounded: after an hour that is
-    /// under 2 sigma^2, where the walk has added 2 sigma^2 T/tau = 72
-    /// sigma^2. Switching back to every-step restarts the bound.
-    #[test]
-    fn a_restored_accelerometer_bias_grows_by_the_walk_up_to_the_instabilitys_largest_change() {
+    /// A level 39-state filter at the paper's site with `noise` and
+    /// `coarse_sigma` (`configure` edits its configuration first), and the
+    /// sample of a still, perfect probe there.
+    fn level_filter_at_rest(
+        noise: &ImuNoise,
+        coarse_sigma: &[f64; 3],
+        configure: impl FnOnce(&mut FineAlignmentConfig<STATES_WITH_BIASES>),
+    ) -> (FineAlignment<f64, STATES_WITH_BIASES>, ImuSample) {
         let site = Position::paper_site();
-        let noise = ImuNoise::scc1300();
-        let config = FineAlignmentConfig::<STATES_WITH_BIASES>::physical(
+        let mut config = FineAlignmentConfig::<STATES_WITH_BIASES>::physical(
             AugmentedModel::paper(),
-            &noise,
-            &[0.01, 0.01, 0.1],
+            noise,
+            coarse_sigma,
             site.lat,
         );
-        let mut fa = FineAlignment::<f64, STATES_WITH_BIASES>::new(
+        configure(&mut config);
+        let filter = FineAlignment::new(
             NavState::at_rest(UnitQuaternion::identity(), site),
             site,
             config,
@@ -980,6 +981,16 @@ mod tests {
             rate: earth_rate_n(site.lat),
             specific_force: -gravity_n(&site),
         };
+        (filter, at_rest)
+    }
+
+    /// An accelerometer bias put back at a station grows by the random
+    /// walk added since its snapshot, but never by more than the
+    /// instability's largest change, 2 sigma^2 (an hour's walk is 72).
+    #[test]
+    fn a_restored_accelerometer_bias_grows_by_the_walk_up_to_the_instabilitys_largest_change() {
+        let noise = ImuNoise::scc1300();
+        let (mut fa, at_rest) = level_filter_at_rest(&noise, &[0.01, 0.01, 0.1], |_| {});
         fa.step(&at_rest);
         let snapshot = fa.accel_bias().unwrap();
         let sigma = noise.accel[0].bias_instability;
@@ -998,32 +1009,18 @@ mod tests {
 
     #[test]
     fn navigation_keeps_the_gyro_bias_constant_and_adds_the_instability_as_rate_noise() {
-        let site = Position::paper_site();
         // The instability alone drives the heading: no white or AR gyro
         // noise, a small heading sigma (its large-angle drift term off).
         let mut noise = ImuNoise::scc1300();
         for g in &mut noise.gyro {
             g.white_density = 0.0;
         }
-        let mut config = FineAlignmentConfig::<STATES_WITH_BIASES>::physical(
-            AugmentedModel::paper(),
-            &noise,
-            &[0.01, 0.01, 0.01],
-            site.lat,
-        );
-        config.zero_velocity_variance = None;
-        config.zero_position_variance = None;
-        config.ar_noise_scale = 0.0;
-        let dt = config.model.dt;
-        let mut fa = FineAlignment::<f64, STATES_WITH_BIASES>::new(
-            NavState::at_rest(UnitQuaternion::identity(), site),
-            site,
-            config,
-        );
-        let at_rest = ImuSample {
-            rate: earth_rate_n(site.lat),
-            specific_force: -gravity_n(&site),
-        };
+        let (mut fa, at_rest) = level_filter_at_rest(&noise, &[0.01, 0.01, 0.01], |config| {
+            config.zero_velocity_variance = None;
+            config.zero_position_variance = None;
+            config.ar_noise_scale = 0.0;
+        });
+        let dt = fa.config.model.dt;
         let p =
             |fa: &FineAlignment<f64, STATES_WITH_BIASES>, i: usize, j: usize| fa.filter.p[(i, j)];
         fa.step(&at_rest);
