@@ -108,36 +108,46 @@ impl ImuNoise {
     };
 
     /// The SCC1300-D04 figures listed in the module documentation.
-    pub fn scc1300() -> Self {
-        let gyro = |ar: Ar4, white: f64| AxisNoise {
-            white_density: white,
-            coloured: Some(ar),
-            bias_instability: rate_from_deg_per_hour(2.1),
-            correlation_time: BIAS_CORRELATION_TIME,
-            residual_bias: rate_from_deg_per_hour(2.1),
-        };
-        let accel = |ar: Ar4| AxisNoise {
-            white_density: 0.052_257_815 / 60.0,
-            coloured: Some(ar),
-            bias_instability: 0.000_554_625,
-            correlation_time: BIAS_CORRELATION_TIME,
-            residual_bias: 1e-3 * STANDARD_GRAVITY,
-        };
+    pub const fn scc1300() -> Self {
         let arw = arw_from_deg_per_sqrt_hour(0.86);
         ImuNoise {
             accel: [
-                accel(ACCEL_DEFAULTS[0]),
-                accel(ACCEL_DEFAULTS[1]),
-                accel(ACCEL_DEFAULTS[2]),
+                scc1300_accel(ACCEL_DEFAULTS[0]),
+                scc1300_accel(ACCEL_DEFAULTS[1]),
+                scc1300_accel(ACCEL_DEFAULTS[2]),
             ],
             // The y rate is derived from accelerometer roll, not a gyro: its
             // noise is the paper's fitted model alone.
             gyro: [
-                gyro(GYRO_DEFAULTS[0], arw),
-                gyro(GYRO_DEFAULTS[1], 0.0),
-                gyro(GYRO_DEFAULTS[2], arw),
+                scc1300_gyro(GYRO_DEFAULTS[0], arw),
+                scc1300_gyro(GYRO_DEFAULTS[1], 0.0),
+                scc1300_gyro(GYRO_DEFAULTS[2], arw),
             ],
         }
+    }
+}
+
+/// The SCC1300 budget as a static: what a navigator uses unless told
+/// otherwise (`probe::Navigator::set_noise_budget`).
+pub static SCC1300_NOISE: ImuNoise = ImuNoise::scc1300();
+
+const fn scc1300_gyro(ar: Ar4, white: f64) -> AxisNoise {
+    AxisNoise {
+        white_density: white,
+        coloured: Some(ar),
+        bias_instability: rate_from_deg_per_hour(2.1),
+        correlation_time: BIAS_CORRELATION_TIME,
+        residual_bias: rate_from_deg_per_hour(2.1),
+    }
+}
+
+const fn scc1300_accel(ar: Ar4) -> AxisNoise {
+    AxisNoise {
+        white_density: 0.052_257_815 / 60.0,
+        coloured: Some(ar),
+        bias_instability: 0.000_554_625,
+        correlation_time: BIAS_CORRELATION_TIME,
+        residual_bias: 1e-3 * STANDARD_GRAVITY,
     }
 }
 

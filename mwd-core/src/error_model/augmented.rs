@@ -91,6 +91,29 @@ impl AugmentedModel {
         }
     }
 
+    /// The model of an error budget `noise` at 20 Hz, coupled: its AR(4)
+    /// models and bias statistics. `paper()` is this with the SCC1300
+    /// budget. An axis without coloured noise gets a white AR model
+    /// (zero coefficients) of a millionth of its white noise's variance
+    /// per sample: the white noise itself is the process noise's
+    /// (`FineAlignmentConfig::physical`), and the AR states keep a
+    /// positive variance, which the covariance's health check asks of
+    /// every state (`KalmanFilter::covariance_is_healthy`).
+    pub fn from_noise(noise: &ImuNoise) -> Self {
+        let dt = SAMPLE_INTERVAL_S;
+        let ar = |axis: &crate::sensor_noise::AxisNoise| {
+            let floor = (axis.white_density * axis.white_density / dt * 1e-6).max(1e-30);
+            axis.coloured.unwrap_or(Ar4::new([0.0; AR_ORDER], floor))
+        };
+        Self {
+            accel: noise.accel.each_ref().map(ar),
+            gyro: noise.gyro.each_ref().map(ar),
+            biases: SensorBiases::from_noise(noise, dt),
+            coupling: Coupling::SensorErrorsDriveNavigation,
+            dt,
+        }
+    }
+
     /// The discrete transition at a linearisation point, for `N` = 33
     /// ([`STATES`]) or 39 ([`STATES_WITH_BIASES`]) states.
     pub fn transition<T: FilterScalar, const N: usize>(
@@ -558,6 +581,23 @@ mod tests {
         phi.propagate_lower(&mut m);
         let reference = dense * p * dense.transpose();
         assert!(lower_rel_diff(&m, &reference) < 1e-14);
+    }
+
+    #[test]
+    fn the_paper_model_is_the_scc1300_budget_s() {
+        assert_eq!(
+            AugmentedModel::from_noise(&ImuNoise::scc1300()),
+            AugmentedModel::paper()
+        );
+        // An axis without coloured noise: a white AR block of a millionth
+        // of the white noise.
+        let mut quiet = ImuNoise::scc1300();
+        quiet.gyro[0].coloured = None;
+        let model = AugmentedModel::from_noise(&quiet);
+        let white = quiet.gyro[0].white_density.powi(2) / SAMPLE_INTERVAL_S;
+        assert!((model.gyro[0].noise_variance / white - 1e-6).abs() < 1e-12);
+        assert_eq!(model.gyro[0].coefficients, [0.0; AR_ORDER]);
+        assert_eq!(model.gyro[2], AugmentedModel::paper().gyro[2]);
     }
 
     #[test]

@@ -69,7 +69,7 @@ use crate::protocol::frame::nav_mode;
 use crate::protocol::frame::station_flags;
 use crate::protocol::uplink::StillSettings;
 use crate::protocol::{NavSolution, RawSample, StationSurvey};
-use crate::sensor_noise::ImuNoise;
+use crate::sensor_noise::{ImuNoise, SCC1300_NOISE};
 use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
 use nalgebra::UnitQuaternion;
 use nalgebra::{Matrix3, Vector3};
@@ -193,14 +193,16 @@ pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 
 /// The filter's settings for a still probe at `position` whose coarse
-/// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad).
+/// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad), with
+/// the sensors' error budget `noise`.
 fn filter_config(
     position: &Position,
     coarse_sigma: &[f64; 3],
+    noise: &ImuNoise,
 ) -> FineAlignmentConfig<STATES_WITH_BIASES> {
     FineAlignmentConfig::physical(
-        AugmentedModel::paper(),
-        &ImuNoise::scc1300(),
+        AugmentedModel::from_noise(noise),
+        noise,
         coarse_sigma,
         position.lat,
     )
@@ -239,6 +241,9 @@ struct Station {
 pub struct Navigator {
     position: Position,
     calibration: ProbeCalibration,
+    /// The sensors' error budget the filter and the aiding sources model
+    /// (default the SCC1300's; a reference, 4 bytes on the probe).
+    noise: &'static ImuNoise,
     phase: Phase,
     /// Idle until the coarse alignment ends, then restarted in place from
     /// it: the filter is the probe's largest object (6 KiB of covariance),
@@ -340,11 +345,13 @@ impl Navigator {
     /// default still settings.
     pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
         let idle = NavState::at_rest(UnitQuaternion::identity(), position);
+        let noise = &SCC1300_NOISE;
         Self {
             position,
             calibration,
+            noise,
             phase: Phase::Coarse(SegmentSums::default()),
-            filter: Filter::new(idle, position, filter_config(&position, &[0.0; 3])),
+            filter: Filter::new(idle, position, filter_config(&position, &[0.0; 3], noise)),
             input: ProbeInput::new(),
             coarse_std: [f32::NAN; 3],
             held: None,
@@ -373,12 +380,45 @@ impl Navigator {
         }
     }
 
+    /// Models the sensors with the error budget `noise` instead of the
+    /// SCC1300's: the filter's AR and bias models, its process noise and
+    /// the aiding sources' variances. The still detector keeps the
+    /// SCC1300's thresholds (a quieter gyro passes them too). For a
+    /// navigator that has not started; the host's studies of other gyro
+    /// grades use it (the probe flies the SCC1300).
+    pub fn set_noise_budget(&mut self, noise: &'static ImuNoise) {
+        self.noise = noise;
+    }
+
+    /// The sensors' error budget the navigator models.
+    pub fn noise_budget(&self) -> &'static ImuNoise {
+        self.noise
+    }
+
     /// Takes one raw sample and returns the solution after it.
     pub fn step(&mut self, raw: &RawSample) -> NavSolution {
+        let reading = reading(raw, &self.calibration);
+        self.step_reading(raw.time_us, raw.sample_counter, reading)
+    }
+
+    /// Takes one calibrated body-frame sample of both parts (the host's
+    /// studies of gyros other than the SCC1300, whose readings do not fit
+    /// the SCC1300's raw counts: 18 LSB per deg/s would round a
+    /// navigation-grade gyro's earth rate away) and returns the solution.
+    pub fn step_sample(
+        &mut self,
+        time_us: u64,
+        sample_counter: u32,
+        sample: &ProbeSample,
+    ) -> NavSolution {
+        self.step_reading(time_us, sample_counter, Reading::Both(*sample))
+    }
+
+    fn step_reading(&mut self, time_us: u64, sample_counter: u32, reading: Reading) -> NavSolution {
         self.flags = 0;
-        self.time_us = raw.time_us;
-        self.sample_counter = raw.sample_counter;
-        let still = match reading(raw, &self.calibration) {
+        self.time_us = time_us;
+        self.sample_counter = sample_counter;
+        let still = match reading {
             Reading::Both(sample) => self.use_sample(&sample, None),
             Reading::Single {
                 sample,
@@ -401,7 +441,7 @@ impl Navigator {
             self.track_station(still);
             self.follow_commands(still);
         }
-        self.solution(raw)
+        self.solution(time_us, sample_counter)
     }
 
     /// The station survey finished by the last [`step`](Self::step), if
@@ -522,7 +562,7 @@ impl Navigator {
         let cos_inclination = dcm_from_quat(&self.filter.state().attitude)[(2, 1)];
         let variance = VerticalEarthRate::<f32>::variance(
             d,
-            GYRO_AXES.map(gyro_long_run_variance),
+            GYRO_AXES.map(|axis| gyro_long_run_variance(self.noise, axis)),
             n,
             tilt.x.max(tilt.y),
             cos_inclination,
@@ -715,7 +755,7 @@ impl Navigator {
                 if drilling && report.sample_used && !self.covariance_invalid {
                     self.toolface_block.add(&sample.specific_force);
                     if self.toolface_block.samples() >= TOOLFACE_BLOCK_SAMPLES {
-                        aid_drilling_toolface(filter, &self.toolface_block);
+                        aid_drilling_toolface(filter, &self.toolface_block, self.noise);
                         self.toolface_block.clear();
                     }
                 } else {
@@ -833,7 +873,8 @@ impl Navigator {
     }
 
     fn finish_coarse_alignment(&mut self, segment: &StaticSegment, gyrocompass_possible: bool) {
-        let config = AlignmentConfig::probe(self.position.lat);
+        let mut config = AlignmentConfig::probe(self.position.lat);
+        config.noise = *self.noise;
         let (roll, pitch, roll_pitch_std) = match level_segment(segment, &config) {
             Ok(l) => (l.roll.value, l.pitch.value, [l.roll.sigma, l.pitch.sigma]),
             Err(_) => (0.0, 0.0, [f64::NAN; 2]),
@@ -858,7 +899,7 @@ impl Navigator {
         self.filter.restart(
             NavState::at_rest(attitude, self.position),
             self.position,
-            filter_config(&self.position, &filter_sigma),
+            filter_config(&self.position, &filter_sigma, self.noise),
         );
         self.covariance_invalid = false;
         self.coasting = false;
@@ -871,10 +912,10 @@ impl Navigator {
         self.phase = Phase::Fine { samples: 0 };
     }
 
-    fn solution(&self, raw: &RawSample) -> NavSolution {
+    fn solution(&self, time_us: u64, sample_counter: u32) -> NavSolution {
         let mut solution = NavSolution {
-            time_us: raw.time_us,
-            sample_counter: raw.sample_counter,
+            time_us,
+            sample_counter,
             mode: nav_mode::COARSE_ALIGNMENT,
             flags: self.flags,
             // Placeholders while there is no solution: NaN, never a
@@ -979,7 +1020,11 @@ impl Navigator {
                 10f64.to_radians()
             }
         });
-        let config = filter_config(&self.position, &[levelling[0], levelling[1], sigma.azimuth]);
+        let config = filter_config(
+            &self.position,
+            &[levelling[0], levelling[1], sigma.azimuth],
+            self.noise,
+        );
         let state = NavState::at_rest(quat_from_euler(&start.to_euler()), self.position);
         self.filter.restart(state, self.position, config);
         self.filter.set_heading(0.0, square(sigma.azimuth));
@@ -1017,7 +1062,7 @@ impl Navigator {
     /// the filter starts again from the tie-in's attitude and sigmas.
     fn restart_from_tie_in(&mut self, tie_in: &TieIn) {
         let sigma = tie_in.euler_sigma();
-        let mut config = filter_config(&self.position, &sigma);
+        let mut config = filter_config(&self.position, &sigma, self.noise);
         config.tilt_prior = TiltPrior::Independent;
         let start = NavState::at_rest(tie_in.attitude(), self.position);
         self.filter.restart(start, self.position, config);
@@ -1128,8 +1173,8 @@ const GROSS_TOOLFACE_CHI2: f64 = 16.0;
 /// (`aid_sources::DrillingToolface`, derivation section 4g): an update, or
 /// when the roll is grossly off (a toolface turned on bottom) the block's
 /// roll with its variance about the tool axis.
-fn aid_drilling_toolface(filter: &mut Filter, block: &ForceBlock) {
-    let budget = ImuNoise::scc1300().accel[0];
+fn aid_drilling_toolface(filter: &mut Filter, block: &ForceBlock, noise: &ImuNoise) {
+    let budget = noise.accel[0];
     let bias_variance = square(budget.residual_bias) + square(budget.bias_instability);
     let Some(m) = DrillingToolface::<f32>::at(filter.state(), block, bias_variance) else {
         return;
@@ -1186,8 +1231,8 @@ fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
 /// the filter's rate-bias states are the constant part only
 /// (`fine_alignment::BiasWalk::InstabilityAsRateNoise`), and a station's
 /// means hold its value of the moment.
-fn gyro_long_run_variance(axis: usize) -> f64 {
-    let noise = ImuNoise::scc1300().gyro[axis];
+fn gyro_long_run_variance(budget: &ImuNoise, axis: usize) -> f64 {
+    let noise = budget.gyro[axis];
     let white = square(noise.white_density) / SAMPLE_INTERVAL_S;
     let coloured = noise.coloured.map_or(0.0, |ar| {
         let gain = 1.0 + ar.coefficients.iter().sum::<f64>();
@@ -1235,6 +1280,68 @@ mod tests {
     }
 
     pub(super) const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
+
+    #[test]
+    fn a_body_sample_steps_as_its_raw_frame_does() {
+        let position = Position::paper_site();
+        let (mut by_raw, mut by_sample) = (Navigator::new(position), Navigator::new(position));
+        // Tilted, so the alignment and the filter have work to do.
+        let tilted = |n| still_sample(n, [0.3, 0.5, STANDARD_GRAVITY_M_S2 - 0.02]);
+        for n in 0..ALL_ALIGNMENT + 40 {
+            let raw = tilted(n);
+            let sample = match reading(&raw, &ProbeCalibration::default()) {
+                Reading::Both(sample) => sample,
+                other => panic!("{other:?}"),
+            };
+            let a = by_raw.step(&raw);
+            let b = by_sample.step_sample(raw.time_us, raw.sample_counter, &sample);
+            assert_eq!(std::format!("{a:?}"), std::format!("{b:?}"), "sample {n}");
+        }
+        assert_eq!(by_raw.filter().state(), by_sample.filter().state());
+    }
+
+    #[test]
+    fn a_quieter_budget_gives_smaller_sigmas() {
+        static QUIET: ImuNoise = {
+            let mut noise = ImuNoise::scc1300();
+            let mut axis = 0;
+            while axis < 3 {
+                noise.gyro[axis].white_density /= 100.0;
+                noise.gyro[axis].bias_instability /= 100.0;
+                noise.gyro[axis].residual_bias /= 100.0;
+                noise.gyro[axis].coloured = None;
+                axis += 2;
+            }
+            noise
+        };
+        let position = Position::paper_site();
+        let (mut scc1300, mut quiet) = (Navigator::new(position), Navigator::new(position));
+        quiet.set_noise_budget(&QUIET);
+        assert_eq!(scc1300.noise_budget(), &ImuNoise::scc1300());
+        let (mut a, mut b) = (None, None);
+        for n in 0..ALL_ALIGNMENT {
+            a = Some(scc1300.step(&level_sample(n)));
+            b = Some(quiet.step(&level_sample(n)));
+        }
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert_eq!(
+            (a.mode, b.mode),
+            (nav_mode::NAVIGATING, nav_mode::NAVIGATING)
+        );
+        // Velocity sigmas are the accelerometers' (the same budget); the
+        // filter's covariance stays healthy with the still AR blocks.
+        assert!(
+            b.velocity_std.iter().all(|s| s.is_finite() && *s > 0.0),
+            "{b:?}"
+        );
+        let gyro_bias = |n: &Navigator, i: usize| {
+            n.filter().filter().p[(
+                crate::error_model::GYRO_BIAS + i,
+                crate::error_model::GYRO_BIAS + i,
+            )]
+        };
+        assert!(gyro_bias(&quiet, 0) < 1e-3 * gyro_bias(&scc1300, 0));
+    }
 
     #[test]
     fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
