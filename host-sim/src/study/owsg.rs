@@ -310,26 +310,31 @@ pub fn predict_on(model: OwsgModel, stations: &[Station], site: &Site) -> Result
             ..*s
         })
         .collect();
-    let reference = figures(&terms, &capped, site)?;
     let limit = MAX_FIRST_ORDER_AZIMUTH_SIGMA_DEG;
-    let (reference, reference_note) = if reference.max_station_azimuth_sigma_deg <= limit {
-        (
+    let (reference, reference_note) = match figures(&terms, &capped, site) {
+        Ok(f) if f.max_station_azimuth_sigma_deg <= limit => (
             Some(Reference {
                 capped_at_deg: range.max_deg,
-                figures: reference,
+                figures: f,
             }),
             None,
-        )
-    } else {
-        (
+        ),
+        Ok(f) => (
             None,
             Some(format!(
                 "no reference at the {} deg limit either: the model's gyro terms give a \
                  single-station azimuth 1-sigma of up to {:.0} deg there (a first-order error \
                  model means nothing above ~{limit} deg)",
-                range.max_deg, reference.max_station_azimuth_sigma_deg
+                range.max_deg, f.max_station_azimuth_sigma_deg
             )),
-        )
+        ),
+        Err(e) => (
+            None,
+            Some(format!(
+                "no reference at the {} deg limit: {e:#}",
+                range.max_deg
+            )),
+        ),
     };
     Ok(OwsgPrediction {
         model: model.name(),
