@@ -2,6 +2,8 @@
 
 pub mod drilling_coverage;
 pub mod drilling_run;
+pub mod lateral_plots;
+pub mod owsg;
 pub mod rins_probe;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
