@@ -2,6 +2,10 @@
 
 pub mod drilling_coverage;
 pub mod drilling_run;
+pub mod grade;
+pub mod lateral;
+pub mod lateral_summary;
+pub mod lateral_table;
 pub mod rins_probe;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
