@@ -155,6 +155,19 @@ pub struct RunOutcome {
     pub samples: usize,
     /// Wall time of the run on its thread (s).
     pub elapsed_s: f64,
+    /// CPU time of its thread (s), where the system tells it
+    /// ([`thread_cpu_s`]): on a shared machine the wall time is not the
+    /// work.
+    pub cpu_s: Option<f64>,
+}
+
+/// The calling thread's CPU time so far (s): Linux's
+/// `/proc/thread-self/schedstat` (its first field: ns on a CPU); `None`
+/// elsewhere or when the kernel does not keep it.
+pub fn thread_cpu_s() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
 }
 
 /// The parent well's survey at the window: its inclination is the
@@ -228,6 +241,7 @@ fn feed(
 /// Runs seed `seed`.
 pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let started = std::time::Instant::now();
+    let cpu_start = thread_cpu_s();
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x57D7_0000_0000_0013);
     let mut plan = config.plan.clone();
     if let Some((scale, stretch)) = config.depth_sigma {
@@ -343,6 +357,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         td_note,
         samples,
         elapsed_s: started.elapsed().as_secs_f64(),
+        cpu_s: cpu_start.zip(thread_cpu_s()).map(|(a, b)| b - a),
     })
 }
 

@@ -95,10 +95,17 @@ pub struct GradeWellSummary {
     pub along_md: Vec<AlongMd>,
     /// Simulated samples (each one navigator epoch).
     pub samples: usize,
-    /// Sum of the runs' times on their threads (s).
-    pub run_time_s: f64,
-    /// Navigator epochs (simulation included) per second of one core.
+    /// Sum of the runs' wall times on their threads (s).
+    pub run_wall_s: f64,
+    /// Sum of their threads' CPU times (s); `None` when the system does
+    /// not tell it for every run.
+    pub run_cpu_s: Option<f64>,
+    /// Navigator epochs (simulation included) per second of one core's
+    /// CPU time; `None` without CPU times.
     pub epochs_per_core_second: Option<f64>,
+    /// The same per second of wall time per thread (lower on a machine
+    /// shared with other work).
+    pub epochs_per_thread_wall_second: Option<f64>,
 }
 
 pub(crate) fn rms(values: &[f64]) -> Option<f64> {
@@ -172,6 +179,7 @@ pub fn summarise(
     let k2 = scale_2d(0.95).powi(2);
     let mut unchecked: BTreeMap<String, usize> = BTreeMap::new();
     let mut by_station: BTreeMap<u16, Tally> = BTreeMap::new();
+    let mut cpu = Some(0.0);
     for (_, r) in results {
         let o = match r {
             Ok(o) => o,
@@ -181,7 +189,8 @@ pub fn summarise(
             }
         };
         s.samples += o.samples;
-        s.run_time_s += o.elapsed_s;
+        s.run_wall_s += o.elapsed_s;
+        cpu = cpu.zip(o.cpu_s).map(|(a, b)| a + b);
         for st in &o.stations {
             s.stations += 1;
             let sd = st.survey.angles_std.map(f64::from);
@@ -245,7 +254,14 @@ pub fn summarise(
     };
     s.td_unchecked = unchecked.into_iter().collect();
     s.along_md = by_station.iter().map(|(n, t)| t.along(*n)).collect();
-    s.epochs_per_core_second = (s.run_time_s > 0.0).then(|| s.samples as f64 / s.run_time_s);
+    let ok = s.runs > s.failed_runs.len();
+    s.run_cpu_s = cpu.filter(|_| ok);
+    s.epochs_per_core_second = s
+        .run_cpu_s
+        .filter(|c| *c > 0.0)
+        .map(|c| s.samples as f64 / c);
+    s.epochs_per_thread_wall_second =
+        (s.run_wall_s > 0.0).then(|| s.samples as f64 / s.run_wall_s);
     s.requirement = requirement(&s);
     s
 }
@@ -312,6 +328,7 @@ mod tests {
             td_note: None,
             samples: 1000,
             elapsed_s: 0.5,
+            cpu_s: Some(0.25),
         }
     }
 
@@ -339,7 +356,8 @@ mod tests {
         assert_eq!(s.along_md[1].station, 2);
         assert_eq!(s.along_md[1].rms_horizontal_error_m, Some(5.0));
         assert_eq!(s.along_md[1].median_horizontal_sigma_m, Some(5.0));
-        assert_eq!(s.epochs_per_core_second, Some(2000.0));
+        assert_eq!(s.epochs_per_core_second, Some(4000.0));
+        assert_eq!(s.epochs_per_thread_wall_second, Some(2000.0));
         // 2 deg of azimuth and 36 m per 1000 m: neither met; a failed run
         // leaves the position requirement unmet whatever the figures
         assert_eq!(s.requirement.attitude_met, Some(false));

@@ -141,7 +141,7 @@ pub fn table(study: &LateralStudy) -> String {
             "RMS (m/1000 m)",
             "p95 (m/1000 m)",
             "position met",
-            "epochs/s/core",
+            "epochs/s/core (CPU)",
         ],
         &rows,
         2,
@@ -236,6 +236,7 @@ pub fn csv(study: &LateralStudy) -> String {
         "position_met",
         "samples",
         "epochs_per_core_second",
+        "epochs_per_thread_wall_second",
     ];
     let f = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v}"));
     let b = |v: Option<bool>| v.map_or_else(String::new, |v| v.to_string());
@@ -273,6 +274,7 @@ pub fn csv(study: &LateralStudy) -> String {
             b(s.requirement.position_met),
             s.samples.to_string(),
             f(s.epochs_per_core_second),
+            f(s.epochs_per_thread_wall_second),
         ];
         out.push_str(&(fields.join(",") + "\n"));
     }
