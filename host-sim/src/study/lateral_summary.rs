@@ -67,6 +67,9 @@ pub struct AlongMd {
     pub rms_azimuth_error_deg: Option<f64>,
     pub median_azimuth_sigma_deg: Option<f64>,
     pub azimuth_within_2_sigma: Fraction,
+    pub rms_inclination_error_deg: Option<f64>,
+    pub median_inclination_sigma_deg: Option<f64>,
+    pub inclination_within_2_sigma: Fraction,
     /// Stations with a determined survey position.
     pub positioned: usize,
     pub rms_horizontal_error_m: Option<f64>,
@@ -88,6 +91,7 @@ pub struct GradeWellSummary {
     pub rms_station_inclination_deg: Option<f64>,
     pub rms_station_azimuth_deg: Option<f64>,
     pub azimuth_within_2_sigma: Fraction,
+    pub inclination_within_2_sigma: Fraction,
     pub td: TdSummary,
     /// Runs without a TD check, by reason.
     pub td_unchecked: Vec<(String, usize)>,
@@ -132,6 +136,8 @@ struct Tally {
     undetermined: usize,
     /// (|error|, sigma) of determined azimuths, deg.
     azimuth: Vec<(f64, f64)>,
+    /// (|error|, sigma) of the inclinations, deg.
+    inclination: Vec<(f64, f64)>,
     /// (radial error, sqrt trace), m.
     position: Vec<(f64, f64)>,
 }
@@ -141,6 +147,9 @@ impl Tally {
         let errors: Vec<f64> = self.azimuth.iter().map(|a| a.0).collect();
         let sigmas: Vec<f64> = self.azimuth.iter().map(|a| a.1).collect();
         let inside = self.azimuth.iter().filter(|(e, s)| *e <= 2.0 * s).count();
+        let inc_errors: Vec<f64> = self.inclination.iter().map(|a| a.0).collect();
+        let inc_sigmas: Vec<f64> = self.inclination.iter().map(|a| a.1).collect();
+        let inc_inside = self.inclination.iter().filter(|(e, s)| *e <= 2.0 * s).count();
         let radial: Vec<f64> = self.position.iter().map(|p| p.0).collect();
         let predicted: Vec<f64> = self.position.iter().map(|p| p.1).collect();
         AlongMd {
@@ -151,6 +160,9 @@ impl Tally {
             rms_azimuth_error_deg: rms(&errors),
             median_azimuth_sigma_deg: median(&sigmas),
             azimuth_within_2_sigma: Fraction::of(inside, self.azimuth.len()),
+            rms_inclination_error_deg: rms(&inc_errors),
+            median_inclination_sigma_deg: median(&inc_sigmas),
+            inclination_within_2_sigma: Fraction::of(inc_inside, self.inclination.len()),
             positioned: self.position.len(),
             rms_horizontal_error_m: rms(&radial),
             median_horizontal_sigma_m: median(&predicted),
@@ -173,7 +185,7 @@ pub fn summarise(
         ..GradeWellSummary::default()
     };
     let (mut inc, mut azi) = (Vec::new(), Vec::new());
-    let mut azi_inside = 0;
+    let (mut azi_inside, mut inc_inside) = (0, 0);
     let (mut td_err, mut td_sigma, mut td_major) = (Vec::new(), Vec::new(), Vec::new());
     let mut td_inside = 0;
     let k2 = scale_2d(0.95).powi(2);
@@ -199,8 +211,12 @@ pub fn summarise(
                 continue;
             }
             inc.push(st.error[0].to_degrees());
+            inc_inside += usize::from(st.error[0].abs() <= 2.0 * sd[0]);
             let tally = by_station.entry(st.survey.station).or_default();
             tally.md.push(st.truth_md);
+            tally
+                .inclination
+                .push((st.error[0].abs().to_degrees(), sd[0].to_degrees()));
             if st.survey.flags & station_flags::AZIMUTH_UNDETERMINED != 0 || !sd[1].is_finite() {
                 s.azimuth_undetermined_stations += 1;
                 tally.undetermined += 1;
@@ -239,6 +255,7 @@ pub fn summarise(
     s.rms_station_inclination_deg = rms(&inc);
     s.rms_station_azimuth_deg = rms(&azi);
     s.azimuth_within_2_sigma = Fraction::of(azi_inside, azi.len());
+    s.inclination_within_2_sigma = Fraction::of(inc_inside, inc.len());
     let per_1000 = |v: Option<f64>| v.map(|v| v * 1000.0 / lateral_length_m);
     let predicted = rms(&td_sigma);
     let major = rms(&td_major);

@@ -77,6 +77,7 @@ fn station_row(s: &GradeWellSummary) -> Vec<String> {
         num(s.rms_station_azimuth_deg, 3),
         fraction(&s.azimuth_within_2_sigma),
         num(s.rms_station_inclination_deg, 3),
+        fraction(&s.inclination_within_2_sigma),
         met(s.requirement.attitude_met),
     ]
 }
@@ -118,6 +119,7 @@ pub fn table(study: &LateralStudy) -> String {
             "azi RMS (deg)",
             "azi within 2 sigma",
             "inc RMS (deg)",
+            "inc within 2 sigma",
             "attitude met",
         ],
         &rows,
@@ -176,6 +178,8 @@ pub fn table(study: &LateralStudy) -> String {
                     a.azimuth_within_2_sigma
                         .fraction
                         .map_or_else(|| "-".into(), |p| format!("{:.1}", 100.0 * p)),
+                    num(a.rms_inclination_error_deg, 3),
+                    num(a.median_inclination_sigma_deg, 3),
                     a.positioned.to_string(),
                     num(a.rms_horizontal_error_m, 2),
                     num(a.median_horizontal_sigma_m, 2),
@@ -191,6 +195,8 @@ pub fn table(study: &LateralStudy) -> String {
                 "azi RMS (deg)",
                 "azi median sigma (deg)",
                 "within 2 sigma (%)",
+                "inc RMS (deg)",
+                "inc median sigma (deg)",
                 "positioned",
                 "horiz RMS (m)",
                 "horiz median 1s (m)",
@@ -218,6 +224,8 @@ pub fn csv(study: &LateralStudy) -> String {
         "azimuth_within_2_sigma",
         "azimuth_within_2_sigma_se",
         "rms_station_inclination_deg",
+        "inclination_within_2_sigma",
+        "inclination_within_2_sigma_se",
         "td_runs_checked",
         "td_rms_horizontal_error_m",
         "td_p95_horizontal_error_m",
@@ -256,6 +264,8 @@ pub fn csv(study: &LateralStudy) -> String {
             f(s.azimuth_within_2_sigma.fraction),
             f(s.azimuth_within_2_sigma.standard_error),
             f(s.rms_station_inclination_deg),
+            f(s.inclination_within_2_sigma.fraction),
+            f(s.inclination_within_2_sigma.standard_error),
             t.runs_checked.to_string(),
             f(t.rms_horizontal_error_m),
             f(t.p95_horizontal_error_m),
