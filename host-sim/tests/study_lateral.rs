@@ -28,8 +28,7 @@ fn short_well() -> Well {
 /// One run of the 100 m lateral as planned (30 m/h, 5 min stills).
 fn one_run(grade: &Grade, seed: u64) -> RunOutcome {
     let well = Well::builtin("100m", &Default::default()).expect("built in");
-    let config =
-        RunConfig::new(well.plan, 0.5f64.to_radians(), grade.clone()).expect("run config");
+    let config = RunConfig::new(well.plan, 0.5f64.to_radians(), grade.clone()).expect("run config");
     drilling_run::run(&config, seed).expect("the run")
 }
 
@@ -58,9 +57,10 @@ fn the_grade_files_parse_and_the_scc1300_is_todays_model() {
 fn a_bad_grade_file_is_refused_naming_the_file_and_the_field() {
     let dir = scratch("study-lateral", "bad-grade");
     let bad = dir.join("bad.json");
-    let text = host_sim::study::grade::BUILTIN[3]
-        .1
-        .replace("\"arw_deg_per_sqrt_h\": 0.002", "\"arw_deg_per_sqrt_h\": -0.002");
+    let text = host_sim::study::grade::BUILTIN[3].1.replace(
+        "\"arw_deg_per_sqrt_h\": 0.002",
+        "\"arw_deg_per_sqrt_h\": -0.002",
+    );
     std::fs::write(&bad, text).unwrap();
     let out = run(&["study", "lateral", "--grade-file", s(&bad), "--runs", "1"]);
     refused(&out, "`gyro.arw_deg_per_sqrt_h` is -0.002 deg/sqrt(h)");
@@ -92,7 +92,10 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
     assert_eq!(calls.into_inner(), 2);
     assert_eq!(result.summaries.len(), 1);
     let s = &result.summaries[0];
-    assert_eq!((s.grade.as_str(), s.well.as_str()), ("scc1300", "100m-fast"));
+    assert_eq!(
+        (s.grade.as_str(), s.well.as_str()),
+        ("scc1300", "100m-fast")
+    );
     assert_eq!(s.runs, 2);
     assert!(s.failed_runs.is_empty(), "{:?}", s.failed_runs);
     // the window, three connections and TD in each run
@@ -115,14 +118,23 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
         assert!(v.is_some_and(f64::is_finite), "{s:?}");
     }
     // MD grows along the well; the window's position is the tie-on's
-    assert!(s.along_md.windows(2).all(|w| w[1].truth_md_m > w[0].truth_md_m));
+    assert!(s
+        .along_md
+        .windows(2)
+        .all(|w| w[1].truth_md_m > w[0].truth_md_m));
     assert_eq!(s.along_md[0].rms_horizontal_error_m, Some(0.0));
     let f = &s.azimuth_within_2_sigma;
     assert!(f.total > 0 && f.inside <= f.total);
     // the table and the CSV carry it
     let text = host_sim::study::lateral_table::table(&result);
-    assert!(text.contains("scc1300") && text.contains("along MD"), "{text}");
-    assert_eq!(host_sim::study::lateral_table::csv(&result).lines().count(), 2);
+    assert!(
+        text.contains("scc1300") && text.contains("along MD"),
+        "{text}"
+    );
+    assert_eq!(
+        host_sim::study::lateral_table::csv(&result).lines().count(),
+        2
+    );
 }
 
 #[test]
@@ -141,7 +153,10 @@ fn a_navigation_grade_gyro_knows_its_azimuth_far_better_on_the_same_seed() {
     // about an hour of drilling per stand: the SCC1300's bias walks the
     // azimuth by degrees; the navigation gyro's station gyrocompassing
     // holds it near 1 deg (seed 11: 8.2 against 1.0 deg)
-    assert!(sb.is_finite() && sb < sa / 4.0, "TD azimuth sigma: scc1300 {sa} deg, navigation {sb} deg");
+    assert!(
+        sb.is_finite() && sb < sa / 4.0,
+        "TD azimuth sigma: scc1300 {sa} deg, navigation {sb} deg"
+    );
     // and its error is inside the sigma it reports (3 sigma: one case)
     let last = b.stations.last().expect("stations");
     assert!(last.error[1].abs().to_degrees() <= 3.0 * sb, "{last:?}");

@@ -55,7 +55,10 @@ pub const BUILTIN: [(&str, &str); 4] = [
         "ge-mwd-2020",
         include_str!("../../data/grades/ge-mwd-2020.json"),
     ),
-    ("navigation", include_str!("../../data/grades/navigation.json")),
+    (
+        "navigation",
+        include_str!("../../data/grades/navigation.json"),
+    ),
 ];
 
 /// A document a grade's figures come from.
@@ -308,7 +311,11 @@ impl Grade {
     /// (deg/sqrt(h)) replaced, for a sweep: the residual bias keeps the
     /// file's ratio to the instability, the coloured noise scales with
     /// the ARW (module docs). Named `<name>@<bias>deg/h,<arw>deg/rt-h`.
-    pub fn with_gyro(&self, bias_instability_deg_per_h: f64, arw_deg_per_sqrt_h: f64) -> Result<Self> {
+    pub fn with_gyro(
+        &self,
+        bias_instability_deg_per_h: f64,
+        arw_deg_per_sqrt_h: f64,
+    ) -> Result<Self> {
         let mut file = self.file.clone();
         let old = file.gyro.clone();
         limits::BIAS_INSTABILITY_DEG_PER_H
@@ -319,9 +326,12 @@ impl Grade {
         file.gyro.bias_instability_deg_per_h = bias_instability_deg_per_h;
         file.gyro.arw_deg_per_sqrt_h = arw_deg_per_sqrt_h;
         file.gyro.residual_bias_deg_per_h = old.residual_bias_deg_per_h.map(|r| r * bias_ratio);
-        for ar in [&mut file.gyro.coloured_noise_x, &mut file.gyro.coloured_noise_z]
-            .into_iter()
-            .flatten()
+        for ar in [
+            &mut file.gyro.coloured_noise_x,
+            &mut file.gyro.coloured_noise_z,
+        ]
+        .into_iter()
+        .flatten()
         {
             ar.noise_variance *= arw_ratio * arw_ratio;
         }
@@ -377,7 +387,10 @@ pub fn ranges() -> [(&'static str, Range); 5] {
             limits::BIAS_INSTABILITY_DEG_PER_H,
         ),
         ("gyro.correlation_time_s", limits::CORRELATION_TIME_S),
-        ("gyro.residual_bias_deg_per_h", limits::RESIDUAL_BIAS_DEG_PER_H),
+        (
+            "gyro.residual_bias_deg_per_h",
+            limits::RESIDUAL_BIAS_DEG_PER_H,
+        ),
         (
             "gyro.coloured_noise_*.noise_variance",
             limits::AR_VARIANCE_DEG2_PER_S2,
@@ -402,7 +415,10 @@ mod tests {
     fn every_built_in_grade_parses_with_sources_and_the_scc1300_accelerometers() {
         let all = Grade::builtin().expect("the built-in files");
         let names: Vec<&str> = all.iter().map(Grade::name).collect();
-        assert_eq!(names, ["scc1300", "high-end-mems", "ge-mwd-2020", "navigation"]);
+        assert_eq!(
+            names,
+            ["scc1300", "high-end-mems", "ge-mwd-2020", "navigation"]
+        );
         let scc = ImuNoise::scc1300();
         for g in &all {
             let b = g.noise_budget();
@@ -433,7 +449,10 @@ mod tests {
         let refused = |edit: &dyn Fn(&mut serde_json::Value), needle: &str| {
             let mut v = base.clone();
             edit(&mut v);
-            let e = format!("{:#}", Grade::parse(&v.to_string(), "test.json").unwrap_err());
+            let e = format!(
+                "{:#}",
+                Grade::parse(&v.to_string(), "test.json").unwrap_err()
+            );
             assert!(e.contains(needle), "{needle:?} not in {e}");
             assert!(e.contains("test.json"), "{e}");
         };
@@ -449,8 +468,14 @@ mod tests {
             &|v| v["gyro"]["correlation_time_s"] = 0.0.into(),
             "`gyro.correlation_time_s` is 0 s",
         );
-        refused(&|v| v["accelerometers"] = "stim300".into(), "only \"scc1300\"");
-        refused(&|v| v["sources"] = serde_json::json!([]), "`sources` is empty");
+        refused(
+            &|v| v["accelerometers"] = "stim300".into(),
+            "only \"scc1300\"",
+        );
+        refused(
+            &|v| v["sources"] = serde_json::json!([]),
+            "`sources` is empty",
+        );
         refused(&|v| v["name"] = "Nav Grade".into(), "lower-case letters");
         refused(&|v| v["gyro"]["arw"] = 1.0.into(), "unknown field `arw`");
         refused(
@@ -472,7 +497,10 @@ mod tests {
         assert!((b.gyro[0].bias_instability - rate_from_deg_per_hour(0.021)).abs() < 1e-18);
         // the SCC1300 file's residual equals its instability: so does the sweep's
         assert!((b.gyro[2].residual_bias / b.gyro[2].bias_instability - 1.0).abs() < 1e-12);
-        let ar0 = ImuNoise::scc1300().gyro[0].coloured.expect("paper AR").noise_variance;
+        let ar0 = ImuNoise::scc1300().gyro[0]
+            .coloured
+            .expect("paper AR")
+            .noise_variance;
         let ar = b.gyro[0].coloured.expect("kept").noise_variance;
         assert!((ar / ar0 - 1e-4).abs() < 1e-12, "{ar} {ar0}");
         assert_eq!(b.gyro[1], ImuNoise::scc1300().gyro[1]);
@@ -498,7 +526,10 @@ mod tests {
         assert_eq!(two[0].name(), "mine");
         assert_eq!(two[1].name(), "scc1300");
         let e = select(&["tactical".into()], &[]).unwrap_err().to_string();
-        assert!(e.contains("no gyro grade \"tactical\"") && e.contains("navigation"), "{e}");
+        assert!(
+            e.contains("no gyro grade \"tactical\"") && e.contains("navigation"),
+            "{e}"
+        );
         let _ = std::fs::remove_dir_all(dir);
     }
 }

@@ -62,9 +62,9 @@ impl Well {
         if let Some(v) = overrides.connection_still_s {
             d.connection_still_s = v;
         }
-        let plan = plan
-            .build()
-            .with_context(|| format!("{label}: invalid plan (with the command line's drilling parameters)"))?;
+        let plan = plan.build().with_context(|| {
+            format!("{label}: invalid plan (with the command line's drilling parameters)")
+        })?;
         Ok(Self {
             label: label.to_string(),
             plan,
@@ -255,7 +255,11 @@ mod tests {
             ..none
         };
         assert_eq!(
-            Well::builtin("100m", &fast).expect("ok").plan.drilling.rop_m_per_h,
+            Well::builtin("100m", &fast)
+                .expect("ok")
+                .plan
+                .drilling
+                .rop_m_per_h,
             60.0
         );
         let bad = DrillingOverrides {
@@ -270,9 +274,14 @@ mod tests {
     #[test]
     fn the_pool_keeps_the_job_order() {
         let calls = AtomicUsize::new(0);
-        let out = run_jobs(50, 3, &|| {
-            calls.fetch_add(1, Ordering::Relaxed);
-        }, |k| k * 2);
+        let out = run_jobs(
+            50,
+            3,
+            &|| {
+                calls.fetch_add(1, Ordering::Relaxed);
+            },
+            |k| k * 2,
+        );
         assert_eq!(out, (0..50).map(|k| k * 2).collect::<Vec<_>>());
         assert_eq!(calls.load(Ordering::Relaxed), 50);
     }

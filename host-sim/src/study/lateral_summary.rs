@@ -149,7 +149,11 @@ impl Tally {
         let inside = self.azimuth.iter().filter(|(e, s)| *e <= 2.0 * s).count();
         let inc_errors: Vec<f64> = self.inclination.iter().map(|a| a.0).collect();
         let inc_sigmas: Vec<f64> = self.inclination.iter().map(|a| a.1).collect();
-        let inc_inside = self.inclination.iter().filter(|(e, s)| *e <= 2.0 * s).count();
+        let inc_inside = self
+            .inclination
+            .iter()
+            .filter(|(e, s)| *e <= 2.0 * s)
+            .count();
         let radial: Vec<f64> = self.position.iter().map(|p| p.0).collect();
         let predicted: Vec<f64> = self.position.iter().map(|p| p.1).collect();
         AlongMd {
@@ -277,8 +281,7 @@ pub fn summarise(
         .run_cpu_s
         .filter(|c| *c > 0.0)
         .map(|c| s.samples as f64 / c);
-    s.epochs_per_thread_wall_second =
-        (s.run_wall_s > 0.0).then(|| s.samples as f64 / s.run_wall_s);
+    s.epochs_per_thread_wall_second = (s.run_wall_s > 0.0).then(|| s.samples as f64 / s.run_wall_s);
     s.requirement = requirement(&s);
     s
 }
@@ -359,7 +362,13 @@ mod tests {
         let s = summarise("g", "w", 100.0, &results);
         assert_eq!((s.runs, s.failed_runs.len(), s.stations), (3, 1, 4));
         // azimuth errors 0.05, 2, 0.05, 2 deg; sigma 0.5: 2 of 4 within 2 sigma
-        assert_eq!((s.azimuth_within_2_sigma.inside, s.azimuth_within_2_sigma.total), (2, 4));
+        assert_eq!(
+            (
+                s.azimuth_within_2_sigma.inside,
+                s.azimuth_within_2_sigma.total
+            ),
+            (2, 4)
+        );
         let expected = ((0.05f64.powi(2) + 4.0) / 2.0).sqrt();
         assert!((s.rms_station_azimuth_deg.unwrap() - expected).abs() < 1e-9);
         // TD radial errors 5 and 1 m: RMS sqrt(13), p95 5, predicted sqrt(5)
@@ -368,7 +377,10 @@ mod tests {
         assert!((s.td.predicted_1_sigma_m.unwrap() - 5f64.sqrt()).abs() < 1e-12);
         assert_eq!(s.td.semi_major_1_sigma_m, Some(2.0));
         assert_eq!(s.td.semi_major_1_sigma_per_1000_m, Some(20.0));
-        assert_eq!((s.td.inside_95_ellipse.inside, s.td.inside_95_ellipse.total), (1, 2));
+        assert_eq!(
+            (s.td.inside_95_ellipse.inside, s.td.inside_95_ellipse.total),
+            (1, 2)
+        );
         assert_eq!(s.along_md.len(), 2);
         assert_eq!(s.along_md[1].station, 2);
         assert_eq!(s.along_md[1].rms_horizontal_error_m, Some(5.0));

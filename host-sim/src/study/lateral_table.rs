@@ -70,10 +70,7 @@ fn station_row(s: &GradeWellSummary) -> Vec<String> {
         s.well.clone(),
         format!("{}/{}", s.runs - s.failed_runs.len(), s.runs),
         s.stations.to_string(),
-        format!(
-            "{}/{}",
-            s.azimuth_undetermined_stations, s.invalid_stations
-        ),
+        format!("{}/{}", s.azimuth_undetermined_stations, s.invalid_stations),
         num(s.rms_station_azimuth_deg, 3),
         fraction(&s.azimuth_within_2_sigma),
         num(s.rms_station_inclination_deg, 3),
@@ -314,7 +311,12 @@ mod tests {
             wall_s: 1.0,
             grades: Vec::new(),
             wells: Vec::new(),
-            summaries: vec![summarise("a", "my,plan.json", 100.0, &[(1, Err("x".into()))])],
+            summaries: vec![summarise(
+                "a",
+                "my,plan.json",
+                100.0,
+                &[(1, Err("x".into()))],
+            )],
         }
     }
 
@@ -325,14 +327,25 @@ mod tests {
         assert!(text.contains("undetermined"), "{text}");
         let lines: Vec<&str> = text.lines().collect();
         // header and rule have the same width
-        assert_eq!(lines[1].len(), lines[2].trim_end().len().max(lines[1].len()));
+        assert_eq!(
+            lines[1].len(),
+            lines[2].trim_end().len().max(lines[1].len())
+        );
         let csv = csv(&s);
         let rows: Vec<&str> = csv.lines().collect();
         assert_eq!(rows.len(), 2);
         let header = rows[0].split(',').count();
-        assert!(rows[1].starts_with("a,\"my,plan.json\",100,1,1,"), "{}", rows[1]);
+        assert!(
+            rows[1].starts_with("a,\"my,plan.json\",100,1,1,"),
+            "{}",
+            rows[1]
+        );
         // the quoted comma is one field
         assert_eq!(rows[1].split(',').count(), header + 1);
-        assert!(rows[1].contains(",,"), "empty fields for undetermined: {}", rows[1]);
+        assert!(
+            rows[1].contains(",,"),
+            "empty fields for undetermined: {}",
+            rows[1]
+        );
     }
 }
