@@ -32,6 +32,7 @@ mod replay;
 mod simulate;
 mod site;
 mod study;
+mod study_lateral;
 mod survey;
 mod survey_capture;
 

@@ -7,8 +7,7 @@ use host_sim::sim::plan::Vibration;
 use host_sim::sim::Plan;
 use host_sim::study::drilling_coverage::{study, table};
 use host_sim::study::drilling_run::RunConfig;
-use host_sim::survey_error::Site;
-use host_sim::survey_listing::drilling::depth_terms;
+use host_sim::study::grade::Grade;
 use std::path::PathBuf;
 
 #[derive(clap::Subcommand, Debug)]
@@ -20,11 +19,17 @@ pub enum StudyCommand {
     /// probe as the backup (issue 17 item 4): azimuth error at TD with and
     /// without it, by gyro grade (docs/redundant-rins.md).
     RinsProbe(RinsProbeArgs),
+    /// Which gyro meets the MGWD paper's requirement (issue 14): seeded
+    /// laterals by gyro grade, station azimuth and TD position errors
+    /// against the predicted sigmas (docs/lateral-study.md).
+    Lateral(LateralArgs),
 }
 
-fn azimuth_sigma_deg(text: &str) -> Result<f64, String> {
+pub(super) fn azimuth_sigma_deg(text: &str) -> Result<f64, String> {
     number_in(text, "the tie-in azimuth sigma", (0.001, 30.0), "deg")
 }
+
+pub use super::study_lateral::LateralArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct CoverageArgs {
@@ -58,6 +63,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     let args = match cmd {
         StudyCommand::DrillingCoverage(args) => args,
         StudyCommand::RinsProbe(args) => return rins_probe(args),
+        StudyCommand::Lateral(args) => return super::study_lateral::run(args),
     };
     let mut plan = Plan::load(&args.plan)?;
     if let Some(level) = args.vibration {
@@ -68,31 +74,12 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
             V::Harsh => Vibration::HARSH,
         };
     }
-    let terms = depth_terms()?;
-    let magnitude = |w: &str| {
-        terms
-            .iter()
-            .find(|t| t.weighting == w)
-            .map(|t| t.magnitude_si)
-    };
-    let depth_sigma = magnitude("DSF").zip(magnitude("DST"));
-    let latitude = plan.site.lat;
-    let config = RunConfig {
+    let mut config = RunConfig::new(
         plan,
-        tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
-        depth_sigma,
-        uncalibrated: args.uncalibrated,
-        terms,
-        site: Site {
-            gravity: 9.806_65,
-            b_total: 0.0,
-            dip: 0.0,
-            declination: 0.0,
-            vertical_limit: 0.0001_f64.to_radians(),
-            latitude,
-            gyro_noise_reduction: 1.0,
-        },
-    };
+        args.tie_in_azimuth_sigma_deg.to_radians(),
+        Grade::scc1300()?,
+    )?;
+    config.uncalibrated = args.uncalibrated;
     let threads = args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |t| t as usize,

@@ -2,7 +2,12 @@
 //! process (no files), the probe's `Navigator` driven through it from a
 //! tie-in, its station surveys paired with the truth and surveyed as
 //! `host-sim survey CAPTURE --depth` does ([`crate::survey_listing::drilling`]).
+//! The gyro grade ([`super::grade`]) decides the sensors: the SCC1300 (the
+//! default) reaches the navigator as the probe's raw frames, as today;
+//! other gyros as calibrated SI samples (`Navigator::step_sample`) with
+//! the navigator modelling their error budget.
 
+use super::grade::Grade;
 use crate::capture::{raw_sample_from_si, SiSample};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey_error::{ErrorTerm, Site};
@@ -13,8 +18,9 @@ use anyhow::{anyhow, Context, Result};
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::{Navigator, TieIn};
+use mwd_core::probe_sample::ProbeSample;
 use mwd_core::protocol::{RawSample, StationSurvey};
-use mwd_core::timing::SAMPLE_INTERVAL_S;
+use mwd_core::timing::{sample_time_us, SAMPLE_INTERVAL_S};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -36,6 +42,72 @@ pub struct RunConfig {
     pub uncalibrated: bool,
     pub terms: Vec<ErrorTerm>,
     pub site: Site,
+    /// The gyros (`Grade::scc1300()`: the probe's part, today's run).
+    pub grade: Grade,
+}
+
+impl RunConfig {
+    /// A calibrated run of `plan` with `grade`: the depth log's scale and
+    /// stretch drawn from the probe tool model's DSFS and DSTG, the survey
+    /// with those depth terms at the plan's latitude.
+    pub fn new(plan: BuiltPlan, tie_in_azimuth_sigma: f64, grade: Grade) -> Result<Self> {
+        let terms = drilling::depth_terms()?;
+        let magnitude = |w: &str| {
+            terms
+                .iter()
+                .find(|t| t.weighting == w)
+                .map(|t| t.magnitude_si)
+        };
+        let depth_sigma = magnitude("DSF").zip(magnitude("DST"));
+        let latitude = plan.site.lat;
+        Ok(Self {
+            plan,
+            tie_in_azimuth_sigma,
+            depth_sigma,
+            uncalibrated: false,
+            terms,
+            site: Site {
+                gravity: 9.806_65,
+                b_total: 0.0,
+                dip: 0.0,
+                declination: 0.0,
+                vertical_limit: 0.0001_f64.to_radians(),
+                latitude,
+                gyro_noise_reduction: 1.0,
+            },
+            grade,
+        })
+    }
+}
+
+/// A station's surveyed horizontal position against the truth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositionCheck {
+    /// North and east error, m.
+    pub error_ne: [f64; 2],
+    /// Predicted NE covariance (m^2): north-north, east-east, north-east.
+    pub cov_ne: [f64; 3],
+}
+
+impl PositionCheck {
+    /// The predicted horizontal 1-sigma: sqrt of the covariance's trace
+    /// (the RMS radial error a covariance predicts).
+    pub fn sigma_horizontal(&self) -> f64 {
+        (self.cov_ne[0] + self.cov_ne[1]).max(0.0).sqrt()
+    }
+
+    /// The 1-sigma semi-major axis of the NE ellipse: the square root of
+    /// the covariance's larger eigenvalue.
+    pub fn semi_major(&self) -> f64 {
+        let [nn, ee, ne] = self.cov_ne;
+        let half_trace = 0.5 * (nn + ee);
+        let root = (0.25 * (nn - ee) * (nn - ee) + ne * ne).sqrt();
+        (half_trace + root).max(0.0).sqrt()
+    }
+
+    pub fn error_horizontal(&self) -> f64 {
+        self.error_ne[0].hypot(self.error_ne[1])
+    }
 }
 
 /// A station survey and the truth at its last still sample.
@@ -45,6 +117,9 @@ pub struct StationCheck {
     /// Errors of inclination, azimuth, toolface (rad, wrapped).
     pub error: [f64; 3],
     pub truth_md: f64,
+    /// The survey's position here; `None` where the station is not in
+    /// the survey (skipped) or its position is undetermined.
+    pub position: Option<PositionCheck>,
 }
 
 /// The run's TD: the last station's horizontal position against the truth.
@@ -54,6 +129,17 @@ pub struct TdCheck {
     pub error_ne: [f64; 2],
     /// Squared Mahalanobis distance in the predicted NE covariance.
     pub d2: f64,
+    /// That covariance (m^2): north-north, east-east, north-east.
+    pub cov_ne: [f64; 3],
+}
+
+impl TdCheck {
+    pub fn position(&self) -> PositionCheck {
+        PositionCheck {
+            error_ne: self.error_ne,
+            cov_ne: self.cov_ne,
+        }
+    }
 }
 
 /// What one run gave.
@@ -65,7 +151,23 @@ pub struct RunOutcome {
     /// undetermined (`td_note` says which).
     pub td: Option<TdCheck>,
     pub td_note: Option<String>,
+    /// Simulated samples, each one navigator epoch.
     pub samples: usize,
+    /// Wall time of the run on its thread (s).
+    pub elapsed_s: f64,
+    /// CPU time of its thread (s), where the system tells it
+    /// ([`thread_cpu_s`]): on a shared machine the wall time is not the
+    /// work.
+    pub cpu_s: Option<f64>,
+}
+
+/// The calling thread's CPU time so far (s): Linux's
+/// `/proc/thread-self/schedstat` (its first field: ns on a CPU); `None`
+/// elsewhere or when the kernel does not keep it.
+pub fn thread_cpu_s() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
 }
 
 /// The parent well's survey at the window: its inclination is the
@@ -117,8 +219,29 @@ pub(crate) fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Re
     }))
 }
 
+/// One measured sample into the navigator: the probe's raw frame for the
+/// SCC1300 part, else the calibrated sample at full resolution.
+fn feed(
+    navigator: &mut Navigator,
+    raw_frames: bool,
+    index: usize,
+    gyro: &Vector3<f64>,
+    accel: &Vector3<f64>,
+) -> Result<()> {
+    if raw_frames {
+        navigator.step(&raw(index, gyro, accel)?);
+    } else {
+        let n = u32::try_from(index).context("more than 2^32 samples")?;
+        let sample = ProbeSample::new(gyro.x, gyro.z, *accel);
+        navigator.step_sample(sample_time_us(n), n, &sample);
+    }
+    Ok(())
+}
+
 /// Runs seed `seed`.
 pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
+    let started = std::time::Instant::now();
+    let cpu_start = thread_cpu_s();
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x57D7_0000_0000_0013);
     let mut plan = config.plan.clone();
     if let Some((scale, stretch)) = config.depth_sigma {
@@ -131,12 +254,16 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let end_md = plan.end_md();
     let drilling = Drilling::new(plan, seed);
     let site = drilling.truth(0.0).position;
-    let model = SensorModel::scc1300(seed);
-    let mut navigator = if config.uncalibrated {
+    let model = config.grade.sensor_model(seed);
+    let raw_frames = config.grade.is_scc1300_part();
+    let mut navigator = if config.uncalibrated || !raw_frames {
+        // other parts' samples come calibrated (`Grade::sensor_model`)
         Navigator::new(site)
     } else {
         Navigator::with_calibration(site, model.deterministic.calibration())
     };
+    // the SCC1300's is the navigator's own static: unchanged
+    navigator.set_noise_budget(config.grade.budget_ref());
     let mut tied = false;
     let mut stations = Vec::new();
     let mut samples = 0;
@@ -145,7 +272,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        navigator.step(&raw(index, &s.gyro, &s.accel)?);
+        feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?;
         samples += 1;
         last = Some((
             s.true_rate,
@@ -176,7 +303,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         });
         for k in 0..MAX_STATION_SAMPLES as usize {
             let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
-            navigator.step(&raw(run_samples + k, &gyro, &force)?);
+            feed(&mut navigator, raw_frames, run_samples + k, &gyro, &force)?;
             samples += 1;
             if let Some(station) = navigator.take_station() {
                 stations.push(station);
@@ -184,7 +311,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
             }
         }
     }
-    let checks: Vec<StationCheck> = stations
+    let mut checks: Vec<StationCheck> = stations
         .iter()
         .map(|st| {
             let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
@@ -197,6 +324,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
                     wrap_pi(a[2] - truth.toolface),
                 ],
                 truth_md: truth.md,
+                position: None,
             }
         })
         .collect();
@@ -216,7 +344,10 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     };
     let (td, td_note) = match drilling::survey(&stations, &depth, tie, &config.terms, &config.site)
     {
-        Ok(survey) => td_check(&survey, &drilling, end_md),
+        Ok(survey) => {
+            attach_positions(&mut checks, &survey, &drilling);
+            td_check(&survey, &drilling, end_md)
+        }
         Err(e) => (None, Some(format!("no survey: {e:#}"))),
     };
     Ok(RunOutcome {
@@ -225,7 +356,37 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         td,
         td_note,
         samples,
+        elapsed_s: started.elapsed().as_secs_f64(),
+        cpu_s: cpu_start.zip(thread_cpu_s()).map(|(a, b)| b - a),
     })
+}
+
+/// The NE covariance of a survey row, if its position is determined.
+fn cov_ne(row: &drilling::DrillingRow) -> Option<[f64; 3]> {
+    let c = row.row.cov.filter(|_| row.position_determined)?;
+    Some([c[0], c[1], c[3]])
+}
+
+/// Each surveyed station's position against the truth at its last still
+/// sample (the station the survey row is made of: same end sample).
+fn attach_positions(checks: &mut [StationCheck], survey: &DrillingSurvey, drilling: &Drilling) {
+    for row in &survey.rows {
+        let Some(cov) = cov_ne(row) else { continue };
+        let Some(check) = checks
+            .iter_mut()
+            .find(|c| c.survey.end_sample == row.survey.end_sample)
+        else {
+            continue;
+        };
+        let truth = drilling.truth((f64::from(row.survey.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
+        check.position = Some(PositionCheck {
+            error_ne: [
+                row.row.north_m - truth.point.nev.x,
+                row.row.east_m - truth.point.nev.y,
+            ],
+            cov_ne: cov,
+        });
+    }
 }
 
 /// The last surveyed station against the truth, if it is at TD (within
@@ -245,19 +406,26 @@ fn td_check(
             Some(format!("last station at MD {:.1} m, not at TD", truth.md)),
         );
     }
-    let Some(c) = last.row.cov.filter(|_| last.position_determined) else {
+    let Some(c) = cov_ne(last) else {
         return (None, Some("TD position undetermined".into()));
     };
     let e = [
         last.row.north_m - truth.point.nev.x,
         last.row.east_m - truth.point.nev.y,
     ];
-    let (nn, ee, ne) = (c[0], c[1], c[3]);
+    let [nn, ee, ne] = c;
     let det = nn * ee - ne * ne;
     // also catches NaN
     if det.is_nan() || det <= 0.0 {
         return (None, Some("TD covariance singular".into()));
     }
     let d2 = (ee * e[0] * e[0] - 2.0 * ne * e[0] * e[1] + nn * e[1] * e[1]) / det;
-    (Some(TdCheck { error_ne: e, d2 }), None)
+    (
+        Some(TdCheck {
+            error_ne: e,
+            d2,
+            cov_ne: c,
+        }),
+        None,
+    )
 }

@@ -2,7 +2,11 @@
 
 pub mod drilling_coverage;
 pub mod drilling_run;
+pub mod grade;
+pub mod lateral;
 pub mod lateral_plots;
+pub mod lateral_summary;
+pub mod lateral_table;
 pub mod owsg;
 pub mod rins_probe;
 

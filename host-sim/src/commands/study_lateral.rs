@@ -1,0 +1,156 @@
+//! `host-sim study lateral` (issue 14 part A): the command line of
+//! [`host_sim::study::lateral`]: grades, wells, drilling parameters, a
+//! progress bar over every job, the tables, CSV and JSON.
+
+use super::limits::number_in;
+use anyhow::{Context, Result};
+use host_sim::study::grade;
+use host_sim::study::lateral::{study, DrillingOverrides, StudyConfig, Well};
+use host_sim::study::lateral_table::{csv, table};
+use std::path::PathBuf;
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]
+pub enum WellChoice {
+    #[value(name = "100m")]
+    Short,
+    #[value(name = "1000m")]
+    Long,
+    Both,
+}
+
+/// The plan's own ranges (`sim::plan::DrillingParams`), checked here too
+/// so a bad number is refused before any work.
+fn rop(text: &str) -> Result<f64, String> {
+    number_in(text, "the rate of penetration", (0.1, 500.0), "m/h")
+}
+
+fn stand_length(text: &str) -> Result<f64, String> {
+    number_in(text, "the stand length", (1.0, 1000.0), "m")
+}
+
+fn connection_still(text: &str) -> Result<f64, String> {
+    number_in(text, "the still time at connections", (0.0, 86_400.0), "s")
+}
+
+#[derive(clap::Args, Debug)]
+pub struct LateralArgs {
+    /// Gyro grades by name (default: all built-in ones and those of
+    /// --grade-file): scc1300, high-end-mems, ge-mwd-2020, navigation.
+    #[arg(long, value_delimiter = ',')]
+    pub grades: Vec<String>,
+    /// A grade file (JSON, host-sim/data/grades/): adds a grade, or
+    /// replaces the built-in one of the same name. Repeatable.
+    #[arg(long = "grade-file")]
+    pub grade_files: Vec<PathBuf>,
+    /// The built-in laterals (ignored when --plan is given).
+    #[arg(long, value_enum, default_value = "both")]
+    pub well: WellChoice,
+    /// A well plan instead (JSON, docs/drilling-simulation.md). Repeatable.
+    #[arg(long = "plan")]
+    pub plans: Vec<PathBuf>,
+    /// Runs per grade and well (seeds first-seed, first-seed + 1, ...).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub runs: u64,
+    #[arg(long, default_value_t = 1)]
+    pub first_seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+    /// Rate of penetration, m/h (default: the plan's).
+    #[arg(long = "rop", value_parser = rop)]
+    pub rop_m_per_h: Option<f64>,
+    /// MD between connections, m (default: the plan's).
+    #[arg(long = "stand-length", value_parser = stand_length)]
+    pub stand_length_m: Option<f64>,
+    /// Still time at each connection, s (default: the plan's).
+    #[arg(long = "connection-still", value_parser = connection_still)]
+    pub connection_still_s: Option<f64>,
+    /// 1-sigma of the parent well's azimuth at the tie-in, deg.
+    #[arg(long = "tie-in-azimuth-sigma", alias = "tie-in-azimuth-sigma-deg", default_value_t = 0.5, value_parser = super::study::azimuth_sigma_deg)]
+    pub tie_in_azimuth_sigma_deg: f64,
+    /// Write the results here (JSON: summaries and the along-MD arrays).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write one row per grade and well here (CSV).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Directory for the plots (error growth along MD per grade).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+}
+
+pub fn run(args: LateralArgs) -> Result<()> {
+    let grades = grade::select(&args.grades, &args.grade_files)?;
+    let overrides = DrillingOverrides {
+        rop_m_per_h: args.rop_m_per_h,
+        stand_length_m: args.stand_length_m,
+        connection_still_s: args.connection_still_s,
+    };
+    let wells: Vec<Well> = if args.plans.is_empty() {
+        let names: &[&str] = match args.well {
+            WellChoice::Short => &["100m"],
+            WellChoice::Long => &["1000m"],
+            WellChoice::Both => &["100m", "1000m"],
+        };
+        names
+            .iter()
+            .map(|n| Well::builtin(n, &overrides))
+            .collect::<Result<_>>()?
+    } else {
+        args.plans
+            .iter()
+            .map(|p| Well::load(p, &overrides))
+            .collect::<Result<_>>()?
+    };
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    );
+    let config = StudyConfig {
+        grades,
+        wells,
+        runs: args.runs as usize,
+        first_seed: args.first_seed,
+        threads,
+        tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
+    };
+    let jobs = (config.grades.len() * config.wells.len()) as u64 * args.runs;
+    let bar = indicatif::ProgressBar::new(jobs);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs (grades x wells x runs), {elapsed} (eta {eta})",
+        )
+        .context("progress bar")?,
+    );
+    let result = study(&config, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let names: Vec<&str> = config.grades.iter().map(|g| g.name()).collect();
+    let wells: Vec<&str> = config.wells.iter().map(|w| w.label.as_str()).collect();
+    outln!(
+        "lateral study: grades {}; wells {}; {} runs each from seed {}; tie-in azimuth sigma {} deg; {} threads; {:.1} s",
+        names.join(", "),
+        wells.join(", "),
+        args.runs,
+        args.first_seed,
+        args.tie_in_azimuth_sigma_deg,
+        threads,
+        result.wall_s
+    );
+    out!("{}", table(&result));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&result)? + "\n";
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.csv {
+        std::fs::write(path, csv(&result))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(dir) = &args.plots {
+        // the plots are drawn by another part of the work (issue 14)
+        eprintln!(
+            "note: --plots {}: this build draws no plots yet",
+            dir.display()
+        );
+    }
+    Ok(())
+}

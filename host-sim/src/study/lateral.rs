@@ -1,0 +1,288 @@
+//! `host-sim study lateral` (issue 14 part A): which gyro meets the MGWD
+//! paper's requirement. N seeded runs of each well ([`super::drilling_run`]:
+//! simulator, navigator, stations, survey, TD check) for each gyro grade
+//! ([`super::grade`]), all grade x well x run jobs in one pool over the
+//! cores; per grade and well the station azimuth errors, the error growth
+//! along MD against the predicted sigmas, the TD horizontal error against
+//! the predicted 1-sigma and 95 % ellipse, and whether the requirement is
+//! met. Summaries are in [`super::lateral_summary`], tables and CSV in
+//! [`super::lateral_table`].
+
+use super::drilling_run::{run, RunConfig, RunOutcome};
+use super::grade::Grade;
+use super::lateral_summary::{summarise, GradeWellSummary};
+use crate::sim::{BuiltPlan, Plan};
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// The repository's two laterals (docs/drilling-simulation.md), built in
+/// so the binary works from any directory.
+pub const BUILTIN_WELLS: [(&str, &str); 2] = [
+    ("100m", include_str!("../../data/plans/lateral-100m.json")),
+    ("1000m", include_str!("../../data/plans/lateral-1000m.json")),
+];
+
+/// Drilling parameters given on the command line instead of the plan's
+/// (checked with the plan's own ranges when it is built).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct DrillingOverrides {
+    pub rop_m_per_h: Option<f64>,
+    pub stand_length_m: Option<f64>,
+    pub connection_still_s: Option<f64>,
+}
+
+/// A well of the study.
+#[derive(Clone, Debug)]
+pub struct Well {
+    /// "100m", "1000m" or the plan file's path.
+    pub label: String,
+    pub plan: BuiltPlan,
+}
+
+impl Well {
+    /// MD drilled from the tie-on to TD (m).
+    pub fn lateral_length_m(&self) -> f64 {
+        self.plan.end_md() - self.plan.tie_on.md()
+    }
+
+    /// A plan from its JSON text with `overrides` applied.
+    pub fn parse(label: &str, text: &str, overrides: &DrillingOverrides) -> Result<Self> {
+        let mut plan: Plan =
+            serde_json::from_str(text).with_context(|| format!("{label}: not a well plan"))?;
+        let d = &mut plan.drilling;
+        if let Some(v) = overrides.rop_m_per_h {
+            d.rop_m_per_h = v;
+        }
+        if let Some(v) = overrides.stand_length_m {
+            d.stand_length_m = v;
+        }
+        if let Some(v) = overrides.connection_still_s {
+            d.connection_still_s = v;
+        }
+        let plan = plan.build().with_context(|| {
+            format!("{label}: invalid plan (with the command line's drilling parameters)")
+        })?;
+        Ok(Self {
+            label: label.to_string(),
+            plan,
+        })
+    }
+
+    /// A built-in well: "100m" or "1000m".
+    pub fn builtin(name: &str, overrides: &DrillingOverrides) -> Result<Self> {
+        let Some((label, text)) = BUILTIN_WELLS.iter().find(|(n, _)| *n == name) else {
+            bail!("no built-in well {name:?}: 100m or 1000m");
+        };
+        Self::parse(label, text, overrides)
+    }
+
+    /// A plan file.
+    pub fn load(path: &Path, overrides: &DrillingOverrides) -> Result<Self> {
+        let text = crate::analysis::text_records::read_small_file(path)
+            .with_context(|| format!("reading the plan {}", path.display()))?;
+        Self::parse(&path.display().to_string(), &text, overrides)
+    }
+}
+
+/// What the study is given.
+#[derive(Clone, Debug)]
+pub struct StudyConfig {
+    pub grades: Vec<Grade>,
+    pub wells: Vec<Well>,
+    /// Runs per grade and well: seeds first_seed, first_seed + 1, ...
+    pub runs: usize,
+    pub first_seed: u64,
+    pub threads: usize,
+    /// 1-sigma of the parent well's azimuth at the tie-in (rad).
+    pub tie_in_azimuth_sigma: f64,
+}
+
+/// A grade as the output lists it.
+#[derive(Clone, Debug, Serialize)]
+pub struct GradeInfo {
+    #[serde(flatten)]
+    pub file: super::grade::GradeFile,
+}
+
+/// A well as the output lists it.
+#[derive(Clone, Debug, Serialize)]
+pub struct WellInfo {
+    pub label: String,
+    pub tie_on_md_m: f64,
+    pub td_md_m: f64,
+    pub lateral_length_m: f64,
+    pub rop_m_per_h: f64,
+    pub stand_length_m: f64,
+    pub connection_still_s: f64,
+}
+
+/// The study's results.
+#[derive(Clone, Debug, Serialize)]
+pub struct LateralStudy {
+    pub runs_per_grade_and_well: usize,
+    pub first_seed: u64,
+    pub threads: usize,
+    pub tie_in_azimuth_sigma_deg: f64,
+    pub wall_s: f64,
+    pub grades: Vec<GradeInfo>,
+    pub wells: Vec<WellInfo>,
+    /// One per grade and well, grade-major in the order given.
+    pub summaries: Vec<GradeWellSummary>,
+}
+
+/// Runs `jobs` jobs on `threads` threads (each takes the next job when
+/// done), calling `progress` after each; outcomes in job order.
+fn run_jobs<T: Send>(
+    jobs: usize,
+    threads: usize,
+    progress: &(dyn Fn() + Sync),
+    job: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
+    let next = AtomicUsize::new(0);
+    let done: Mutex<Vec<(usize, T)>> = Mutex::new(Vec::with_capacity(jobs));
+    std::thread::scope(|scope| {
+        for _ in 0..threads.max(1) {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                if k >= jobs {
+                    break;
+                }
+                let outcome = job(k);
+                if let Ok(mut d) = done.lock() {
+                    d.push((k, outcome));
+                }
+                progress();
+            });
+        }
+    });
+    let mut done = done.into_inner().unwrap_or_default();
+    done.sort_by_key(|d| d.0);
+    done.into_iter().map(|d| d.1).collect()
+}
+
+/// Runs the study; `progress` is called after each of the
+/// grades x wells x runs jobs.
+pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<LateralStudy> {
+    let started = std::time::Instant::now();
+    let mut configs = Vec::new();
+    for grade in &config.grades {
+        for well in &config.wells {
+            configs.push(RunConfig::new(
+                well.plan.clone(),
+                config.tie_in_azimuth_sigma,
+                grade.clone(),
+            )?);
+        }
+    }
+    // one pool for every job, the longest wells first (no long run left
+    // alone at the end while the other cores idle)
+    let mut jobs: Vec<(usize, u64)> = (0..configs.len())
+        .flat_map(|c| (0..config.runs as u64).map(move |r| (c, r)))
+        .collect();
+    let length = |c: usize| configs[c].plan.end_md() - configs[c].plan.tie_on.md();
+    jobs.sort_by(|a, b| length(b.0).total_cmp(&length(a.0)).then(a.cmp(b)));
+    let outcomes = run_jobs(jobs.len(), config.threads, progress, |k| {
+        let (c, r) = jobs[k];
+        let seed = config.first_seed + r;
+        let outcome = run(&configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}"));
+        (c, seed, outcome)
+    });
+    let mut per_config: Vec<Vec<(u64, Result<RunOutcome, String>)>> =
+        (0..configs.len()).map(|_| Vec::new()).collect();
+    for (c, seed, outcome) in outcomes {
+        per_config[c].push((seed, outcome));
+    }
+    let mut summaries = Vec::new();
+    for (c, mut results) in per_config.into_iter().enumerate() {
+        results.sort_by_key(|r| r.0);
+        let (grade, well) = (
+            &config.grades[c / config.wells.len()],
+            &config.wells[c % config.wells.len()],
+        );
+        summaries.push(summarise(
+            grade.name(),
+            &well.label,
+            well.lateral_length_m(),
+            &results,
+        ));
+    }
+    Ok(LateralStudy {
+        runs_per_grade_and_well: config.runs,
+        first_seed: config.first_seed,
+        threads: config.threads,
+        tie_in_azimuth_sigma_deg: config.tie_in_azimuth_sigma.to_degrees(),
+        wall_s: started.elapsed().as_secs_f64(),
+        grades: config
+            .grades
+            .iter()
+            .map(|g| GradeInfo {
+                file: g.file.clone(),
+            })
+            .collect(),
+        wells: config
+            .wells
+            .iter()
+            .map(|w| WellInfo {
+                label: w.label.clone(),
+                tie_on_md_m: w.plan.tie_on.md(),
+                td_md_m: w.plan.end_md(),
+                lateral_length_m: w.lateral_length_m(),
+                rop_m_per_h: w.plan.drilling.rop_m_per_h,
+                stand_length_m: w.plan.drilling.stand_length_m,
+                connection_still_s: w.plan.drilling.connection_still_s,
+            })
+            .collect(),
+        summaries,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn built_in_wells_build_and_overrides_are_checked() {
+        let none = DrillingOverrides::default();
+        let short = Well::builtin("100m", &none).expect("built in");
+        assert!((short.lateral_length_m() - 100.0).abs() < 1e-6);
+        let long = Well::builtin("1000m", &none).expect("built in");
+        assert!(long.lateral_length_m() > 900.0);
+        let fast = DrillingOverrides {
+            rop_m_per_h: Some(60.0),
+            ..none
+        };
+        assert_eq!(
+            Well::builtin("100m", &fast)
+                .expect("ok")
+                .plan
+                .drilling
+                .rop_m_per_h,
+            60.0
+        );
+        let bad = DrillingOverrides {
+            stand_length_m: Some(0.0),
+            ..none
+        };
+        let e = format!("{:#}", Well::builtin("100m", &bad).unwrap_err());
+        assert!(e.contains("drilling.stand_length_m"), "{e}");
+        assert!(Well::builtin("10km", &none).is_err());
+    }
+
+    #[test]
+    fn the_pool_keeps_the_job_order() {
+        let calls = AtomicUsize::new(0);
+        let out = run_jobs(
+            50,
+            3,
+            &|| {
+                calls.fetch_add(1, Ordering::Relaxed);
+            },
+            |k| k * 2,
+        );
+        assert_eq!(out, (0..50).map(|k| k * 2).collect::<Vec<_>>());
+        assert_eq!(calls.load(Ordering::Relaxed), 50);
+    }
+}

@@ -1,0 +1,407 @@
+//! The lateral study's statistics per grade and well
+//! ([`super::lateral`]): named fields, serialised as they are, so other
+//! columns (covariance analysis) and plots can be added beside them.
+//!
+//! Conventions: an RMS, percentile or median over no cases is `None`
+//! (undetermined), never 0. Azimuth statistics are over the stations the
+//! probe flags determined; the undetermined ones are counted. The
+//! horizontal 1-sigma a covariance predicts is sqrt(trace) of its NE block
+//! (the RMS radial error it implies), compared with the RMS of the radial
+//! errors; the 95 % ellipse holds a TD when its squared Mahalanobis
+//! distance is <= -2 ln 0.05 = 5.991 (chi-square, 2 degrees of freedom).
+
+use super::drilling_coverage::Fraction;
+use super::drilling_run::RunOutcome;
+use crate::survey_listing::ellipse::scale_2d;
+use mwd_core::protocol::frame::station_flags;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The MGWD paper's design requirement (`/work/shared/paper/mgwd.md`):
+/// attitude error under 0.1 deg, position error under 1 m per 1000 m.
+pub const ATTITUDE_LIMIT_DEG: f64 = 0.1;
+pub const POSITION_LIMIT_M_PER_1000_M: f64 = 1.0;
+
+/// TD statistics over the runs whose TD was checked.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct TdSummary {
+    pub runs_checked: usize,
+    pub rms_horizontal_error_m: Option<f64>,
+    /// Nearest-rank 95th percentile of the radial error.
+    pub p95_horizontal_error_m: Option<f64>,
+    /// RMS over runs of sqrt(trace of the predicted NE covariance).
+    pub predicted_1_sigma_m: Option<f64>,
+    pub predicted_2_sigma_m: Option<f64>,
+    pub inside_95_ellipse: Fraction,
+    /// RMS over runs of the 1-sigma semi-major axis, and per 1000 m of
+    /// lateral (MD from the tie-on to TD).
+    pub semi_major_1_sigma_m: Option<f64>,
+    pub semi_major_1_sigma_per_1000_m: Option<f64>,
+}
+
+/// Whether the requirement is met; `None`: undetermined (no cases).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Requirement {
+    /// The larger of the station inclination and azimuth RMS errors.
+    pub attitude_error_deg: Option<f64>,
+    /// Met when it is under the limit and no station's azimuth is
+    /// undetermined or invalid (a withheld azimuth does not meet it).
+    pub attitude_met: Option<bool>,
+    pub rms_td_error_per_1000_m: Option<f64>,
+    pub p95_td_error_per_1000_m: Option<f64>,
+    /// Met when the RMS per 1000 m is under the limit and every run's TD
+    /// was positioned.
+    pub position_met: Option<bool>,
+}
+
+/// Error growth along MD: the stations with one number across the runs.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct AlongMd {
+    /// 1 = the window's station.
+    pub station: u16,
+    /// Mean true MD of the station over the runs (m).
+    pub truth_md_m: f64,
+    /// Stations with this number (valid).
+    pub stations: usize,
+    pub azimuth_undetermined: usize,
+    pub rms_azimuth_error_deg: Option<f64>,
+    pub median_azimuth_sigma_deg: Option<f64>,
+    pub azimuth_within_2_sigma: Fraction,
+    pub rms_inclination_error_deg: Option<f64>,
+    pub median_inclination_sigma_deg: Option<f64>,
+    pub inclination_within_2_sigma: Fraction,
+    /// Stations with a determined survey position.
+    pub positioned: usize,
+    pub rms_horizontal_error_m: Option<f64>,
+    pub median_horizontal_sigma_m: Option<f64>,
+}
+
+/// One grade on one well.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct GradeWellSummary {
+    pub grade: String,
+    pub well: String,
+    pub lateral_length_m: f64,
+    pub runs: usize,
+    pub failed_runs: Vec<String>,
+    pub stations: usize,
+    /// Flagged invalid (not counted anywhere else).
+    pub invalid_stations: usize,
+    pub azimuth_undetermined_stations: usize,
+    pub rms_station_inclination_deg: Option<f64>,
+    pub rms_station_azimuth_deg: Option<f64>,
+    pub azimuth_within_2_sigma: Fraction,
+    pub inclination_within_2_sigma: Fraction,
+    pub td: TdSummary,
+    /// Runs without a TD check, by reason.
+    pub td_unchecked: Vec<(String, usize)>,
+    pub requirement: Requirement,
+    pub along_md: Vec<AlongMd>,
+    /// Simulated samples (each one navigator epoch).
+    pub samples: usize,
+    /// Sum of the runs' wall times on their threads (s).
+    pub run_wall_s: f64,
+    /// Sum of their threads' CPU times (s); `None` when the system does
+    /// not tell it for every run.
+    pub run_cpu_s: Option<f64>,
+    /// Navigator epochs (simulation included) per second of one core's
+    /// CPU time; `None` without CPU times.
+    pub epochs_per_core_second: Option<f64>,
+    /// The same per second of wall time per thread (lower on a machine
+    /// shared with other work).
+    pub epochs_per_thread_wall_second: Option<f64>,
+}
+
+pub(crate) fn rms(values: &[f64]) -> Option<f64> {
+    (!values.is_empty())
+        .then(|| (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt())
+}
+
+/// Nearest-rank percentile `p` (0-1).
+pub(crate) fn percentile(values: &[f64], p: f64) -> Option<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let rank = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1));
+    v.get(rank - 1).copied()
+}
+
+fn median(values: &[f64]) -> Option<f64> {
+    percentile(values, 0.5)
+}
+
+/// One station number's values while summarising.
+#[derive(Default)]
+struct Tally {
+    md: Vec<f64>,
+    undetermined: usize,
+    /// (|error|, sigma) of determined azimuths, deg.
+    azimuth: Vec<(f64, f64)>,
+    /// (|error|, sigma) of the inclinations, deg.
+    inclination: Vec<(f64, f64)>,
+    /// (radial error, sqrt trace), m.
+    position: Vec<(f64, f64)>,
+}
+
+impl Tally {
+    fn along(&self, station: u16) -> AlongMd {
+        let errors: Vec<f64> = self.azimuth.iter().map(|a| a.0).collect();
+        let sigmas: Vec<f64> = self.azimuth.iter().map(|a| a.1).collect();
+        let inside = self.azimuth.iter().filter(|(e, s)| *e <= 2.0 * s).count();
+        let inc_errors: Vec<f64> = self.inclination.iter().map(|a| a.0).collect();
+        let inc_sigmas: Vec<f64> = self.inclination.iter().map(|a| a.1).collect();
+        let inc_inside = self
+            .inclination
+            .iter()
+            .filter(|(e, s)| *e <= 2.0 * s)
+            .count();
+        let radial: Vec<f64> = self.position.iter().map(|p| p.0).collect();
+        let predicted: Vec<f64> = self.position.iter().map(|p| p.1).collect();
+        AlongMd {
+            station,
+            truth_md_m: self.md.iter().sum::<f64>() / self.md.len().max(1) as f64,
+            stations: self.md.len(),
+            azimuth_undetermined: self.undetermined,
+            rms_azimuth_error_deg: rms(&errors),
+            median_azimuth_sigma_deg: median(&sigmas),
+            azimuth_within_2_sigma: Fraction::of(inside, self.azimuth.len()),
+            rms_inclination_error_deg: rms(&inc_errors),
+            median_inclination_sigma_deg: median(&inc_sigmas),
+            inclination_within_2_sigma: Fraction::of(inc_inside, self.inclination.len()),
+            positioned: self.position.len(),
+            rms_horizontal_error_m: rms(&radial),
+            median_horizontal_sigma_m: median(&predicted),
+        }
+    }
+}
+
+/// The summary of one grade's runs on one well (seed order).
+pub fn summarise(
+    grade: &str,
+    well: &str,
+    lateral_length_m: f64,
+    results: &[(u64, Result<RunOutcome, String>)],
+) -> GradeWellSummary {
+    let mut s = GradeWellSummary {
+        grade: grade.to_string(),
+        well: well.to_string(),
+        lateral_length_m,
+        runs: results.len(),
+        ..GradeWellSummary::default()
+    };
+    let (mut inc, mut azi) = (Vec::new(), Vec::new());
+    let (mut azi_inside, mut inc_inside) = (0, 0);
+    let (mut td_err, mut td_sigma, mut td_major) = (Vec::new(), Vec::new(), Vec::new());
+    let mut td_inside = 0;
+    let k2 = scale_2d(0.95).powi(2);
+    let mut unchecked: BTreeMap<String, usize> = BTreeMap::new();
+    let mut by_station: BTreeMap<u16, Tally> = BTreeMap::new();
+    let mut cpu = Some(0.0);
+    for (_, r) in results {
+        let o = match r {
+            Ok(o) => o,
+            Err(e) => {
+                s.failed_runs.push(e.clone());
+                continue;
+            }
+        };
+        s.samples += o.samples;
+        s.run_wall_s += o.elapsed_s;
+        cpu = cpu.zip(o.cpu_s).map(|(a, b)| a + b);
+        for st in &o.stations {
+            s.stations += 1;
+            let sd = st.survey.angles_std.map(f64::from);
+            if st.survey.flags & station_flags::SOLUTION_INVALID != 0 || !sd[0].is_finite() {
+                s.invalid_stations += 1;
+                continue;
+            }
+            inc.push(st.error[0].to_degrees());
+            inc_inside += usize::from(st.error[0].abs() <= 2.0 * sd[0]);
+            let tally = by_station.entry(st.survey.station).or_default();
+            tally.md.push(st.truth_md);
+            tally
+                .inclination
+                .push((st.error[0].abs().to_degrees(), sd[0].to_degrees()));
+            if st.survey.flags & station_flags::AZIMUTH_UNDETERMINED != 0 || !sd[1].is_finite() {
+                s.azimuth_undetermined_stations += 1;
+                tally.undetermined += 1;
+            } else {
+                let e = st.error[1].abs();
+                azi.push(e.to_degrees());
+                azi_inside += usize::from(e <= 2.0 * sd[1]);
+                tally.azimuth.push((e.to_degrees(), sd[1].to_degrees()));
+            }
+            if let Some(p) = &st.position {
+                tally
+                    .position
+                    .push((p.error_horizontal(), p.sigma_horizontal()));
+            }
+        }
+        match (&o.td, &o.td_note) {
+            (Some(t), _) => {
+                let p = t.position();
+                td_err.push(p.error_horizontal());
+                td_sigma.push(p.sigma_horizontal());
+                td_major.push(p.semi_major());
+                td_inside += usize::from(t.d2 <= k2);
+            }
+            (None, note) => {
+                let reason = note.clone().unwrap_or_else(|| "unknown".into());
+                // by the reason's kind, not its numbers
+                let key = if reason.starts_with("last station at MD") {
+                    "last station not at TD".to_string()
+                } else {
+                    reason.split(':').next().unwrap_or("").to_string()
+                };
+                *unchecked.entry(key).or_default() += 1;
+            }
+        }
+    }
+    s.rms_station_inclination_deg = rms(&inc);
+    s.rms_station_azimuth_deg = rms(&azi);
+    s.azimuth_within_2_sigma = Fraction::of(azi_inside, azi.len());
+    s.inclination_within_2_sigma = Fraction::of(inc_inside, inc.len());
+    let per_1000 = |v: Option<f64>| v.map(|v| v * 1000.0 / lateral_length_m);
+    let predicted = rms(&td_sigma);
+    let major = rms(&td_major);
+    s.td = TdSummary {
+        runs_checked: td_err.len(),
+        rms_horizontal_error_m: rms(&td_err),
+        p95_horizontal_error_m: percentile(&td_err, 0.95),
+        predicted_1_sigma_m: predicted,
+        predicted_2_sigma_m: predicted.map(|p| 2.0 * p),
+        inside_95_ellipse: Fraction::of(td_inside, td_err.len()),
+        semi_major_1_sigma_m: major,
+        semi_major_1_sigma_per_1000_m: per_1000(major),
+    };
+    s.td_unchecked = unchecked.into_iter().collect();
+    s.along_md = by_station.iter().map(|(n, t)| t.along(*n)).collect();
+    let ok = s.runs > s.failed_runs.len();
+    s.run_cpu_s = cpu.filter(|_| ok);
+    s.epochs_per_core_second = s
+        .run_cpu_s
+        .filter(|c| *c > 0.0)
+        .map(|c| s.samples as f64 / c);
+    s.epochs_per_thread_wall_second = (s.run_wall_s > 0.0).then(|| s.samples as f64 / s.run_wall_s);
+    s.requirement = requirement(&s);
+    s
+}
+
+fn requirement(s: &GradeWellSummary) -> Requirement {
+    let attitude = match (s.rms_station_inclination_deg, s.rms_station_azimuth_deg) {
+        (Some(i), Some(a)) => Some(i.max(a)),
+        _ => None,
+    };
+    let withheld = s.azimuth_undetermined_stations + s.invalid_stations > 0;
+    let attitude_met = if s.stations == 0 {
+        None
+    } else if withheld {
+        Some(false)
+    } else {
+        attitude.map(|a| a < ATTITUDE_LIMIT_DEG)
+    };
+    let ok_runs = s.runs - s.failed_runs.len();
+    let per_1000 = |v: Option<f64>| v.map(|v| v * 1000.0 / s.lateral_length_m);
+    let rms_per = per_1000(s.td.rms_horizontal_error_m);
+    let position_met = rms_per.map(|r| {
+        r < POSITION_LIMIT_M_PER_1000_M && s.td.runs_checked == ok_runs && ok_runs == s.runs
+    });
+    Requirement {
+        attitude_error_deg: attitude,
+        attitude_met,
+        rms_td_error_per_1000_m: rms_per,
+        p95_td_error_per_1000_m: per_1000(s.td.p95_horizontal_error_m),
+        position_met,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study::drilling_run::{PositionCheck, StationCheck, TdCheck};
+    use mwd_core::protocol::StationSurvey;
+
+    fn station(number: u16, azimuth_error_deg: f64, sigma_deg: f32) -> StationCheck {
+        StationCheck {
+            survey: StationSurvey {
+                station: number,
+                angles_std: [0.001, sigma_deg.to_radians(), 0.001],
+                ..StationSurvey::default()
+            },
+            error: [0.0005, azimuth_error_deg.to_radians(), 0.0],
+            truth_md: 3000.0 + f64::from(number) * 28.0,
+            position: Some(PositionCheck {
+                error_ne: [3.0, 4.0],
+                cov_ne: [9.0, 16.0, 0.0],
+            }),
+        }
+    }
+
+    fn outcome(seed: u64, error_ne: [f64; 2], d2: f64) -> RunOutcome {
+        RunOutcome {
+            seed,
+            stations: vec![station(1, 0.05, 0.5), station(2, 2.0, 0.5)],
+            td: Some(TdCheck {
+                error_ne,
+                d2,
+                cov_ne: [4.0, 1.0, 0.0],
+            }),
+            td_note: None,
+            samples: 1000,
+            elapsed_s: 0.5,
+            cpu_s: Some(0.25),
+        }
+    }
+
+    #[test]
+    fn statistics_of_known_runs() {
+        let results = vec![
+            (1, Ok(outcome(1, [3.0, 4.0], 1.0))),
+            (2, Ok(outcome(2, [0.0, 1.0], 7.0))),
+            (3, Err("seed 3: broken".to_string())),
+        ];
+        let s = summarise("g", "w", 100.0, &results);
+        assert_eq!((s.runs, s.failed_runs.len(), s.stations), (3, 1, 4));
+        // azimuth errors 0.05, 2, 0.05, 2 deg; sigma 0.5: 2 of 4 within 2 sigma
+        assert_eq!(
+            (
+                s.azimuth_within_2_sigma.inside,
+                s.azimuth_within_2_sigma.total
+            ),
+            (2, 4)
+        );
+        let expected = ((0.05f64.powi(2) + 4.0) / 2.0).sqrt();
+        assert!((s.rms_station_azimuth_deg.unwrap() - expected).abs() < 1e-9);
+        // TD radial errors 5 and 1 m: RMS sqrt(13), p95 5, predicted sqrt(5)
+        assert!((s.td.rms_horizontal_error_m.unwrap() - 13f64.sqrt()).abs() < 1e-12);
+        assert_eq!(s.td.p95_horizontal_error_m, Some(5.0));
+        assert!((s.td.predicted_1_sigma_m.unwrap() - 5f64.sqrt()).abs() < 1e-12);
+        assert_eq!(s.td.semi_major_1_sigma_m, Some(2.0));
+        assert_eq!(s.td.semi_major_1_sigma_per_1000_m, Some(20.0));
+        assert_eq!(
+            (s.td.inside_95_ellipse.inside, s.td.inside_95_ellipse.total),
+            (1, 2)
+        );
+        assert_eq!(s.along_md.len(), 2);
+        assert_eq!(s.along_md[1].station, 2);
+        assert_eq!(s.along_md[1].rms_horizontal_error_m, Some(5.0));
+        assert_eq!(s.along_md[1].median_horizontal_sigma_m, Some(5.0));
+        assert_eq!(s.epochs_per_core_second, Some(4000.0));
+        assert_eq!(s.epochs_per_thread_wall_second, Some(2000.0));
+        // 2 deg of azimuth and 36 m per 1000 m: neither met; a failed run
+        // leaves the position requirement unmet whatever the figures
+        assert_eq!(s.requirement.attitude_met, Some(false));
+        assert_eq!(s.requirement.position_met, Some(false));
+    }
+
+    #[test]
+    fn no_cases_are_undetermined_never_zero() {
+        let s = summarise("g", "w", 100.0, &[(1, Err("seed 1: x".into()))]);
+        assert_eq!(s.rms_station_azimuth_deg, None);
+        assert_eq!(s.td.rms_horizontal_error_m, None);
+        assert_eq!(s.td.inside_95_ellipse.fraction, None);
+        assert_eq!(s.requirement.attitude_met, None);
+        assert_eq!(s.requirement.position_met, None);
+        assert_eq!(s.epochs_per_core_second, None);
+        assert_eq!(percentile(&[], 0.95), None);
+    }
+}

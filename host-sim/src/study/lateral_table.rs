@@ -1,0 +1,351 @@
+//! The lateral study's terminal tables and CSV ([`super::lateral`]).
+//! Undetermined figures print as "-" in tables (with the reason in the
+//! notes under them) and as empty fields in the CSV, never as a number.
+
+use super::drilling_coverage::Fraction;
+use super::lateral::LateralStudy;
+use super::lateral_summary::{GradeWellSummary, ATTITUDE_LIMIT_DEG, POSITION_LIMIT_M_PER_1000_M};
+
+/// Columns aligned: the first `left` columns to the left, the rest (numbers)
+/// to the right; a rule under the header.
+fn aligned(header: &[&str], rows: &[Vec<String>], left: usize) -> String {
+    let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for row in rows {
+        for (w, cell) in widths.iter_mut().zip(row) {
+            *w = (*w).max(cell.chars().count());
+        }
+    }
+    let line = |cells: &mut dyn Iterator<Item = &str>| -> String {
+        let parts: Vec<String> = cells
+            .zip(&widths)
+            .enumerate()
+            .map(|(i, (c, w))| {
+                if i < left {
+                    format!("{c:<w$}")
+                } else {
+                    format!("{c:>w$}")
+                }
+            })
+            .collect();
+        parts.join("  ").trim_end().to_string() + "\n"
+    };
+    let mut out = line(&mut header.iter().copied());
+    let rule: Vec<String> = widths.iter().map(|w| "-".repeat(*w)).collect();
+    out.push_str(&(rule.join("  ") + "\n"));
+    for row in rows {
+        out.push_str(&line(&mut row.iter().map(String::as_str)));
+    }
+    out
+}
+
+fn num(v: Option<f64>, decimals: usize) -> String {
+    v.map_or_else(|| "-".into(), |v| format!("{v:.decimals$}"))
+}
+
+/// "95.0 +- 1.5 % (190/200)", or "-" without cases.
+fn fraction(f: &Fraction) -> String {
+    match (f.fraction, f.standard_error) {
+        (Some(p), Some(se)) => format!(
+            "{:.1} +- {:.1} % ({}/{})",
+            100.0 * p,
+            100.0 * se,
+            f.inside,
+            f.total
+        ),
+        _ => "-".into(),
+    }
+}
+
+fn met(v: Option<bool>) -> String {
+    match v {
+        Some(true) => "yes".into(),
+        Some(false) => "no".into(),
+        None => "undetermined".into(),
+    }
+}
+
+fn station_row(s: &GradeWellSummary) -> Vec<String> {
+    vec![
+        s.grade.clone(),
+        s.well.clone(),
+        format!("{}/{}", s.runs - s.failed_runs.len(), s.runs),
+        s.stations.to_string(),
+        format!("{}/{}", s.azimuth_undetermined_stations, s.invalid_stations),
+        num(s.rms_station_azimuth_deg, 3),
+        fraction(&s.azimuth_within_2_sigma),
+        num(s.rms_station_inclination_deg, 3),
+        fraction(&s.inclination_within_2_sigma),
+        met(s.requirement.attitude_met),
+    ]
+}
+
+fn td_row(s: &GradeWellSummary) -> Vec<String> {
+    let t = &s.td;
+    vec![
+        s.grade.clone(),
+        s.well.clone(),
+        format!("{}/{}", t.runs_checked, s.runs),
+        num(t.rms_horizontal_error_m, 2),
+        num(t.p95_horizontal_error_m, 2),
+        num(t.predicted_1_sigma_m, 2),
+        num(t.predicted_2_sigma_m, 2),
+        fraction(&t.inside_95_ellipse),
+        num(t.semi_major_1_sigma_per_1000_m, 2),
+        num(s.requirement.rms_td_error_per_1000_m, 2),
+        num(s.requirement.p95_td_error_per_1000_m, 2),
+        met(s.requirement.position_met),
+        num(s.epochs_per_core_second, 0),
+    ]
+}
+
+/// The terminal tables: stations and the attitude requirement, TD and the
+/// position requirement, then the error growth along MD per grade and well.
+pub fn table(study: &LateralStudy) -> String {
+    let mut out = String::new();
+    out.push_str(&format!(
+        "stations (azimuth over the determined ones; undetermined/invalid counted; attitude: the larger RMS < {ATTITUDE_LIMIT_DEG} deg, no azimuth withheld)\n"
+    ));
+    let rows: Vec<Vec<String>> = study.summaries.iter().map(station_row).collect();
+    out.push_str(&aligned(
+        &[
+            "grade",
+            "well",
+            "runs ok",
+            "stations",
+            "undet/inv",
+            "azi RMS (deg)",
+            "azi within 2 sigma",
+            "inc RMS (deg)",
+            "inc within 2 sigma",
+            "attitude met",
+        ],
+        &rows,
+        2,
+    ));
+    out.push_str(&format!(
+        "\nTD horizontal position (predicted 1-sigma: RMS of sqrt(trace NE cov); position: RMS < {POSITION_LIMIT_M_PER_1000_M} m per 1000 m, every TD positioned)\n"
+    ));
+    let rows: Vec<Vec<String>> = study.summaries.iter().map(td_row).collect();
+    out.push_str(&aligned(
+        &[
+            "grade",
+            "well",
+            "TD checked",
+            "RMS (m)",
+            "p95 (m)",
+            "pred 1s (m)",
+            "pred 2s (m)",
+            "inside 95 % ellipse",
+            "semi-major 1s (m/1000 m)",
+            "RMS (m/1000 m)",
+            "p95 (m/1000 m)",
+            "position met",
+            "epochs/s/core (CPU)",
+        ],
+        &rows,
+        2,
+    ));
+    for s in &study.summaries {
+        for (reason, n) in &s.td_unchecked {
+            out.push_str(&format!(
+                "  {} {}: TD not checked in {n} runs: {reason}\n",
+                s.grade, s.well
+            ));
+        }
+        for e in s.failed_runs.iter().take(3) {
+            out.push_str(&format!("  {} {}: failed: {e}\n", s.grade, s.well));
+        }
+    }
+    for s in &study.summaries {
+        out.push_str(&format!(
+            "\nalong MD: {} on the {} well (azimuth over the determined stations; horizontal over the positioned ones)\n",
+            s.grade, s.well
+        ));
+        let rows: Vec<Vec<String>> = s
+            .along_md
+            .iter()
+            .map(|a| {
+                vec![
+                    a.station.to_string(),
+                    format!("{:.1}", a.truth_md_m),
+                    a.stations.to_string(),
+                    a.azimuth_undetermined.to_string(),
+                    num(a.rms_azimuth_error_deg, 3),
+                    num(a.median_azimuth_sigma_deg, 3),
+                    a.azimuth_within_2_sigma
+                        .fraction
+                        .map_or_else(|| "-".into(), |p| format!("{:.1}", 100.0 * p)),
+                    num(a.rms_inclination_error_deg, 3),
+                    num(a.median_inclination_sigma_deg, 3),
+                    a.positioned.to_string(),
+                    num(a.rms_horizontal_error_m, 2),
+                    num(a.median_horizontal_sigma_m, 2),
+                ]
+            })
+            .collect();
+        out.push_str(&aligned(
+            &[
+                "station",
+                "MD (m)",
+                "n",
+                "undet",
+                "azi RMS (deg)",
+                "azi median sigma (deg)",
+                "within 2 sigma (%)",
+                "inc RMS (deg)",
+                "inc median sigma (deg)",
+                "positioned",
+                "horiz RMS (m)",
+                "horiz median 1s (m)",
+            ],
+            &rows,
+            0,
+        ));
+    }
+    out
+}
+
+/// CSV: one row per grade and well, units in the header, undetermined
+/// fields empty.
+pub fn csv(study: &LateralStudy) -> String {
+    let header = [
+        "grade",
+        "well",
+        "lateral_length_m",
+        "runs",
+        "failed_runs",
+        "stations",
+        "invalid_stations",
+        "azimuth_undetermined_stations",
+        "rms_station_azimuth_deg",
+        "azimuth_within_2_sigma",
+        "azimuth_within_2_sigma_se",
+        "rms_station_inclination_deg",
+        "inclination_within_2_sigma",
+        "inclination_within_2_sigma_se",
+        "td_runs_checked",
+        "td_rms_horizontal_error_m",
+        "td_p95_horizontal_error_m",
+        "td_predicted_1_sigma_m",
+        "td_predicted_2_sigma_m",
+        "td_inside_95_ellipse_k",
+        "td_inside_95_ellipse_n",
+        "td_inside_95_ellipse",
+        "td_inside_95_ellipse_se",
+        "td_semi_major_1_sigma_m",
+        "td_semi_major_1_sigma_per_1000_m",
+        "attitude_error_deg",
+        "attitude_met",
+        "rms_td_error_per_1000_m",
+        "p95_td_error_per_1000_m",
+        "position_met",
+        "samples",
+        "epochs_per_core_second",
+        "epochs_per_thread_wall_second",
+    ];
+    let f = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v}"));
+    let b = |v: Option<bool>| v.map_or_else(String::new, |v| v.to_string());
+    let mut out = header.join(",") + "\n";
+    for s in &study.summaries {
+        let t = &s.td;
+        let fields = [
+            csv_field(&s.grade),
+            csv_field(&s.well),
+            format!("{}", s.lateral_length_m),
+            s.runs.to_string(),
+            s.failed_runs.len().to_string(),
+            s.stations.to_string(),
+            s.invalid_stations.to_string(),
+            s.azimuth_undetermined_stations.to_string(),
+            f(s.rms_station_azimuth_deg),
+            f(s.azimuth_within_2_sigma.fraction),
+            f(s.azimuth_within_2_sigma.standard_error),
+            f(s.rms_station_inclination_deg),
+            f(s.inclination_within_2_sigma.fraction),
+            f(s.inclination_within_2_sigma.standard_error),
+            t.runs_checked.to_string(),
+            f(t.rms_horizontal_error_m),
+            f(t.p95_horizontal_error_m),
+            f(t.predicted_1_sigma_m),
+            f(t.predicted_2_sigma_m),
+            t.inside_95_ellipse.inside.to_string(),
+            t.inside_95_ellipse.total.to_string(),
+            f(t.inside_95_ellipse.fraction),
+            f(t.inside_95_ellipse.standard_error),
+            f(t.semi_major_1_sigma_m),
+            f(t.semi_major_1_sigma_per_1000_m),
+            f(s.requirement.attitude_error_deg),
+            b(s.requirement.attitude_met),
+            f(s.requirement.rms_td_error_per_1000_m),
+            f(s.requirement.p95_td_error_per_1000_m),
+            b(s.requirement.position_met),
+            s.samples.to_string(),
+            f(s.epochs_per_core_second),
+            f(s.epochs_per_thread_wall_second),
+        ];
+        out.push_str(&(fields.join(",") + "\n"));
+    }
+    out
+}
+
+/// A text field quoted when it holds a comma, quote or line break (RFC 4180).
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study::lateral_summary::summarise;
+
+    fn study() -> LateralStudy {
+        LateralStudy {
+            runs_per_grade_and_well: 1,
+            first_seed: 1,
+            threads: 1,
+            tie_in_azimuth_sigma_deg: 0.5,
+            wall_s: 1.0,
+            grades: Vec::new(),
+            wells: Vec::new(),
+            summaries: vec![summarise(
+                "a",
+                "my,plan.json",
+                100.0,
+                &[(1, Err("x".into()))],
+            )],
+        }
+    }
+
+    #[test]
+    fn undetermined_is_a_dash_or_an_empty_field_never_a_number() {
+        let s = study();
+        let text = table(&s);
+        assert!(text.contains("undetermined"), "{text}");
+        let lines: Vec<&str> = text.lines().collect();
+        // header and rule have the same width
+        assert_eq!(
+            lines[1].len(),
+            lines[2].trim_end().len().max(lines[1].len())
+        );
+        let csv = csv(&s);
+        let rows: Vec<&str> = csv.lines().collect();
+        assert_eq!(rows.len(), 2);
+        let header = rows[0].split(',').count();
+        assert!(
+            rows[1].starts_with("a,\"my,plan.json\",100,1,1,"),
+            "{}",
+            rows[1]
+        );
+        // the quoted comma is one field
+        assert_eq!(rows[1].split(',').count(), header + 1);
+        assert!(
+            rows[1].contains(",,"),
+            "empty fields for undetermined: {}",
+            rows[1]
+        );
+    }
+}
