@@ -83,13 +83,21 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
         first_seed: 5,
         threads: 2,
         tie_in_azimuth_sigma: 0.5f64.to_radians(),
+        monte_carlo: true,
+        sweep: None,
     };
     let calls = std::sync::atomic::AtomicUsize::new(0);
     let result = study(&config, &|| {
         calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     })
     .expect("the study");
-    assert_eq!(calls.into_inner(), 2);
+    assert_eq!(
+        calls.into_inner(),
+        3,
+        "two runs and one covariance analysis"
+    );
+    assert_eq!(result.covariance.len(), 1);
+    assert_eq!(result.agreement.len(), 1);
     assert_eq!(result.summaries.len(), 1);
     let s = &result.summaries[0];
     assert_eq!(

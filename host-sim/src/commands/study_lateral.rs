@@ -6,6 +6,8 @@ use super::limits::number_in;
 use anyhow::{Context, Result};
 use host_sim::study::grade;
 use host_sim::study::lateral::{study, DrillingOverrides, StudyConfig, Well};
+use host_sim::study::lateral_covariance::SweepGrid;
+use host_sim::study::lateral_figures::plots;
 use host_sim::study::lateral_table::{csv, table};
 use std::path::PathBuf;
 
@@ -74,9 +76,19 @@ pub struct LateralArgs {
     /// Write one row per grade and well here (CSV).
     #[arg(long)]
     pub csv: Option<PathBuf>,
-    /// Directory for the plots (error growth along MD per grade).
+    /// Directory for the plots (SVG and PNG): error growth along MD per
+    /// grade against the predicted sigmas, and the sweep's contour map.
     #[arg(long)]
     pub plots: Option<PathBuf>,
+    /// Covariance analysis only (one error-free run per grade and well,
+    /// seconds to a minute), no Monte Carlo.
+    #[arg(long)]
+    pub covariance_only: bool,
+    /// Also sweep the first grade's gyro bias instability (0.001-10 deg/h)
+    /// and ARW (0.001-3 deg/sqrt(h)) by covariance analysis, this many
+    /// log-spaced values of each.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=20))]
+    pub sweep: Option<u64>,
 }
 
 pub fn run(args: LateralArgs) -> Result<()> {
@@ -113,12 +125,17 @@ pub fn run(args: LateralArgs) -> Result<()> {
         first_seed: args.first_seed,
         threads,
         tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
+        monte_carlo: !args.covariance_only,
+        sweep: args.sweep.map(|n| SweepGrid::default_grid(n as usize)),
     };
-    let jobs = (config.grades.len() * config.wells.len()) as u64 * args.runs;
+    let pairs = (config.grades.len() * config.wells.len()) as u64;
+    let sweep_points = args.sweep.map_or(0, |n| n * n) * config.wells.len() as u64;
+    let runs = if args.covariance_only { 0 } else { args.runs };
+    let jobs = pairs * (runs + 1) + sweep_points;
     let bar = indicatif::ProgressBar::new(jobs);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} runs (grades x wells x runs), {elapsed} (eta {eta})",
+            "{bar:40} {pos}/{len} runs (Monte Carlo, covariance analysis, sweep), {elapsed} (eta {eta})",
         )
         .context("progress bar")?,
     );
@@ -130,7 +147,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
         "lateral study: grades {}; wells {}; {} runs each from seed {}; tie-in azimuth sigma {} deg; {} threads; {:.1} s",
         names.join(", "),
         wells.join(", "),
-        args.runs,
+        runs,
         args.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
@@ -146,11 +163,13 @@ pub fn run(args: LateralArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(dir) = &args.plots {
-        // the plots are drawn by another part of the work (issue 14)
-        eprintln!(
-            "note: --plots {}: this build draws no plots yet",
-            dir.display()
-        );
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for path in plots(&result, dir)? {
+            outln!("wrote {}", path.display());
+        }
+    }
+    for e in &result.errors {
+        eprintln!("error: {e}");
     }
     Ok(())
 }

@@ -40,6 +40,12 @@ pub struct RunConfig {
     /// `simulate`'s captures run); default: calibrated, as a probe in a
     /// well is (residual errors: the noise model's).
     pub uncalibrated: bool,
+    /// Covariance analysis instead of a Monte Carlo draw: the same plan
+    /// (and its seed's vibration and orienter steps) with error-free
+    /// sensors, an error-free tie-in (sent with its sigmas) and depth log,
+    /// so the navigator's and the survey's covariances are what it reports
+    /// while its errors stay ~0 ([`covariance_analysis`]).
+    pub noise_free: bool,
     pub terms: Vec<ErrorTerm>,
     pub site: Site,
     /// The gyros (`Grade::scc1300()`: the probe's part, today's run).
@@ -65,6 +71,7 @@ impl RunConfig {
             tie_in_azimuth_sigma,
             depth_sigma,
             uncalibrated: false,
+            noise_free: false,
             terms,
             site: Site {
                 gravity: 9.806_65,
@@ -200,6 +207,32 @@ pub(crate) fn tie_in(
     TieIn::new(angles, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
 }
 
+/// The tie-in of the covariance analysis: the truth, sent with the sigmas
+/// [`tie_in`] draws its errors with.
+fn exact_tie_in(truth: &DrillingAngles, sigma_azi: f64) -> Result<TieIn> {
+    let sigma = DrillingAngles {
+        inclination: TIE_IN_INCLINATION_SIGMA_DEG.to_radians(),
+        azimuth: sigma_azi,
+        toolface: TIE_IN_TOOLFACE_SIGMA_DEG.to_radians(),
+    };
+    TieIn::new(*truth, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
+}
+
+/// Covariance analysis of `config`'s well and grade (issue 14's fast
+/// path): one run with error-free sensors ([`RunConfig::noise_free`]).
+/// The filter is linear in its errors, so its covariance does not depend
+/// on the noise drawn, only on the trajectory and the probe's decisions
+/// (still or drilling, which the seed's vibration and orienter steps
+/// drive); the stations' sigmas and the survey's TD covariance of this one
+/// run are the prediction a Monte Carlo's spread is checked against.
+pub fn covariance_analysis(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
+    let config = RunConfig {
+        noise_free: true,
+        ..config.clone()
+    };
+    run(&config, seed)
+}
+
 /// 1-sigma of the parent well's inclination at the window (deg): a
 /// gyro or MWD survey's, ISCWSA MWD's inclination terms at a station.
 pub const TIE_IN_INCLINATION_SIGMA_DEG: f64 = 0.1;
@@ -244,7 +277,10 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let cpu_start = thread_cpu_s();
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x57D7_0000_0000_0013);
     let mut plan = config.plan.clone();
-    if let Some((scale, stretch)) = config.depth_sigma {
+    if config.noise_free {
+        plan.drilling.depth_errors.scale_ppm = 0.0;
+        plan.drilling.depth_errors.stretch_per_m = 0.0;
+    } else if let Some((scale, stretch)) = config.depth_sigma {
         let a: f64 = StandardNormal.sample(&mut rng);
         let b: f64 = StandardNormal.sample(&mut rng);
         plan.drilling.depth_errors.scale_ppm = a * scale * 1e6;
@@ -254,8 +290,17 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let end_md = plan.end_md();
     let drilling = Drilling::new(plan, seed);
     let site = drilling.truth(0.0).position;
-    let model = config.grade.sensor_model(seed);
-    let raw_frames = config.grade.is_scc1300_part();
+    let model = if config.noise_free {
+        SensorModel {
+            seed,
+            ..SensorModel::ideal()
+        }
+    } else {
+        config.grade.sensor_model(seed)
+    };
+    // (error-free samples through the SCC1300's counts would be rounded
+    // without the noise that dithers them: a bias of up to half a count)
+    let raw_frames = config.grade.is_scc1300_part() && !config.noise_free;
     let mut navigator = if config.uncalibrated || !raw_frames {
         // other parts' samples come calibrated (`Grade::sensor_model`)
         Navigator::new(site)
@@ -283,7 +328,11 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
             // levelled and still at the window: the tie-in replaces the
             // gyrocompass azimuth
             let truth = DrillingAngles::from_euler(&d.truth.euler());
-            let t = tie_in(&truth, config.tie_in_azimuth_sigma, &mut rng)?;
+            let t = if config.noise_free {
+                exact_tie_in(&truth, config.tie_in_azimuth_sigma)?
+            } else {
+                tie_in(&truth, config.tie_in_azimuth_sigma, &mut rng)?
+            };
             navigator.start_from_tie_in(&t);
             tied = true;
             continue;

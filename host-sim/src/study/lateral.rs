@@ -10,7 +10,11 @@
 
 use super::drilling_run::{run, RunConfig, RunOutcome};
 use super::grade::Grade;
+use super::lateral_covariance::{
+    agreement, predict, Agreement, CovariancePrediction, SweepGrid, SweepResult,
+};
 use super::lateral_summary::{summarise, GradeWellSummary};
+use super::owsg::OwsgPrediction;
 use crate::sim::{BuiltPlan, Plan};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
@@ -98,6 +102,11 @@ pub struct StudyConfig {
     pub threads: usize,
     /// 1-sigma of the parent well's azimuth at the tie-in (rad).
     pub tie_in_azimuth_sigma: f64,
+    /// The Monte Carlo runs (`false`: covariance analysis only).
+    pub monte_carlo: bool,
+    /// A sweep of the first grade's gyro bias and ARW on each well
+    /// (covariance analysis).
+    pub sweep: Option<SweepGrid>,
 }
 
 /// A grade as the output lists it.
@@ -129,8 +138,40 @@ pub struct LateralStudy {
     pub wall_s: f64,
     pub grades: Vec<GradeInfo>,
     pub wells: Vec<WellInfo>,
-    /// One per grade and well, grade-major in the order given.
+    /// One per grade and well, grade-major in the order given (empty
+    /// without the Monte Carlo).
     pub summaries: Vec<GradeWellSummary>,
+    /// Covariance analysis, one per grade and well, the same order.
+    pub covariance: Vec<CovariancePrediction>,
+    /// Covariance analysis against the Monte Carlo, the same order.
+    pub agreement: Vec<Agreement>,
+    /// The OWSG gyro models on each well (`owsg`), valid or not.
+    pub owsg: Vec<WellOwsg>,
+    /// The sweeps, one per well.
+    pub sweeps: Vec<SweepResult>,
+    pub errors: Vec<String>,
+}
+
+/// The OWSG gyro models' predictions on one well.
+#[derive(Clone, Debug, Serialize)]
+pub struct WellOwsg {
+    pub well: String,
+    pub models: Vec<OwsgPrediction>,
+}
+
+/// One job of the pool.
+#[derive(Clone, Copy, Debug)]
+enum Job {
+    /// Config index, run index.
+    MonteCarlo(usize, u64),
+    Covariance(usize),
+    /// Well index, bias index, ARW index.
+    Sweep(usize, usize, usize),
+}
+
+enum JobOutcome {
+    Run(Result<RunOutcome, String>),
+    Prediction(Result<CovariancePrediction, String>),
 }
 
 /// Runs `jobs` jobs on `threads` threads (each takes the next job when
@@ -177,40 +218,114 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
             )?);
         }
     }
-    // one pool for every job, the longest wells first (no long run left
-    // alone at the end while the other cores idle)
-    let mut jobs: Vec<(usize, u64)> = (0..configs.len())
-        .flat_map(|c| (0..config.runs as u64).map(move |r| (c, r)))
-        .collect();
+    let jobs = job_list(config, &configs)?;
+    let sweep_grades = sweep_grades(config)?;
     let length = |c: usize| configs[c].plan.end_md() - configs[c].plan.tie_on.md();
-    jobs.sort_by(|a, b| length(b.0).total_cmp(&length(a.0)).then(a.cmp(b)));
-    let outcomes = run_jobs(jobs.len(), config.threads, progress, |k| {
-        let (c, r) = jobs[k];
-        let seed = config.first_seed + r;
-        let outcome = run(&configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}"));
-        (c, seed, outcome)
+    let outcomes = run_jobs(jobs.len(), config.threads, progress, |k| match jobs[k] {
+        Job::MonteCarlo(c, r) => {
+            let seed = config.first_seed + r;
+            JobOutcome::Run(run(&configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}")))
+        }
+        Job::Covariance(c) => {
+            let (g, w) = (c / config.wells.len(), c % config.wells.len());
+            JobOutcome::Prediction(predict(
+                &configs[c],
+                &config.grades[g],
+                &config.wells[w].label,
+                length(c),
+                config.first_seed,
+            ))
+        }
+        Job::Sweep(w, i, j) => {
+            let grade = &sweep_grades[i][j];
+            JobOutcome::Prediction(predict(
+                &configs[w],
+                grade,
+                &config.wells[w].label,
+                length(w),
+                config.first_seed,
+            ))
+        }
     });
+    let n = configs.len();
     let mut per_config: Vec<Vec<(u64, Result<RunOutcome, String>)>> =
-        (0..configs.len()).map(|_| Vec::new()).collect();
-    for (c, seed, outcome) in outcomes {
-        per_config[c].push((seed, outcome));
+        (0..n).map(|_| Vec::new()).collect();
+    let mut covariance: Vec<Option<CovariancePrediction>> = vec![None; n];
+    let mut sweeps: Vec<SweepResult> = Vec::new();
+    let mut errors = Vec::new();
+    if let Some(grid) = &config.sweep {
+        let empty = vec![vec![None; grid.arw_deg_per_sqrt_h.len()]; grid.bias_deg_per_h.len()];
+        for well in &config.wells {
+            sweeps.push(SweepResult {
+                base_grade: config.grades[0].name().to_string(),
+                well: well.label.clone(),
+                grid: grid.clone(),
+                td_sigma_per_1000_m: empty.clone(),
+                azimuth_sigma_deg: empty.clone(),
+                failures: Vec::new(),
+            });
+        }
+    }
+    for (job, outcome) in jobs.iter().zip(outcomes) {
+        match (*job, outcome) {
+            (Job::MonteCarlo(c, r), JobOutcome::Run(o)) => {
+                per_config[c].push((config.first_seed + r, o))
+            }
+            (Job::Covariance(c), JobOutcome::Prediction(p)) => match p {
+                Ok(p) => covariance[c] = Some(p),
+                Err(e) => errors.push(format!("covariance analysis: {e}")),
+            },
+            (Job::Sweep(w, i, j), JobOutcome::Prediction(p)) => match p {
+                Ok(p) => {
+                    sweeps[w].td_sigma_per_1000_m[i][j] = p
+                        .td_horizontal_1_sigma_m
+                        .map(|v| v * 1000.0 / p.lateral_length_m);
+                    sweeps[w].azimuth_sigma_deg[i][j] = p.rms_station_azimuth_sigma_deg;
+                }
+                Err(e) => sweeps[w].failures.push(e),
+            },
+            _ => errors.push("internal: a job's outcome of the wrong kind".into()),
+        }
     }
     let mut summaries = Vec::new();
-    for (c, mut results) in per_config.into_iter().enumerate() {
-        results.sort_by_key(|r| r.0);
-        let (grade, well) = (
-            &config.grades[c / config.wells.len()],
-            &config.wells[c % config.wells.len()],
-        );
-        summaries.push(summarise(
-            grade.name(),
-            &well.label,
-            well.lateral_length_m(),
-            &results,
-        ));
+    if config.monte_carlo {
+        for (c, mut results) in per_config.into_iter().enumerate() {
+            results.sort_by_key(|r| r.0);
+            let (grade, well) = (
+                &config.grades[c / config.wells.len()],
+                &config.wells[c % config.wells.len()],
+            );
+            summaries.push(summarise(
+                grade.name(),
+                &well.label,
+                well.lateral_length_m(),
+                &results,
+            ));
+        }
+    }
+    let covariance: Vec<CovariancePrediction> = covariance.into_iter().flatten().collect();
+    let agreement_rows = summaries
+        .iter()
+        .filter_map(|m| {
+            covariance
+                .iter()
+                .find(|c| c.grade == m.grade && c.well == m.well)
+                .map(|c| agreement(c, m))
+        })
+        .collect();
+    let mut owsg = Vec::new();
+    for well in &config.wells {
+        let site = super::owsg::study_site(well.plan.site.lat);
+        match super::owsg::predict_all(&well.plan, &site) {
+            Ok(models) => owsg.push(WellOwsg {
+                well: well.label.clone(),
+                models,
+            }),
+            Err(e) => errors.push(format!("OWSG models on {}: {e:#}", well.label)),
+        }
     }
     Ok(LateralStudy {
-        runs_per_grade_and_well: config.runs,
+        runs_per_grade_and_well: if config.monte_carlo { config.runs } else { 0 },
         first_seed: config.first_seed,
         threads: config.threads,
         tie_in_azimuth_sigma_deg: config.tie_in_azimuth_sigma.to_degrees(),
@@ -236,7 +351,63 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
             })
             .collect(),
         summaries,
+        covariance,
+        agreement: agreement_rows,
+        owsg,
+        sweeps,
+        errors,
     })
+}
+
+/// Every job: the Monte Carlo runs, one covariance analysis per grade and
+/// well, the sweep's points; the longest wells first (no long run left
+/// alone at the end while the other cores idle).
+fn job_list(config: &StudyConfig, configs: &[RunConfig]) -> Result<Vec<Job>> {
+    let mut jobs: Vec<Job> = Vec::new();
+    if config.monte_carlo {
+        for c in 0..configs.len() {
+            jobs.extend((0..config.runs as u64).map(|r| Job::MonteCarlo(c, r)));
+        }
+    }
+    jobs.extend((0..configs.len()).map(Job::Covariance));
+    if let Some(grid) = &config.sweep {
+        for w in 0..config.wells.len() {
+            for i in 0..grid.bias_deg_per_h.len() {
+                for j in 0..grid.arw_deg_per_sqrt_h.len() {
+                    jobs.push(Job::Sweep(w, i, j));
+                }
+            }
+        }
+    }
+    let length = |job: &Job| {
+        let c = match *job {
+            Job::MonteCarlo(c, _) | Job::Covariance(c) | Job::Sweep(c, _, _) => c,
+        };
+        configs[c].plan.end_md() - configs[c].plan.tie_on.md()
+    };
+    jobs.sort_by(|a, b| length(b).total_cmp(&length(a)));
+    if jobs.is_empty() {
+        bail!("nothing to do: no grade or no well");
+    }
+    Ok(jobs)
+}
+
+/// The sweep's grades: the first grade with each grid point's gyro bias
+/// instability and ARW ([bias index][arw index]).
+fn sweep_grades(config: &StudyConfig) -> Result<Vec<Vec<Grade>>> {
+    let Some(grid) = &config.sweep else {
+        return Ok(Vec::new());
+    };
+    let base = config.grades.first().context("a sweep needs a grade")?;
+    grid.bias_deg_per_h
+        .iter()
+        .map(|&b| {
+            grid.arw_deg_per_sqrt_h
+                .iter()
+                .map(|&a| base.with_gyro(b, a))
+                .collect()
+        })
+        .collect()
 }
 
 #[cfg(test)]

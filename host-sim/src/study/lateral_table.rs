@@ -202,6 +202,91 @@ pub fn table(study: &LateralStudy) -> String {
             0,
         ));
     }
+    out.push_str(&covariance_table(study));
+    out
+}
+
+/// The covariance analysis (one error-free run per grade and well), its
+/// agreement with the Monte Carlo, the OWSG models and the sweeps.
+fn covariance_table(study: &LateralStudy) -> String {
+    let mut out = String::new();
+    out.push_str(&format!(
+        "\ncovariance analysis (one error-free run each; ratio: predicted / Monte Carlo RMS, check |ratio - 1| <= 10 %; position: semi-major 1s < {POSITION_LIMIT_M_PER_1000_M} m per 1000 m)\n"
+    ));
+    let rows: Vec<Vec<String>> = study
+        .covariance
+        .iter()
+        .map(|c| {
+            let a = study
+                .agreement
+                .iter()
+                .find(|a| a.grade == c.grade && a.well == c.well);
+            vec![
+                c.grade.clone(),
+                c.well.clone(),
+                num(c.rms_station_azimuth_sigma_deg, 4),
+                num(c.rms_station_inclination_sigma_deg, 4),
+                c.azimuth_undetermined_stations.to_string(),
+                num(c.td_horizontal_1_sigma_m, 3),
+                num(c.td_semi_major_1_sigma_per_1000_m, 3),
+                num(a.and_then(|a| a.azimuth_ratio), 2),
+                num(a.and_then(|a| a.td_ratio), 2),
+                met(a.and_then(|a| a.within_10_percent)),
+                num(c.cpu_s, 1),
+            ]
+        })
+        .collect();
+    out.push_str(&aligned(
+        &[
+            "grade",
+            "well",
+            "azi sigma RMS (deg)",
+            "inc sigma RMS (deg)",
+            "azi undet",
+            "TD pred 1s (m)",
+            "semi-major 1s (m/1000 m)",
+            "azi ratio",
+            "TD ratio",
+            "within 10 %",
+            "CPU (s)",
+        ],
+        &rows,
+        2,
+    ));
+    for c in &study.covariance {
+        if let Some(note) = &c.td_note {
+            out.push_str(&format!("  {} {}: no TD figure: {note}\n", c.grade, c.well));
+        }
+    }
+    for w in &study.owsg {
+        for m in &w.models {
+            out.push_str(&format!("  OWSG {} on the {} well: {}\n", m.model, w.well, m.cell()));
+        }
+    }
+    for sweep in &study.sweeps {
+        out.push_str(&format!(
+            "\nsweep on the {} well ({} but the gyros): TD horizontal 1-sigma per 1000 m (m); rows: bias instability (deg/h), columns: ARW (deg/sqrt(h))\n",
+            sweep.well, sweep.base_grade
+        ));
+        let mut header = vec!["bias \\ ARW".to_string()];
+        header.extend(sweep.grid.arw_deg_per_sqrt_h.iter().map(|a| format!("{a:.3}")));
+        let rows: Vec<Vec<String>> = sweep
+            .grid
+            .bias_deg_per_h
+            .iter()
+            .zip(&sweep.td_sigma_per_1000_m)
+            .map(|(b, row)| {
+                let mut r = vec![format!("{b:.3}")];
+                r.extend(row.iter().map(|v| num(*v, 2)));
+                r
+            })
+            .collect();
+        let header: Vec<&str> = header.iter().map(String::as_str).collect();
+        out.push_str(&aligned(&header, &rows, 0));
+        for f in sweep.failures.iter().take(3) {
+            out.push_str(&format!("  failed: {f}\n"));
+        }
+    }
     out
 }
 

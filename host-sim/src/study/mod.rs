@@ -4,6 +4,8 @@ pub mod drilling_coverage;
 pub mod drilling_run;
 pub mod grade;
 pub mod lateral;
+pub mod lateral_covariance;
+pub mod lateral_figures;
 pub mod lateral_plots;
 pub mod lateral_summary;
 pub mod lateral_table;
