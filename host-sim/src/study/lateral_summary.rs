@@ -406,7 +406,10 @@ mod tests {
         o.td_note = Some("TD position undetermined".into());
         let s = summarise("g", "w", 1000.0, &[(1, Ok(o))]);
         assert_eq!(s.td.rms_horizontal_error_m, None);
-        assert_eq!(s.td_unchecked, [("TD position undetermined".to_string(), 1)]);
+        assert_eq!(
+            s.td_unchecked,
+            [("TD position undetermined".to_string(), 1)]
+        );
         assert_eq!(s.requirement.position_met, Some(false));
         // and a clean one under the limit meets it
         let s = summarise("g", "w", 1000.0, &[(1, Ok(outcome(1, [0.3, 0.4], 0.1)))]);
