@@ -50,7 +50,7 @@ pub struct Requirement {
     pub rms_td_error_per_1000_m: Option<f64>,
     pub p95_td_error_per_1000_m: Option<f64>,
     /// Met when the RMS per 1000 m is under the limit and every run's TD
-    /// was positioned.
+    /// was positioned (a run without a TD position: not met).
     pub position_met: Option<bool>,
 }
 
@@ -302,9 +302,15 @@ fn requirement(s: &GradeWellSummary) -> Requirement {
     let ok_runs = s.runs - s.failed_runs.len();
     let per_1000 = |v: Option<f64>| v.map(|v| v * 1000.0 / s.lateral_length_m);
     let rms_per = per_1000(s.td.rms_horizontal_error_m);
-    let position_met = rms_per.map(|r| {
-        r < POSITION_LIMIT_M_PER_1000_M && s.td.runs_checked == ok_runs && ok_runs == s.runs
-    });
+    // a TD withheld (undetermined) or a failed run does not meet it, as a
+    // withheld azimuth does not meet the attitude requirement
+    let position_met = if ok_runs == 0 {
+        None
+    } else if s.td.runs_checked < ok_runs || ok_runs < s.runs {
+        Some(false)
+    } else {
+        rms_per.map(|r| r < POSITION_LIMIT_M_PER_1000_M)
+    };
     Requirement {
         attitude_error_deg: attitude,
         attitude_met,
@@ -391,6 +397,23 @@ mod tests {
         // leaves the position requirement unmet whatever the figures
         assert_eq!(s.requirement.attitude_met, Some(false));
         assert_eq!(s.requirement.position_met, Some(false));
+    }
+
+    #[test]
+    fn a_withheld_td_does_not_meet_the_position_requirement() {
+        let mut o = outcome(1, [0.0, 0.01], 0.1);
+        o.td = None;
+        o.td_note = Some("TD position undetermined".into());
+        let s = summarise("g", "w", 1000.0, &[(1, Ok(o))]);
+        assert_eq!(s.td.rms_horizontal_error_m, None);
+        assert_eq!(
+            s.td_unchecked,
+            [("TD position undetermined".to_string(), 1)]
+        );
+        assert_eq!(s.requirement.position_met, Some(false));
+        // and a clean one under the limit meets it
+        let s = summarise("g", "w", 1000.0, &[(1, Ok(outcome(1, [0.3, 0.4], 0.1)))]);
+        assert_eq!(s.requirement.position_met, Some(true));
     }
 
     #[test]
