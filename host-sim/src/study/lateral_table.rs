@@ -260,7 +260,12 @@ fn covariance_table(study: &LateralStudy) -> String {
     }
     for w in &study.owsg {
         for m in &w.models {
-            out.push_str(&format!("  OWSG {} on the {} well: {}\n", m.model, w.well, m.cell()));
+            out.push_str(&format!(
+                "  OWSG {} on the {} well: {}\n",
+                m.model,
+                w.well,
+                m.cell()
+            ));
         }
     }
     for sweep in &study.sweeps {
@@ -269,7 +274,13 @@ fn covariance_table(study: &LateralStudy) -> String {
             sweep.well, sweep.base_grade
         ));
         let mut header = vec!["bias \\ ARW".to_string()];
-        header.extend(sweep.grid.arw_deg_per_sqrt_h.iter().map(|a| format!("{a:.3}")));
+        header.extend(
+            sweep
+                .grid
+                .arw_deg_per_sqrt_h
+                .iter()
+                .map(|a| format!("{a:.3}")),
+        );
         let rows: Vec<Vec<String>> = sweep
             .grid
             .bias_deg_per_h
@@ -402,6 +413,11 @@ mod tests {
                 100.0,
                 &[(1, Err("x".into()))],
             )],
+            covariance: Vec::new(),
+            agreement: Vec::new(),
+            owsg: Vec::new(),
+            sweeps: Vec::new(),
+            errors: Vec::new(),
         }
     }
 
