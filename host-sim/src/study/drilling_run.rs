@@ -73,15 +73,7 @@ impl RunConfig {
             uncalibrated: false,
             noise_free: false,
             terms,
-            site: Site {
-                gravity: 9.806_65,
-                b_total: 0.0,
-                dip: 0.0,
-                declination: 0.0,
-                vertical_limit: 0.0001_f64.to_radians(),
-                latitude,
-                gyro_noise_reduction: 1.0,
-            },
+            site: super::owsg::study_site(latitude),
             grade,
         })
     }
