@@ -24,7 +24,7 @@ use crate::kalman::{
 };
 use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 /// How the AR states start.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -276,6 +276,10 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     /// computed attitude (`ToolAxisSource::AtRest`), not a measurement:
     /// see [`hold_tool_axis`](Self::hold_tool_axis).
     held_tool_axis: bool,
+    /// The attitude the error model is linearised at, when fixed
+    /// ([`fix_linearization`](Self::fix_linearization)); `None`: the
+    /// computed attitude of each step.
+    linearization_attitude: Option<UnitQuaternion<f64>>,
     bias_walk: BiasWalk,
     /// Per bias state (accelerometers x, y, z then rates): the random-walk
     /// variance added since the start.
@@ -296,6 +300,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             steps: 0,
             rejected_samples: 0,
             held_tool_axis: false,
+            linearization_attitude: None,
             bias_walk: BiasWalk::EveryStep,
             bias_walk_added: [0.0; 6],
         };
@@ -342,6 +347,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.steps = 0;
         self.rejected_samples = 0;
         self.held_tool_axis = false;
+        self.linearization_attitude = None;
         self.bias_walk = BiasWalk::EveryStep;
         self.bias_walk_added = [0.0; 6];
     }
@@ -381,7 +387,11 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
         self.strapdown.step(sample);
         let state = *self.strapdown.state();
-        let c_bn = state.attitude.to_rotation_matrix().into_inner();
+        let c_bn = self
+            .linearization_attitude
+            .unwrap_or(state.attitude)
+            .to_rotation_matrix()
+            .into_inner();
         let lp = LinearizationPoint {
             c_bn,
             velocity_n: state.velocity,
@@ -397,15 +407,26 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
         let mut q = self.q;
         self.scale_bias_walk(&mut q);
-        if !extra.is_none() {
+        if self.held_tool_axis {
+            // The held axis's row takes no process noise
+            // (`predict_holding_axis`); this step's extra attitude noise
+            // (a rate that was not measured, e.g. a gap's held sample)
+            // is added after it, about every axis: what was not measured
+            // may have turned the tool about its axis too.
             for i in 0..3 {
-                q[ATT + i] += T::of(extra.attitude);
                 q[VEL + i] += T::of(extra.velocity);
             }
-        }
-        if self.held_tool_axis {
             self.predict_with_held_tool_axis(&phi, &q, &c_bn);
+            for i in 0..3 {
+                self.filter.p[(ATT + i, ATT + i)] += T::of(extra.attitude);
+            }
         } else {
+            if !extra.is_none() {
+                for i in 0..3 {
+                    q[ATT + i] += T::of(extra.attitude);
+                    q[VEL + i] += T::of(extra.velocity);
+                }
+            }
             self.filter.predict(&phi, &q);
         }
         self.add_gyro_instability_noise(&c_bn);
@@ -509,7 +530,12 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// N^3 product). Without it the model expects the earth rate to turn a
     /// heading error into a drift about the tool axis that the held rate
     /// cancels, sees none at a station, and reads that as heading
-    /// information it does not have.
+    /// information it does not have. The process noise is held out of that
+    /// row too, (I - e e^T) Q (I - e e^T) (derivation section 4i): no gyro
+    /// senses the tool axis, so its angle random walk does not turn the
+    /// held roll; added there, it kept the station toolface sigma at about
+    /// twice its error after connections had taught the accelerometer bias
+    /// across gravity.
     fn predict_with_held_tool_axis(
         &mut self,
         phi: &AugmentedTransition<T, N>,
@@ -705,6 +731,23 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
     }
 
+    /// Linearises the error model of the following steps (Phi, the held
+    /// tool axis, the gyro instability's noise) at the attitude computed
+    /// now (`true`; kept while called with `true` again), or again at each
+    /// step's computed attitude (`false`). For a tool that is still (a
+    /// station): its true attitude does not change, but the estimate does,
+    /// by every zero-velocity update's correction, and a Jacobian that
+    /// follows that jitter sees the tool-axis accelerometer bias from
+    /// directions the tool never took (derivation section 4i: the
+    /// first-estimates Jacobian of Huang, Mourikis and Roumeliotis, 2008).
+    pub fn fix_linearization(&mut self, fixed: bool) {
+        if !fixed {
+            self.linearization_attitude = None;
+        } else if self.linearization_attitude.is_none() {
+            self.linearization_attitude = Some(self.strapdown.state().attitude);
+        }
+    }
+
     /// Whether the tool-axis rate fed to the following steps is held at the
     /// frame's rate (`ToolAxisSource::AtRest`) rather than measured: the
     /// time update then leaves the attitude error about the tool axis
@@ -797,9 +840,11 @@ fn add_levelling_bias_correlation<T: FilterScalar, const N: usize>(
 
 /// `filter`'s time update with the attitude error about the unit vector
 /// `axis` (nav frame) held where it was: transition M = Phi - e w^T, e =
-/// (axis, 0, ...), w = Phi^T e - e ([`FineAlignment::hold_tool_axis`]).
-/// The structured Phi P Phi^T + Q plus the rank-2 correction
-/// -z e^T - e z^T + s e e^T with z = Phi P w and s = w^T P w.
+/// (axis, 0, ...), w = Phi^T e - e ([`FineAlignment::hold_tool_axis`]),
+/// and process noise (I - e e^T) Q (I - e e^T) (`q` diagonal). The
+/// structured Phi P Phi^T + Q plus the rank-2 correction
+/// -z e^T - e z^T + s e e^T with z = Phi P w + Q e and
+/// s = w^T P w + e^T Q e.
 pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
     filter: &mut KalmanFilter<T, N>,
     phi: &AugmentedTransition<T, N>,
@@ -840,10 +885,20 @@ pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
             }
         }
     }
-    let s = w.dot(&z);
+    let mut s = w.dot(&z);
     let wx = w.dot(&filter.x);
     filter.predict(phi, q);
     phi.apply_to_vector(&mut z);
+    // The held row's process noise is zero as well: x' = M x + (I - e e^T)
+    // n (the held component is t . phi_k itself, with no sensor behind
+    // it), so Q enters as (I - e e^T) Q (I - e e^T) = Q - (Q e) e^T -
+    // e (Q e)^T + (e^T Q e) e e^T. With Q diagonal, Q e is t scaled by
+    // the attitude entries of q: folded into z and s below.
+    for (k, tk) in t.iter().enumerate() {
+        let qe = q[ATT + k] * *tk;
+        z[ATT + k] += qe;
+        s += *tk * qe;
+    }
     let p = &mut filter.p;
     for (k, tk) in t.iter().enumerate() {
         for i in 0..N {
@@ -865,7 +920,6 @@ pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
 mod tests {
     use super::*;
     use crate::earth::earth_rate_n;
-    use nalgebra::UnitQuaternion;
 
     /// A negative or NaN attitude variance gives NaN Euler sigmas, never
     /// the 0 the old `max(0.0)` made of it.
@@ -895,8 +949,9 @@ mod tests {
     }
 
     /// The held-axis time update (structured product plus rank-2
-    /// correction) equals the dense M P M^T + Q, M = Phi - e w^T, and
-    /// leaves the attitude error about the axis where it was.
+    /// correction) equals the dense M P M^T + (I - e e^T) Q (I - e e^T),
+    /// M = Phi - e w^T (Q with different attitude entries), and leaves the
+    /// attitude error about the axis where it was, variance and all.
     #[test]
     fn holding_an_axis_matches_the_dense_transition() {
         let model = AugmentedModel::paper();
@@ -929,7 +984,9 @@ mod tests {
         let dense = phi.to_dense();
         let w = dense.transpose() * e - e;
         let m = dense - e * w.transpose();
-        let want_p = m * p0 * m.transpose() + SMatrix::from_diagonal(&q);
+        let hold =
+            SMatrix::<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>::identity() - e * e.transpose();
+        let want_p = m * p0 * m.transpose() + hold * SMatrix::from_diagonal(&q) * hold;
         let want_x = m * x0;
         let mut filter = KalmanFilter::new(p0);
         filter.x = x0;
@@ -944,16 +1001,15 @@ mod tests {
                 );
             }
         }
-        // Along the axis the attitude error is carried unchanged: its
-        // variance grows only by the axis's share of Q.
+        // Along the axis the attitude error is carried unchanged, with no
+        // process noise: its variance does not grow.
         let along = |p: &SMatrix<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>| {
             (0..3)
                 .flat_map(|a| (0..3).map(move |b| (a, b)))
                 .map(|(a, b)| axis[a] * axis[b] * p[(ATT + a, ATT + b)])
                 .sum::<f64>()
         };
-        let q_along: f64 = (0..3).map(|a| axis[a] * axis[a] * q[ATT + a]).sum();
-        assert!((along(&filter.p) - along(&p0) - q_along).abs() <= 1e-15);
+        assert!((along(&filter.p) - along(&p0)).abs() <= 1e-15);
     }
 
     /// A level 39-state filter at the paper's site with `noise` and
@@ -982,6 +1038,54 @@ mod tests {
             specific_force: -gravity_n(&site),
         };
         (filter, at_rest)
+    }
+
+    /// With the linearisation fixed, a step's covariance does not depend
+    /// on where the estimate has moved the attitude since (a 0.5-deg roll
+    /// correction here); unfixed it does, through C_b^n in Phi. Fixing again
+    /// keeps the first attitude; unfixing goes back to each step's.
+    #[test]
+    fn a_fixed_linearization_does_not_follow_the_estimate() {
+        let noise = ImuNoise::scc1300();
+        let (mut start, at_rest) = level_filter_at_rest(&noise, &[0.01, 0.01, 0.1], |_| {});
+        start.step(&at_rest);
+        start.hold_tool_axis(true);
+        let covariance_after = |fix: bool, turn: f64| {
+            let mut fa = start.clone();
+            fa.fix_linearization(fix);
+            let roll = euler_from_quat(&fa.state().attitude).roll;
+            fa.set_roll(roll + turn);
+            fa.fix_linearization(fix);
+            fa.step(&at_rest);
+            fa.filter.p
+        };
+        let largest_change =
+            |a: &SMatrix<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>,
+             b: &SMatrix<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>| {
+                (0..STATES_WITH_BIASES)
+                    .flat_map(|i| (0..STATES_WITH_BIASES).map(move |j| (i, j)))
+                    .map(|(i, j)| (a[(i, j)] - b[(i, j)]).abs() / (a[(i, i)] * a[(j, j)]).sqrt())
+                    .fold(0.0, f64::max)
+            };
+        let turn = 0.5 * DEG;
+        let fixed = largest_change(&covariance_after(true, 0.0), &covariance_after(true, turn));
+        let free = largest_change(
+            &covariance_after(false, 0.0),
+            &covariance_after(false, turn),
+        );
+        // What is left fixed is the velocity's share of Phi (Coriolis and
+        // transport terms at the step's computed velocity).
+        assert!(fixed < 1e-7, "fixed: {fixed:e}");
+        assert!(free > 1e-4, "free: {free:e}");
+        assert!(fixed < 1e-3 * free, "fixed {fixed:e}, free {free:e}");
+        let mut fa = start.clone();
+        fa.fix_linearization(true);
+        let first = fa.linearization_attitude;
+        fa.set_roll(0.1);
+        fa.fix_linearization(true);
+        assert_eq!(fa.linearization_attitude, first);
+        fa.fix_linearization(false);
+        assert_eq!(fa.linearization_attitude, None);
     }
 
     /// An accelerometer bias put back at a station grows by the random

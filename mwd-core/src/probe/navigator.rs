@@ -729,6 +729,16 @@ impl Navigator {
                     extra.velocity += square(jitter * SAMPLE_INTERVAL_S) * onset;
                 }
                 filter.linearize_at_gravity(drilling || still);
+                // A still tool's attitude does not change: once the
+                // station's first block has re-levelled it, the error model
+                // stays linearised there instead of following each ZUPT's
+                // correction (derivation section 4i).
+                let settled = still
+                    && self
+                        .station
+                        .as_ref()
+                        .is_some_and(|s| s.epochs >= SURVEY_SETTLE_EPOCHS);
+                filter.fix_linearization(settled);
                 let report = filter.step_with(&imu, &extra);
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
