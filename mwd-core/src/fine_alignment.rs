@@ -26,6 +26,14 @@ use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
+/// How far the computed attitude may turn from a fixed linearisation point
+/// before the point is taken again (rad;
+/// [`FineAlignment::fix_linearization`]): 1 deg, well above a station's
+/// ZUPT jitter (~0.01 deg), well below the heading a quiet gyro re-finds.
+pub const MAX_LINEARIZATION_TURN_RAD: f64 = 1.0 * core::f64::consts::PI / 180.0;
+/// cos(MAX_LINEARIZATION_TURN_RAD / 2) = 0.99996192...
+const COS_HALF_MAX_LINEARIZATION_TURN: f64 = 0.999_961_923_064_171;
+
 /// How the AR states start.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ArInitialCovariance {
@@ -740,12 +748,22 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// follows that jitter sees the tool-axis accelerometer bias from
     /// directions the tool never took (derivation section 4i: the
     /// first-estimates Jacobian of Huang, Mourikis and Roumeliotis, 2008).
+    /// A first estimate is only good while the estimate stays near it: a
+    /// quiet gyro gyrocompasses a station's heading by degrees, and a model
+    /// left at the old heading (the held axis, the biases' directions) then
+    /// drove it away (100 deg in one simulated station). So the attitude is
+    /// taken again once the estimate has turned more than
+    /// [`MAX_LINEARIZATION_TURN_RAD`] from it.
     pub fn fix_linearization(&mut self, fixed: bool) {
-        if !fixed {
-            self.linearization_attitude = None;
-        } else if self.linearization_attitude.is_none() {
-            self.linearization_attitude = Some(self.strapdown.state().attitude);
-        }
+        let current = self.strapdown.state().attitude;
+        self.linearization_attitude = match self.linearization_attitude {
+            _ if !fixed => None,
+            // |q1 . q2| = cos(angle / 2): no trigonometry per step
+            Some(at) if at.coords.dot(&current.coords).abs() >= COS_HALF_MAX_LINEARIZATION_TURN => {
+                Some(at)
+            }
+            _ => Some(current),
+        };
     }
 
     /// Whether the tool-axis rate fed to the following steps is held at the
@@ -1043,7 +1061,9 @@ mod tests {
     /// With the linearisation fixed, a step's covariance does not depend
     /// on where the estimate has moved the attitude since (a 0.5-deg roll
     /// correction here); unfixed it does, through C_b^n in Phi. Fixing again
-    /// keeps the first attitude; unfixing goes back to each step's.
+    /// keeps the first attitude while the estimate stays within
+    /// `MAX_LINEARIZATION_TURN_RAD` of it and takes the new one beyond;
+    /// unfixing goes back to each step's.
     #[test]
     fn a_fixed_linearization_does_not_follow_the_estimate() {
         let noise = ImuNoise::scc1300();
@@ -1081,11 +1101,21 @@ mod tests {
         let mut fa = start.clone();
         fa.fix_linearization(true);
         let first = fa.linearization_attitude;
-        fa.set_roll(0.1);
+        let roll = euler_from_quat(&fa.state().attitude).roll;
+        // within the turn allowed: the first attitude is kept
+        fa.set_roll(roll + 0.9 * MAX_LINEARIZATION_TURN_RAD);
         fa.fix_linearization(true);
         assert_eq!(fa.linearization_attitude, first);
+        // beyond it (a heading re-found by degrees): taken again
+        fa.set_roll(roll + 1.1 * MAX_LINEARIZATION_TURN_RAD);
+        fa.fix_linearization(true);
+        assert_ne!(fa.linearization_attitude, first);
+        assert_eq!(fa.linearization_attitude, Some(fa.state().attitude));
         fa.fix_linearization(false);
         assert_eq!(fa.linearization_attitude, None);
+        extern crate std;
+        let cos_half = std::primitive::f64::cos(0.5 * MAX_LINEARIZATION_TURN_RAD);
+        assert!((COS_HALF_MAX_LINEARIZATION_TURN - cos_half).abs() < 1e-15);
     }
 
     /// An accelerometer bias put back at a station grows by the random
