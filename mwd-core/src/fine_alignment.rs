@@ -30,7 +30,7 @@ use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 /// before the point is taken again (rad;
 /// [`FineAlignment::fix_linearization`]): 1 deg, well above a station's
 /// ZUPT jitter (~0.01 deg), well below the heading a quiet gyro re-finds.
-pub const MAX_LINEARIZATION_TURN_RAD: f64 = 1.0 * core::f64::consts::PI / 180.0;
+pub const MAX_LINEARIZATION_TURN_RAD: f64 = crate::conventions::DEG;
 /// cos(MAX_LINEARIZATION_TURN_RAD / 2) = 0.99996192...
 const COS_HALF_MAX_LINEARIZATION_TURN: f64 = 0.999_961_923_064_171;
 
