@@ -9,6 +9,7 @@ use anyhow::{bail, Context, Result};
 use host_sim::capture::read_probe_capture;
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::depth_log::DepthLog;
+use host_sim::survey_listing::drilling::AzimuthSigmaTrack;
 use host_sim::survey_listing::{drilling, drilling_text, LengthUnit};
 use mwd_core::protocol::Payload;
 use std::path::PathBuf;
@@ -91,7 +92,19 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         gyro_noise_reduction: 1.0,
     };
     let terms = drilling::depth_terms()?;
-    let survey = drilling::survey(&stations, &depth, tie, &terms, &site)
+    let track: AzimuthSigmaTrack = capture
+        .frames
+        .iter()
+        .filter_map(|f| match &f.payload {
+            Payload::Nav(n) => Some(n),
+            _ => None,
+        })
+        .collect();
+    let azi_before: Vec<_> = stations
+        .iter()
+        .map(|s| track.before(s.start_sample))
+        .collect();
+    let survey = drilling::survey(&stations, &azi_before, &depth, tie, &terms, &site)
         .with_context(|| format!("{}", args.stations.display()))?;
     let s = &capture.stats;
     let bad = s.crc_errors + s.malformed + s.unknown_kind;

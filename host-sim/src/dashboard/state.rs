@@ -22,6 +22,7 @@ use super::stations::{stations_json, SurveySetup};
 use super::view::{
     attitude_channels, event_text, latest_json, sensor_channels, ATTITUDE_CHANNELS, SENSOR_CHANNELS,
 };
+use crate::survey_listing::drilling::AzimuthSigmaTrack;
 
 /// The bounds of the dashboard's buffers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -104,6 +105,10 @@ pub struct DashboardState {
     last_time_s: f64,
     latest: Option<NavSolution>,
     stations: VecDeque<StationSurvey>,
+    /// Each station's azimuth sigma at its start, from `azimuth_track`.
+    stations_azi_before: VecDeque<Option<f64>>,
+    /// The solutions' azimuth sigmas since the last station.
+    azimuth_track: AzimuthSigmaTrack,
     stations_dropped: u64,
     stations_view: Value,
     stations_update: u64,
@@ -125,7 +130,7 @@ pub struct DashboardState {
 
 impl DashboardState {
     pub fn new(source: SourceInfo, session: u64, limits: Limits) -> Self {
-        let stations_view = stations_json(&[], 0, &source.survey);
+        let stations_view = stations_json(&[], &[], 0, &source.survey);
         Self {
             limits,
             session,
@@ -140,6 +145,8 @@ impl DashboardState {
             last_time_s: f64::NEG_INFINITY,
             latest: None,
             stations: VecDeque::new(),
+            stations_azi_before: VecDeque::new(),
+            azimuth_track: AzimuthSigmaTrack::default(),
             stations_dropped: 0,
             stations_view,
             stations_update: 0,
@@ -196,6 +203,7 @@ impl DashboardState {
                     self.long_attitude.push(update, (t, channels));
                 }
                 self.solutions_seen += 1;
+                self.azimuth_track.push(nav);
                 self.latest = Some(*nav);
             }
             Payload::Event(event) => {
@@ -205,12 +213,17 @@ impl DashboardState {
             Payload::Station(station) => {
                 if self.stations.len() == self.limits.stations {
                     self.stations.pop_front();
+                    self.stations_azi_before.pop_front();
                     self.stations_dropped += 1;
                 }
                 self.stations.push_back(*station);
+                let before = self.azimuth_track.before(station.start_sample);
+                self.stations_azi_before.push_back(before);
+                self.azimuth_track.forget_before(station.end_sample);
                 let list: Vec<StationSurvey> = self.stations.iter().copied().collect();
+                let before: Vec<Option<f64>> = self.stations_azi_before.iter().copied().collect();
                 self.stations_view =
-                    stations_json(&list, self.stations_dropped, &self.source.survey);
+                    stations_json(&list, &before, self.stations_dropped, &self.source.survey);
                 self.stations_update = update;
             }
         }

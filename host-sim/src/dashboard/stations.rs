@@ -93,7 +93,12 @@ fn positioned(row: &mut Value, d: &DrillingRow) {
 /// The stations for the page: the list, the note on positions, and the
 /// plan view (east, north) and vertical section (section, TVD) of the
 /// stations whose position is determined.
-pub fn stations_json(stations: &[StationSurvey], dropped: u64, setup: &SurveySetup) -> Value {
+pub fn stations_json(
+    stations: &[StationSurvey],
+    azi_before: &[Option<f64>],
+    dropped: u64,
+    setup: &SurveySetup,
+) -> Value {
     let mut rows: Vec<Value> = stations.iter().map(station_row).collect();
     let mut plan = Vec::new();
     let mut section = Vec::new();
@@ -109,7 +114,7 @@ pub fn stations_json(stations: &[StationSurvey], dropped: u64, setup: &SurveySet
                 north: 0.0,
                 east: 0.0,
             };
-            match drilling::survey(stations, depth, tie, &setup.terms, &setup.site) {
+            match drilling::survey(stations, azi_before, depth, tie, &setup.terms, &setup.site) {
                 Ok(survey) => {
                     for d in &survey.rows {
                         // By number and time: a station's NaN correlations

@@ -12,14 +12,14 @@ use crate::capture::{raw_sample_from_si, SiSample};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey_error::{ErrorTerm, Site};
 use crate::survey_listing::depth_log::DepthLog;
-use crate::survey_listing::drilling::{self, DrillingSurvey};
+use crate::survey_listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey};
 use crate::survey_listing::TieOnInput;
 use anyhow::{anyhow, Context, Result};
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::{Navigator, TieIn};
 use mwd_core::probe_sample::ProbeSample;
-use mwd_core::protocol::{RawSample, StationSurvey};
+use mwd_core::protocol::{NavSolution, RawSample, StationSurvey};
 use mwd_core::timing::{sample_time_us, SAMPLE_INTERVAL_S};
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -252,15 +252,14 @@ fn feed(
     index: usize,
     gyro: &Vector3<f64>,
     accel: &Vector3<f64>,
-) -> Result<()> {
-    if raw_frames {
-        navigator.step(&raw(index, gyro, accel)?);
+) -> Result<NavSolution> {
+    Ok(if raw_frames {
+        navigator.step(&raw(index, gyro, accel)?)
     } else {
         let n = u32::try_from(index).context("more than 2^32 samples")?;
         let sample = ProbeSample::new(gyro.x, gyro.z, *accel);
-        navigator.step_sample(sample_time_us(n), n, &sample);
-    }
-    Ok(())
+        navigator.step_sample(sample_time_us(n), n, &sample)
+    })
 }
 
 /// Runs seed `seed`.
@@ -303,13 +302,14 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     navigator.set_noise_budget(config.grade.budget_ref());
     let mut tied = false;
     let mut stations = Vec::new();
+    let mut track = AzimuthSigmaTrack::default();
     let mut samples = 0;
     let sim = DrillingSimulator::new(&drilling, model.clone(), SAMPLE_INTERVAL_S);
     // the last sample's true means and whether the run ends still
     let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?;
+        track.push(&feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?);
         samples += 1;
         last = Some((
             s.true_rate,
@@ -344,7 +344,13 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         });
         for k in 0..MAX_STATION_SAMPLES as usize {
             let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
-            feed(&mut navigator, raw_frames, run_samples + k, &gyro, &force)?;
+            track.push(&feed(
+                &mut navigator,
+                raw_frames,
+                run_samples + k,
+                &gyro,
+                &force,
+            )?);
             samples += 1;
             if let Some(station) = navigator.take_station() {
                 stations.push(station);
@@ -383,8 +389,19 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         north: tie_on.nev().x,
         east: tie_on.nev().y,
     };
-    let (td, td_note) = match drilling::survey(&stations, &depth, tie, &config.terms, &config.site)
-    {
+    let azi_before: Vec<_> = stations
+        .iter()
+        .map(|s| track.before(s.start_sample))
+        .collect();
+    let survey = drilling::survey(
+        &stations,
+        &azi_before,
+        &depth,
+        tie,
+        &config.terms,
+        &config.site,
+    );
+    let (td, td_note) = match survey {
         Ok(survey) => {
             attach_positions(&mut checks, &survey, &drilling);
             td_check(&survey, &drilling, end_md)

@@ -6,15 +6,25 @@
 //!
 //! How the stations' errors are correlated (docs/drilling-survey.md):
 //! * azimuth: the probe carries its azimuth through drilling on the gyros
-//!   from the tie-in (or its first gyrocompass), so its error is a random
-//!   walk: each station's error is the previous one's plus an independent
-//!   increment. The covariance of stations j and k is then
-//!   `min(s_j^2, s_k^2)` (the Brownian kernel at "times" `s^2`, positive
-//!   semi-definite for any sigmas, so also when a bias update at a station
-//!   makes a sigma shrink). As error sources: one source per station,
-//!   systematic from that station on, of magnitude
-//!   `sqrt(s_(j)^2 - s_(j-1)^2)` in the order of the variances; the first
-//!   is the tie-in's part, systematic for the whole run;
+//!   from the tie-in (or its first gyrocompass), and each station's
+//!   earth-rate updates may then pull part of it back. As a Kalman update
+//!   of a scalar error that started the station with variance `s_pre^2`
+//!   and ended it with `s_k^2`, the station keeps the fraction
+//!   `a_k = s_k^2 / s_pre,k^2` of the error it started with and adds an
+//!   independent part. The stations' errors are then a Markov chain:
+//!   `e_k = a_k e_(k-1) + d_k u_k`, `u_k` independent unit normals,
+//!   `d_k^2 = s_k^2 - a_k^2 s_(k-1)^2`, so `cov(e_j, e_k) = s_j^2 a_(j+1)
+//!   ... a_k`. `s_pre,k` is the probe's azimuth sigma just before the
+//!   station's first zero-velocity update ([`AngleSigma::azi_before`]).
+//!   Where it is not known it is taken as the previous station's sigma:
+//!   a growing sigma is then a random walk (`a_k = 1`, the covariance
+//!   `min(s_j^2, s_k^2)`), a shrinking one a bias update that keeps
+//!   `s_k^2 / s_(k-1)^2` of the error. `a_k` is held to at most 1 and to
+//!   at most `s_k / s_(k-1)` (so `d_k^2 >= 0`): every station keeps its
+//!   own sigma exactly and the covariance stays a linear map of
+//!   independent sources (positive semi-definite by construction). One
+//!   source per station, from that station on, decaying by the `a`s; the
+//!   first is the tie-in's part;
 //! * inclination: re-levelled at every station through the zero-velocity
 //!   updates, so random from station to station, except for the part the
 //!   filter correlates with that station's azimuth:
@@ -50,6 +60,11 @@ pub struct AngleSigma {
     pub azi: f64,
     /// Correlation of the inclination and azimuth errors (NaN: taken as 0).
     pub corr_inc_azi: f64,
+    /// The azimuth sigma (rad) just before the station's first
+    /// zero-velocity update: what its earth-rate updates started from.
+    /// `None` (or not a finite number > 0): the previous station's sigma
+    /// (module docs).
+    pub azi_before: Option<f64>,
 }
 
 /// Why a propagation was refused.
@@ -162,32 +177,21 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
             }
         })
         .collect();
-    // azimuth random walk in the order of the variances (stable: ties keep
-    // the station order and get zero-size increments)
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| sigmas[a].azi.total_cmp(&sigmas[b].azi));
-    let mut rank = vec![0; n];
-    for (r, &k) in order.iter().enumerate() {
-        rank[k] = r;
-    }
+    let chain = azimuth_chain(sigmas);
     let mut out = Vec::with_capacity(2 * n);
-    let mut previous = 0.0;
-    for (r, &k) in order.iter().enumerate() {
-        let variance = sigmas[k].azi.powi(2);
-        let size = (variance - previous).max(0.0).sqrt();
-        previous = variance;
-        if size == 0.0 {
+    for (j, link) in chain.iter().enumerate() {
+        if link.fresh == 0.0 {
             continue;
         }
-        let weights = (0..n)
-            .map(|i| {
-                if rank[i] >= r {
-                    [share[i] * size, size]
-                } else {
-                    [0.0, 0.0]
-                }
-            })
-            .collect();
+        // u_j's share of e_k: d_j a_(j+1) ... a_k
+        let mut weights = vec![[0.0, 0.0]; n];
+        let mut w = link.fresh;
+        for k in j..n {
+            if k > j {
+                w *= chain[k].carried;
+            }
+            weights[k] = [share[k] * w, w];
+        }
         out.push(Source { weights });
     }
     for (k, s) in sigmas.iter().enumerate() {
@@ -205,6 +209,42 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
         out.push(Source { weights });
     }
     out
+}
+
+/// One link of the azimuth chain `e_k = a_k e_(k-1) + d_k u_k`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ChainLink {
+    /// a_k: the fraction of the previous station's error carried here.
+    carried: f64,
+    /// d_k: the size of this station's independent part.
+    fresh: f64,
+}
+
+/// The azimuth chain of the module docs: each station keeps its sigma
+/// exactly (`a_k^2 s_(k-1)^2 + d_k^2 = s_k^2`).
+fn azimuth_chain(sigmas: &[AngleSigma]) -> Vec<ChainLink> {
+    let mut previous = 0.0; // s_(k-1)^2; none before the first station
+    sigmas
+        .iter()
+        .map(|s| {
+            let variance = s.azi.powi(2);
+            let start = s
+                .azi_before
+                .filter(|b| b.is_finite() && *b > 0.0)
+                .map_or(previous, |b| b * b);
+            let mut carried = if start > 0.0 {
+                (variance / start).min(1.0)
+            } else {
+                1.0
+            };
+            if previous > 0.0 {
+                carried = carried.min((variance / previous).sqrt());
+            }
+            let fresh = (variance - carried * carried * previous).max(0.0).sqrt();
+            previous = variance;
+            ChainLink { carried, fresh }
+        })
+        .collect()
 }
 
 /// d dr/dI and d dr/dA per unit length at a station and the half course
@@ -273,7 +313,92 @@ mod tests {
             inc,
             azi,
             corr_inc_azi: 0.0,
+            azi_before: None,
         }
+    }
+
+    /// cov(e_j, e_k) of the chain, from its links.
+    fn chain_covariance(sigmas: &[AngleSigma], j: usize, k: usize) -> f64 {
+        let chain = azimuth_chain(sigmas);
+        let (j, k) = (j.min(k), j.max(k));
+        // e_k's part that is e_j: a_(j+1) ... a_k
+        let carried: f64 = chain[j + 1..=k].iter().map(|l| l.carried).product();
+        sigmas[j].azi.powi(2) * carried
+    }
+
+    #[test]
+    fn every_station_keeps_its_own_azimuth_sigma_whatever_the_chain() {
+        let before = |b: Option<f64>| AngleSigma {
+            azi_before: b,
+            ..sigma(0.0, 0.0)
+        };
+        // growing, shrinking, a start below the previous station's sigma,
+        // a full re-find, an unknown and a bad start
+        let azi = [0.02, 0.03, 0.01, 0.015, 0.005, 0.02, 0.02];
+        let pre = [
+            None,
+            Some(0.04),
+            Some(0.02),
+            Some(0.012),
+            Some(1.0),
+            None,
+            Some(f64::NAN),
+        ];
+        let s: Vec<AngleSigma> = azi
+            .iter()
+            .zip(pre)
+            .map(|(&a, b)| AngleSigma {
+                azi: a,
+                ..before(b)
+            })
+            .collect();
+        let chain = azimuth_chain(&s);
+        let mut previous = 0.0;
+        for (k, l) in chain.iter().enumerate() {
+            assert!((0.0..=1.0).contains(&l.carried), "{k}: {l:?}");
+            let variance = l.carried.powi(2) * previous + l.fresh.powi(2);
+            assert!((variance - azi[k].powi(2)).abs() < 1e-15, "{k}: {l:?}");
+            previous = variance;
+        }
+        // a_k = s_k^2 / s_pre^2 where the start is known and above the
+        // previous sigma; 1 for an unknown start and a growing sigma
+        assert!((chain[1].carried - (0.03f64 / 0.04).powi(2)).abs() < 1e-15);
+        assert!((chain[2].carried - (0.01f64 / 0.02).powi(2)).abs() < 1e-15);
+        assert!((chain[4].carried - 0.005f64.powi(2)).abs() < 1e-15);
+        assert_eq!(chain[5].carried, 1.0);
+        // a start below the previous sigma (0.012 < 0.015 after 0.01):
+        // held to s_k / s_(k-1) so the fresh part is not negative
+        assert!(chain[3].carried <= 1.0 && chain[3].fresh >= 0.0);
+    }
+
+    #[test]
+    fn a_station_that_refinds_its_azimuth_forgets_the_previous_error() {
+        // 5 stations, each re-finding the azimuth to 0.01 from a start of
+        // 0.1: a = 0.01, nearly independent errors, so the sideways TD
+        // error adds in quadrature, far below the random walk's.
+        let st = straight(5, 25.0, 90.0, 0.0);
+        let s = 0.01;
+        let refound: Vec<AngleSigma> = (0..5)
+            .map(|_| AngleSigma {
+                azi_before: Some(10.0 * s),
+                ..sigma(0.0, s)
+            })
+            .collect();
+        let c = angle_covariance(&st, &refound).unwrap();
+        let h = [12.5, 25.0, 25.0, 25.0, 12.5];
+        let var: f64 = (0..5)
+            .flat_map(|j| (0..5).map(move |k| (j, k)))
+            .map(|(j, k)| h[j] * h[k] * chain_covariance(&refound, j, k))
+            .sum();
+        assert!((c[4][1] - var).abs() < 1e-12 * var, "{} vs {var}", c[4][1]);
+        let independent: f64 = h.iter().map(|h| (h * s).powi(2)).sum();
+        assert!((c[4][1] / independent - 1.0).abs() < 0.05, "{}", c[4][1]);
+        let systematic = c_systematic(&st, s);
+        assert!(c[4][1] < 0.5 * systematic);
+    }
+
+    fn c_systematic(st: &[Station], s: f64) -> f64 {
+        angle_covariance(st, &vec![sigma(0.0, s); st.len()]).unwrap()[st.len() - 1][1]
     }
 
     #[test]
@@ -324,6 +449,7 @@ mod tests {
                 inc: 0.001,
                 azi: 0.002,
                 corr_inc_azi: 0.9,
+                azi_before: None,
             };
             3
         ];

@@ -70,6 +70,59 @@ pub fn depth_terms() -> Result<Vec<ErrorTerm>> {
     Ok(terms)
 }
 
+/// The azimuth 1-sigma the probe reported in its 20 Hz solutions, by
+/// sample counter: the sigma each station's earth-rate updates started
+/// from, for the stations' carried fraction
+/// ([`crate::survey_error::probe_station`]). Empty when the solutions are
+/// not at hand: the model then takes each station's start as the previous
+/// station's sigma.
+#[derive(Clone, Debug, Default)]
+pub struct AzimuthSigmaTrack {
+    /// (sample counter, azimuth sigma in rad), counters increasing.
+    points: Vec<(u32, f32)>,
+}
+
+impl AzimuthSigmaTrack {
+    /// Adds a solution; one out of order (a reboot, a repeated frame) ends
+    /// what is known before it, as a new run would.
+    pub fn push(&mut self, s: &NavSolution) {
+        if self
+            .points
+            .last()
+            .is_some_and(|&(last, _)| s.sample_counter <= last)
+        {
+            self.points.clear();
+        }
+        self.points.push((s.sample_counter, s.attitude_std[2]));
+    }
+
+    /// Forgets the solutions before `sample` (a live display keeps only
+    /// what a station still to come can start from).
+    pub fn forget_before(&mut self, sample: u32) {
+        let k = self.points.partition_point(|&(c, _)| c < sample);
+        self.points.drain(..k);
+    }
+
+    /// The sigma of the last solution before `sample`, if it is a finite
+    /// number > 0 and no more than a second (20 samples) before it.
+    pub fn before(&self, sample: u32) -> Option<f64> {
+        let k = self.points.partition_point(|&(c, _)| c < sample);
+        let &(counter, sigma) = self.points.get(k.checked_sub(1)?)?;
+        let sigma = f64::from(sigma);
+        (sample - counter <= 20 && sigma.is_finite() && sigma > 0.0).then_some(sigma)
+    }
+}
+
+impl<'a> FromIterator<&'a NavSolution> for AzimuthSigmaTrack {
+    fn from_iter<I: IntoIterator<Item = &'a NavSolution>>(iter: I) -> Self {
+        let mut track = Self::default();
+        for s in iter {
+            track.push(s);
+        }
+        track
+    }
+}
+
 fn azimuth_determined(s: &StationSurvey) -> bool {
     s.flags & station_flags::AZIMUTH_UNDETERMINED == 0 && s.angles_std[1].is_finite()
 }
@@ -87,18 +140,22 @@ fn unusable(s: &StationSurvey) -> Option<&'static str> {
 }
 
 /// The survey of `stations` (in the order the probe sent them) with MD
-/// from `depth`; `tie`: the tie-on's position, and its MD if given.
+/// from `depth`; `tie`: the tie-on's position, and its MD if given;
+/// `azi_before`: each station's azimuth sigma at its start
+/// ([`AzimuthSigmaTrack::before`] its `start_sample`), for the stations'
+/// correlation; shorter than `stations` (empty) where not known.
 pub fn survey(
     stations: &[StationSurvey],
+    azi_before: &[Option<f64>],
     depth: &DepthLog,
     tie: TieOnInput,
     terms: &[ErrorTerm],
     site: &Site,
 ) -> Result<DrillingSurvey> {
     let mut skipped = Vec::new();
-    let mut kept: Vec<(StationSurvey, f64, f64)> = Vec::new();
+    let mut kept: Vec<(StationSurvey, f64, f64, Option<f64>)> = Vec::new();
     let (first, last) = depth.span();
-    for s in stations {
+    for (k, s) in stations.iter().enumerate() {
         if let Some(reason) = unusable(s) {
             skipped.push(Skipped {
                 survey: *s,
@@ -126,7 +183,7 @@ pub fn survey(
         }
         // Not beyond the previous station: the string did not move in
         // between; the later station (more still time behind it) stands.
-        while let Some((previous, _, prev_md)) = kept.last() {
+        while let Some((previous, _, prev_md, _)) = kept.last() {
             if md > *prev_md {
                 break;
             }
@@ -136,9 +193,9 @@ pub fn survey(
             });
             kept.pop();
         }
-        kept.push((*s, time_s, md));
+        kept.push((*s, time_s, md, azi_before.get(k).copied().flatten()));
     }
-    let Some(&(_, _, first_md)) = kept.first() else {
+    let Some(&(_, _, first_md, _)) = kept.first() else {
         bail!("no usable station survey in the capture");
     };
     let md_offset_m = tie.md.map_or(0.0, |md| md - first_md);
@@ -146,7 +203,7 @@ pub fn survey(
         unit: LengthUnit::Metre,
         stations: kept
             .iter()
-            .map(|(s, time_s, md)| InputStation {
+            .map(|(s, time_s, md, _)| InputStation {
                 md: md + md_offset_m,
                 inc_deg: f64::from(s.angles[0]).to_degrees(),
                 azi_deg: f64::from(s.angles[1]).to_degrees(),
@@ -159,11 +216,12 @@ pub fn survey(
     let (rows, _) = compute(&file, AzimuthReference::True, tie_position, None)?;
     let sigmas: Vec<Option<AngleSigma>> = kept
         .iter()
-        .map(|(s, ..)| {
-            azimuth_determined(s).then(|| AngleSigma {
+        .map(|(s, _, _, before)| {
+            azimuth_determined(s).then_some(AngleSigma {
                 inc: f64::from(s.angles_std[0]),
                 azi: f64::from(s.angles_std[1]),
                 corr_inc_azi: f64::from(s.correlations[0]),
+                azi_before: *before,
             })
         })
         .collect();
@@ -172,7 +230,7 @@ pub fn survey(
         .iter()
         .zip(rows)
         .enumerate()
-        .map(|(k, ((s, time_s, _), mut row))| {
+        .map(|(k, ((s, time_s, ..), mut row))| {
             row.cov = covs.get(k).copied();
             DrillingRow {
                 survey: *s,
@@ -331,6 +389,7 @@ pub fn trajectory(
                 inc: s[0],
                 azi: s[1],
                 corr_inc_azi: f64::NAN,
+                azi_before: None,
             })
         })
         .collect();
@@ -350,4 +409,58 @@ pub fn trajectory(
             }
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn solution(counter: u32, azimuth_std: f32) -> NavSolution {
+        NavSolution {
+            sample_counter: counter,
+            attitude_std: [0.0, 0.0, azimuth_std],
+            ..NavSolution::default()
+        }
+    }
+
+    #[test]
+    fn a_station_starts_from_the_last_solution_before_its_first_update() {
+        let track: AzimuthSigmaTrack = [solution(10, 0.1), solution(11, 0.2), solution(12, 0.3)]
+            .iter()
+            .collect();
+        assert_eq!(track.before(12), Some(f64::from(0.2f32)));
+        assert_eq!(track.before(32), Some(f64::from(0.3f32)));
+        // nothing before the first, nothing older than a second
+        assert_eq!(track.before(10), None);
+        assert_eq!(track.before(33), None);
+    }
+
+    #[test]
+    fn an_invalid_sigma_or_a_restart_leaves_the_start_unknown() {
+        let mut track = AzimuthSigmaTrack::default();
+        track.push(&solution(5, f32::INFINITY));
+        assert_eq!(track.before(6), None);
+        track.push(&solution(6, f32::NAN));
+        assert_eq!(track.before(7), None);
+        track.push(&solution(7, 0.0));
+        assert_eq!(track.before(8), None);
+        // a counter that goes back is a new run: the old one is forgotten
+        track.push(&solution(100, 0.5));
+        track.push(&solution(3, 0.25));
+        assert_eq!(track.before(101), None);
+        assert_eq!(track.before(4), Some(0.25));
+    }
+
+    #[test]
+    fn forgetting_keeps_what_a_later_station_can_start_from() {
+        let mut track: AzimuthSigmaTrack = (0..50)
+            .map(|k| solution(k, 0.5))
+            .collect::<Vec<_>>()
+            .iter()
+            .collect();
+        track.forget_before(40);
+        assert_eq!(track.points.len(), 10);
+        assert_eq!(track.before(45), Some(0.5));
+        assert_eq!(track.before(40), None);
+    }
 }
