@@ -6,6 +6,7 @@
 //! horizontal ellipse (95 +- 3 % of runs).
 
 use super::drilling_run::{run, RunConfig, RunOutcome};
+use super::stats::{median, rms};
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -75,11 +76,6 @@ pub struct StationCoverage {
     /// The same of the determined azimuths.
     pub rms_azimuth_deg: Option<f64>,
     pub median_azimuth_sigma_deg: Option<f64>,
-}
-
-fn rms(values: &[f64]) -> Option<f64> {
-    (!values.is_empty())
-        .then(|| (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt())
 }
 
 /// Runs seeds `first_seed..first_seed + runs` on `threads` threads;
@@ -203,9 +199,8 @@ struct StationTally {
 /// pairs.
 fn rms_and_median_sigma(pairs: &[(f64, f64)]) -> (Option<f64>, Option<f64>) {
     let errors: Vec<f64> = pairs.iter().map(|(e, _)| *e).collect();
-    let mut sigmas: Vec<f64> = pairs.iter().map(|(_, s)| *s).collect();
-    sigmas.sort_by(f64::total_cmp);
-    (rms(&errors), sigmas.get(sigmas.len() / 2).copied())
+    let sigmas: Vec<f64> = pairs.iter().map(|(_, s)| *s).collect();
+    (rms(&errors), median(&sigmas))
 }
 
 impl StationTally {

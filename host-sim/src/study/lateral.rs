@@ -15,12 +15,11 @@ use super::lateral_covariance::{
 };
 use super::lateral_summary::{summarise, GradeWellSummary};
 use super::owsg::OwsgPrediction;
+use super::run_jobs;
 use crate::sim::{BuiltPlan, Plan};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 /// The repository's two laterals (docs/drilling-simulation.md), built in
 /// so the binary works from any directory.
@@ -172,36 +171,6 @@ enum Job {
 enum JobOutcome {
     Run(Result<RunOutcome, String>),
     Prediction(Result<CovariancePrediction, String>),
-}
-
-/// Runs `jobs` jobs on `threads` threads (each takes the next job when
-/// done), calling `progress` after each; outcomes in job order.
-fn run_jobs<T: Send>(
-    jobs: usize,
-    threads: usize,
-    progress: &(dyn Fn() + Sync),
-    job: impl Fn(usize) -> T + Sync,
-) -> Vec<T> {
-    let next = AtomicUsize::new(0);
-    let done: Mutex<Vec<(usize, T)>> = Mutex::new(Vec::with_capacity(jobs));
-    std::thread::scope(|scope| {
-        for _ in 0..threads.max(1) {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= jobs {
-                    break;
-                }
-                let outcome = job(k);
-                if let Ok(mut d) = done.lock() {
-                    d.push((k, outcome));
-                }
-                progress();
-            });
-        }
-    });
-    let mut done = done.into_inner().unwrap_or_default();
-    done.sort_by_key(|d| d.0);
-    done.into_iter().map(|d| d.1).collect()
 }
 
 /// Runs the study; `progress` is called after each of the

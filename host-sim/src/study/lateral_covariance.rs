@@ -9,7 +9,8 @@
 
 use super::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
 use super::grade::Grade;
-use super::lateral_summary::{rms, GradeWellSummary};
+use super::lateral_summary::GradeWellSummary;
+use super::stats::rms;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
 

@@ -12,6 +12,7 @@
 
 use super::drilling_coverage::Fraction;
 use super::drilling_run::RunOutcome;
+use super::stats::{median, percentile, rms};
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -110,23 +111,6 @@ pub struct GradeWellSummary {
     /// The same per second of wall time per thread (lower on a machine
     /// shared with other work).
     pub epochs_per_thread_wall_second: Option<f64>,
-}
-
-pub(crate) fn rms(values: &[f64]) -> Option<f64> {
-    (!values.is_empty())
-        .then(|| (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt())
-}
-
-/// Nearest-rank percentile `p` (0-1).
-pub(crate) fn percentile(values: &[f64], p: f64) -> Option<f64> {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let rank = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1));
-    v.get(rank - 1).copied()
-}
-
-fn median(values: &[f64]) -> Option<f64> {
-    percentile(values, 0.5)
 }
 
 /// One station number's values while summarising.
@@ -425,6 +409,5 @@ mod tests {
         assert_eq!(s.requirement.attitude_met, None);
         assert_eq!(s.requirement.position_met, None);
         assert_eq!(s.epochs_per_core_second, None);
-        assert_eq!(percentile(&[], 0.95), None);
     }
 }

@@ -11,6 +11,7 @@ pub mod lateral_summary;
 pub mod lateral_table;
 pub mod owsg;
 pub mod rins_probe;
+pub mod stats;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -25,25 +26,38 @@ pub fn run_seeds<T: Send>(
     progress: &(dyn Fn() + Sync),
     run: impl Fn(u64) -> anyhow::Result<T> + Sync,
 ) -> Vec<(u64, Result<T, String>)> {
+    run_jobs(runs, threads, progress, |k| {
+        let seed = first_seed + k as u64;
+        (seed, run(seed).map_err(|e| format!("seed {seed}: {e:#}")))
+    })
+}
+
+/// Runs `jobs` jobs on `threads` threads (each takes the next job when
+/// done), calling `progress` after each; the outcomes in job order.
+pub fn run_jobs<T: Send>(
+    jobs: usize,
+    threads: usize,
+    progress: &(dyn Fn() + Sync),
+    job: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(u64, Result<T, String>)>> = Mutex::new(Vec::new());
+    let done: Mutex<Vec<(usize, T)>> = Mutex::new(Vec::with_capacity(jobs));
     std::thread::scope(|scope| {
         for _ in 0..threads.max(1) {
             scope.spawn(|| loop {
                 let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= runs {
+                if k >= jobs {
                     break;
                 }
-                let seed = first_seed + k as u64;
-                let outcome = run(seed).map_err(|e| format!("seed {seed}: {e:#}"));
-                if let Ok(mut r) = results.lock() {
-                    r.push((seed, outcome));
+                let outcome = job(k);
+                if let Ok(mut d) = done.lock() {
+                    d.push((k, outcome));
                 }
                 progress();
             });
         }
     });
-    let mut results = results.into_inner().unwrap_or_default();
-    results.sort_by_key(|r| r.0);
-    results
+    let mut done = done.into_inner().unwrap_or_default();
+    done.sort_by_key(|d| d.0);
+    done.into_iter().map(|d| d.1).collect()
 }

@@ -19,6 +19,7 @@
 
 use super::drilling_coverage::Fraction;
 use super::drilling_run::{raw, tie_in};
+use super::stats::{percentile, rms};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use anyhow::Result;
 use mwd_core::conventions::{dcm_from_quat, wrap_pi, DrillingAngles};
@@ -263,21 +264,6 @@ pub struct TdSummary {
     pub undetermined: usize,
 }
 
-fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    (n > 0).then(|| (sum / n as f64).sqrt())
-}
-
-/// Nearest-rank percentile `p` (0-1) of `values`.
-fn percentile(mut values: Vec<f64>, p: f64) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    let rank = ((p * values.len() as f64).ceil() as usize).clamp(1, values.len());
-    Some(values[rank - 1])
-}
-
 fn within(checks: &[AzimuthCheck], k: f64) -> Fraction {
     let determined: Vec<_> = checks
         .iter()
@@ -291,9 +277,13 @@ fn td_summary(checks: &[AzimuthCheck]) -> TdSummary {
     let errors: Vec<f64> = checks.iter().map(|c| c.error.abs().to_degrees()).collect();
     TdSummary {
         runs_at_td: checks.len(),
-        rms_error_deg: rms(errors.iter().copied()),
-        p95_abs_error_deg: percentile(errors, 0.95),
-        rms_sigma_deg: rms(checks.iter().filter_map(|c| c.sigma).map(f64::to_degrees)),
+        rms_error_deg: rms(&errors),
+        p95_abs_error_deg: percentile(&errors, 0.95),
+        rms_sigma_deg: rms(&checks
+            .iter()
+            .filter_map(|c| c.sigma)
+            .map(f64::to_degrees)
+            .collect::<Vec<_>>()),
         within_2_sigma: within(checks, 2.0),
         undetermined: checks.iter().filter(|c| c.sigma.is_none()).count(),
     }
@@ -436,13 +426,5 @@ mod tests {
             tactical.noise.gyro[0].residual_bias
         );
         assert!(base.quantize && !tactical.quantize);
-    }
-
-    #[test]
-    fn the_percentile_is_the_nearest_rank() {
-        let v: Vec<f64> = (1..=20).map(f64::from).collect();
-        assert_eq!(percentile(v.clone(), 0.95), Some(19.0));
-        assert_eq!(percentile(v, 1.0), Some(20.0));
-        assert_eq!(percentile(Vec::new(), 0.95), None);
     }
 }
