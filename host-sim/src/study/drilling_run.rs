@@ -13,7 +13,9 @@ use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorError
 use crate::survey_error::{ErrorTerm, Site};
 use crate::survey_listing::depth_log::DepthLog;
 use crate::survey_listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey};
-use crate::survey_listing::TieOnInput;
+use crate::survey_listing::{
+    compute, AzimuthReference, InputStation, LengthUnit, StationFile, TieOnInput,
+};
 use anyhow::{anyhow, Context, Result};
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
@@ -150,6 +152,11 @@ pub struct RunOutcome {
     /// undetermined (`td_note` says which).
     pub td: Option<TdCheck>,
     pub td_note: Option<String>,
+    /// The survey method's own TD horizontal error (m): minimum curvature
+    /// through the true MD and angles at the survey's stations against
+    /// the drilled path's TD (the path changes its curvature between
+    /// stations). No sensor is in it, and no sigma covers it.
+    pub method_td_error_m: Option<f64>,
     /// Simulated samples, each one navigator epoch.
     pub samples: usize,
     /// Wall time of the run on its thread (s).
@@ -401,22 +408,59 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         &config.terms,
         &config.site,
     );
-    let (td, td_note) = match survey {
+    let (td, td_note, method_td_error_m) = match survey {
         Ok(survey) => {
             attach_positions(&mut checks, &survey, &drilling);
-            td_check(&survey, &drilling, end_md)
+            let (td, note) = td_check(&survey, &drilling, end_md);
+            let method = td.and(method_td_error(&survey, &drilling));
+            (td, note, method)
         }
-        Err(e) => (None, Some(format!("no survey: {e:#}"))),
+        Err(e) => (None, Some(format!("no survey: {e:#}")), None),
     };
     Ok(RunOutcome {
         seed,
         stations: checks,
         td,
         td_note,
+        method_td_error_m,
         samples,
         elapsed_s: started.elapsed().as_secs_f64(),
         cpu_s: cpu_start.zip(thread_cpu_s()).map(|(a, b)| b - a),
     })
+}
+
+/// The horizontal distance between the drilled path's position at the
+/// survey's last station and minimum curvature through the true MD and
+/// angles at its stations from the true tie-on position.
+fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<f64> {
+    let truths: Vec<_> = survey
+        .rows
+        .iter()
+        .map(|r| drilling.truth((f64::from(r.survey.end_sample) + 1.0) * SAMPLE_INTERVAL_S))
+        .collect();
+    let (first, last) = (truths.first()?, truths.last()?);
+    let file = StationFile {
+        unit: LengthUnit::Metre,
+        stations: truths
+            .iter()
+            .map(|t| InputStation {
+                md: t.md,
+                inc_deg: t.point.inclination.to_degrees(),
+                azi_deg: wrap_two_pi(t.point.azimuth).to_degrees(),
+                toolface_deg: None,
+                time_s: None,
+            })
+            .collect(),
+    };
+    let tie = TieOnInput {
+        md: None,
+        tvd: first.point.nev.z,
+        north: first.point.nev.x,
+        east: first.point.nev.y,
+    };
+    let (rows, _) = compute(&file, AzimuthReference::True, tie, None).ok()?;
+    let end = rows.last()?;
+    Some((end.north_m - last.point.nev.x).hypot(end.east_m - last.point.nev.y))
 }
 
 /// The NE covariance of a survey row, if its position is determined.

@@ -410,19 +410,4 @@ mod tests {
         assert!(e.contains("drilling.stand_length_m"), "{e}");
         assert!(Well::builtin("10km", &none).is_err());
     }
-
-    #[test]
-    fn the_pool_keeps_the_job_order() {
-        let calls = AtomicUsize::new(0);
-        let out = run_jobs(
-            50,
-            3,
-            &|| {
-                calls.fetch_add(1, Ordering::Relaxed);
-            },
-            |k| k * 2,
-        );
-        assert_eq!(out, (0..50).map(|k| k * 2).collect::<Vec<_>>());
-        assert_eq!(calls.load(Ordering::Relaxed), 50);
-    }
 }

@@ -32,6 +32,11 @@ pub struct CovariancePrediction {
     pub azimuth_undetermined_stations: usize,
     /// Along MD: truth MD, azimuth sigma (deg), horizontal 1-sigma (m).
     pub along_md: Vec<(f64, Option<f64>, Option<f64>)>,
+    /// The survey method's own TD horizontal error on this well (m):
+    /// minimum curvature through the true angles at the stations against
+    /// the drilled path ([`RunOutcome::method_td_error_m`]). The predicted
+    /// sigma has no term for it (docs/lateral-study.md).
+    pub method_td_error_m: Option<f64>,
     /// Why there is no TD figure, if there is none.
     pub td_note: Option<String>,
     pub cpu_s: Option<f64>,
@@ -72,6 +77,7 @@ impl CovariancePrediction {
             rms_station_inclination_sigma_deg: rms(&inc),
             azimuth_undetermined_stations: undetermined,
             along_md,
+            method_td_error_m: o.method_td_error_m,
             td_note: o.td_note.clone(),
             cpu_s: o.cpu_s,
             wall_s: o.elapsed_s,

@@ -336,6 +336,7 @@ mod tests {
                 cov_ne: [4.0, 1.0, 0.0],
             }),
             td_note: None,
+            method_td_error_m: None,
             samples: 1000,
             elapsed_s: 0.5,
             cpu_s: Some(0.25),

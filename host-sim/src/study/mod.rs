@@ -61,3 +61,35 @@ pub fn run_jobs<T: Send>(
     done.sort_by_key(|d| d.0);
     done.into_iter().map(|d| d.1).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pool_keeps_the_job_order() {
+        let calls = AtomicUsize::new(0);
+        let out = run_jobs(
+            50,
+            3,
+            &|| {
+                calls.fetch_add(1, Ordering::Relaxed);
+            },
+            |k| k * 2,
+        );
+        assert_eq!(out, (0..50).map(|k| k * 2).collect::<Vec<_>>());
+        assert_eq!(calls.load(Ordering::Relaxed), 50);
+    }
+
+    #[test]
+    fn seeds_come_back_in_order_with_their_errors_named() {
+        let out = run_seeds(6, 10, 2, &|| {}, |seed| {
+            anyhow::ensure!(seed != 12, "bad");
+            Ok(seed * 2)
+        });
+        let seeds: Vec<u64> = out.iter().map(|r| r.0).collect();
+        assert_eq!(seeds, (10..16).collect::<Vec<_>>());
+        assert_eq!(out[0].1, Ok(20));
+        assert_eq!(out[2].1, Err("seed 12: bad".to_string()));
+    }
+}
