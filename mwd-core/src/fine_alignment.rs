@@ -766,6 +766,16 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         };
     }
 
+    /// The attitude the error model is linearised at: the fixed one
+    /// ([`fix_linearization`](Self::fix_linearization)) or the current
+    /// estimate. An aiding row that depends on the attitude (the station's
+    /// rate gyrocompass, `aid_sources::EarthRate`) takes it too, so that
+    /// the model's Jacobians all sit at one point (derivation section 4e).
+    pub fn linearization_attitude(&self) -> UnitQuaternion<f64> {
+        self.linearization_attitude
+            .unwrap_or(self.strapdown.state().attitude)
+    }
+
     /// Whether the tool-axis rate fed to the following steps is held at the
     /// frame's rate (`ToolAxisSource::AtRest`) rather than measured: the
     /// time update then leaves the attitude error about the tool axis
@@ -1106,6 +1116,8 @@ mod tests {
         fa.set_roll(roll + 0.9 * MAX_LINEARIZATION_TURN_RAD);
         fa.fix_linearization(true);
         assert_eq!(fa.linearization_attitude, first);
+        assert_eq!(Some(fa.linearization_attitude()), first);
+        assert_ne!(fa.linearization_attitude(), fa.state().attitude);
         // beyond it (a heading re-found by degrees): taken again
         fa.set_roll(roll + 1.1 * MAX_LINEARIZATION_TURN_RAD);
         fa.fix_linearization(true);
@@ -1113,6 +1125,7 @@ mod tests {
         assert_eq!(fa.linearization_attitude, Some(fa.state().attitude));
         fa.fix_linearization(false);
         assert_eq!(fa.linearization_attitude, None);
+        assert_eq!(fa.linearization_attitude(), fa.state().attitude);
         extern crate std;
         let cos_half = std::primitive::f64::cos(0.5 * MAX_LINEARIZATION_TURN_RAD);
         assert!((COS_HALF_MAX_LINEARIZATION_TURN - cos_half).abs() < 1e-15);
