@@ -261,10 +261,10 @@ fn drilling_keeps_velocity_and_tilt_bounded_and_stations_come() {
             deg_h(b[1])
         );
     }
-    // The vertical-earth-rate update runs at every station of 30 s or
-    // more; with this gyro noise a 5-minute station resolves the bias to
-    // ~3 deg/h, the budget's own prior (derivation section 4e): the sigmas
-    // stay finite and do not run away.
+    // The rate gyrocompass runs at every block of 40 still cycles; with
+    // this gyro noise a 5-minute station resolves the bias of the gyro
+    // nearest the vertical to ~3 deg/h, the budget's own prior (derivation
+    // section 4e): the sigmas stay finite and do not run away.
     assert!(
         r.bias_std
             .iter()

@@ -24,7 +24,7 @@ use crate::kalman::{
 };
 use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
-use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, UnitQuaternion, Vector3};
 
 /// How far the computed attitude may turn from a fixed linearisation point
 /// before the point is taken again (rad;
@@ -33,6 +33,14 @@ use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 pub const MAX_LINEARIZATION_TURN_RAD: f64 = crate::conventions::DEG;
 /// cos(MAX_LINEARIZATION_TURN_RAD / 2) = 0.99996192...
 const COS_HALF_MAX_LINEARIZATION_TURN: f64 = 0.999_961_923_064_171;
+/// How far a fixed linearisation point's heading may lag the estimate's
+/// before it is turned to it, about the vertical (rad;
+/// [`FineAlignment::fix_linearization`]): 0.1 deg, far below the SCC1300's
+/// heading sigma (~7 deg) and a quiet gyro's station corrections, and far
+/// above rounding: a few turns of the covariance per station.
+pub const MAX_LINEARIZATION_HEADING_LAG_RAD: f64 = 0.1 * crate::conventions::DEG;
+/// sin^2(MAX_LINEARIZATION_HEADING_LAG_RAD / 2) = 7.6154...e-7.
+const SIN_SQ_HALF_MAX_HEADING_LAG: f64 = 7.615_433_561_505_986e-7;
 
 /// How the AR states start.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -749,21 +757,98 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// directions the tool never took (derivation section 4i: the
     /// first-estimates Jacobian of Huang, Mourikis and Roumeliotis, 2008).
     /// A first estimate is only good while the estimate stays near it: a
-    /// quiet gyro gyrocompasses a station's heading by degrees, and a model
+    /// station re-finds its heading by degrees (a quiet gyro's rate
+    /// gyrocompass, or the SCC1300's heading sigma of ~7 deg being read
+    /// from its horizontal earth rate and the tilt it drives), and a model
     /// left at the old heading (the held axis, the biases' directions) then
-    /// drove it away (100 deg in one simulated station). So the attitude is
-    /// taken again once the estimate has turned more than
-    /// [`MAX_LINEARIZATION_TURN_RAD`] from it.
+    /// drove it away (100 deg in one simulated station) or, re-taken at
+    /// each degree, saw the tool-axis accelerometer bias from new
+    /// directions again. The heading is not what the first estimate is
+    /// for: the point's heading follows the estimate's (about the vertical,
+    /// once it lags by more than [`MAX_LINEARIZATION_HEADING_LAG_RAD`]),
+    /// and the navigation-frame attitude and velocity errors' covariance is
+    /// turned with it ([`follow_heading`](Self::follow_heading), derivation
+    /// section 4e), while its tilt and roll stay the first estimate's. The
+    /// point is taken again only once the estimate has turned more than
+    /// [`MAX_LINEARIZATION_TURN_RAD`] from it otherwise (a re-levelling).
     pub fn fix_linearization(&mut self, fixed: bool) {
         let current = self.strapdown.state().attitude;
         self.linearization_attitude = match self.linearization_attitude {
             _ if !fixed => None,
-            // |q1 . q2| = cos(angle / 2): no trigonometry per step
-            Some(at) if at.coords.dot(&current.coords).abs() >= COS_HALF_MAX_LINEARIZATION_TURN => {
-                Some(at)
+            None => Some(current),
+            Some(at) => {
+                let at = self.follow_heading(at, &current);
+                // |q1 . q2| = cos(angle / 2): no trigonometry per step
+                if at.coords.dot(&current.coords).abs() >= COS_HALF_MAX_LINEARIZATION_TURN {
+                    Some(at)
+                } else {
+                    Some(current)
+                }
             }
-            _ => Some(current),
         };
+    }
+
+    /// The fixed point `at` turned about the navigation frame's vertical
+    /// to the heading of `current`, once it lags by more than
+    /// [`MAX_LINEARIZATION_HEADING_LAG_RAD`], with the covariance of the
+    /// navigation-frame errors (attitude and velocity) turned by the same
+    /// rotation R_z: P <- T P T^T, T = R_z on those two blocks and 1 on the
+    /// rest (the body-frame biases and AR states, and the position, whose
+    /// past does not turn with a new heading). So the model's C_b^n and the
+    /// covariance the filter holds in navigation axes stay in one frame: a
+    /// still tool's errors are then the same statement about the body
+    /// whatever heading the estimate has found, and the zero-velocity
+    /// updates do not see a bias from a direction the tool never took
+    /// (derivation section 4e). The rotation is the twist about the
+    /// vertical of current at^-1 (swing-twist: (w, 0, 0, k) normalised; no
+    /// trigonometry).
+    fn follow_heading(
+        &mut self,
+        at: UnitQuaternion<f64>,
+        current: &UnitQuaternion<f64>,
+    ) -> UnitQuaternion<f64> {
+        let turn = current * at.inverse();
+        let (w, k) = (turn.w, turn.k);
+        let twist_sq = w * w + k * k;
+        // sin^2(twist / 2) = k^2 / (w^2 + k^2); also a turn of 180 deg
+        // about a horizontal axis (twist_sq = 0, k = 0) stays here
+        if k * k <= SIN_SQ_HALF_MAX_HEADING_LAG * twist_sq {
+            return at;
+        }
+        let norm = libm::sqrt(twist_sq);
+        let twist = UnitQuaternion::new_unchecked(Quaternion::new(w / norm, 0.0, 0.0, k / norm));
+        let r = twist.to_rotation_matrix().into_inner().map(T::of);
+        let p = &mut self.filter.p;
+        for first in [ATT, VEL] {
+            let rows = r * p.fixed_view::<3, N>(first, 0);
+            p.fixed_view_mut::<3, N>(first, 0).copy_from(&rows);
+        }
+        for first in [ATT, VEL] {
+            let columns = p.fixed_view::<N, 3>(0, first) * r.transpose();
+            p.fixed_view_mut::<N, 3>(0, first).copy_from(&columns);
+        }
+        // exactly symmetric again (the two products round differently)
+        let half = T::of(0.5);
+        for first in [ATT, VEL] {
+            for i in first..first + 3 {
+                for j in 0..N {
+                    let v = (p[(i, j)] + p[(j, i)]) * half;
+                    p[(i, j)] = v;
+                    p[(j, i)] = v;
+                }
+            }
+        }
+        twist * at
+    }
+
+    /// The attitude the error model is linearised at: the fixed one
+    /// ([`fix_linearization`](Self::fix_linearization)) or the current
+    /// estimate. An aiding row that depends on the attitude (the station's
+    /// rate gyrocompass, `aid_sources::EarthRate`) takes it too, so that
+    /// the model's Jacobians all sit at one point (derivation section 4e).
+    pub fn linearization_attitude(&self) -> UnitQuaternion<f64> {
+        self.linearization_attitude
+            .unwrap_or(self.strapdown.state().attitude)
     }
 
     /// Whether the tool-axis rate fed to the following steps is held at the
@@ -1106,6 +1191,8 @@ mod tests {
         fa.set_roll(roll + 0.9 * MAX_LINEARIZATION_TURN_RAD);
         fa.fix_linearization(true);
         assert_eq!(fa.linearization_attitude, first);
+        assert_eq!(Some(fa.linearization_attitude()), first);
+        assert_ne!(fa.linearization_attitude(), fa.state().attitude);
         // beyond it (a heading re-found by degrees): taken again
         fa.set_roll(roll + 1.1 * MAX_LINEARIZATION_TURN_RAD);
         fa.fix_linearization(true);
@@ -1113,9 +1200,68 @@ mod tests {
         assert_eq!(fa.linearization_attitude, Some(fa.state().attitude));
         fa.fix_linearization(false);
         assert_eq!(fa.linearization_attitude, None);
+        assert_eq!(fa.linearization_attitude(), fa.state().attitude);
         extern crate std;
         let cos_half = std::primitive::f64::cos(0.5 * MAX_LINEARIZATION_TURN_RAD);
         assert!((COS_HALF_MAX_LINEARIZATION_TURN - cos_half).abs() < 1e-15);
+    }
+
+    /// A fixed point follows the estimate's heading about the vertical
+    /// (beyond `MAX_LINEARIZATION_HEADING_LAG_RAD`), keeping its own tilt
+    /// and roll, and turns the navigation-frame attitude and velocity
+    /// covariance with it: P <- T P T^T, the body-frame states untouched.
+    #[test]
+    fn a_fixed_linearization_follows_the_heading_and_turns_the_covariance() {
+        let noise = ImuNoise::scc1300();
+        let (mut fa, at_rest) = level_filter_at_rest(&noise, &[0.01, 0.01, 0.1], |_| {});
+        for _ in 0..50 {
+            fa.step(&at_rest);
+        }
+        fa.hold_tool_axis(true);
+        fa.fix_linearization(true);
+        let first = fa.linearization_attitude();
+        let set_heading = |fa: &mut FineAlignment<f64, STATES_WITH_BIASES>, heading: f64, roll: f64| {
+            let mut state = *fa.state();
+            let mut e = euler_from_quat(&state.attitude);
+            e.heading = heading;
+            e.roll = roll;
+            state.attitude = quat_from_euler(&e);
+            fa.strapdown.reset(state);
+        };
+        let e0 = euler_from_quat(&first);
+        // within the lag: nothing moves
+        let p0 = fa.filter.p;
+        set_heading(&mut fa, e0.heading + 0.9 * MAX_LINEARIZATION_HEADING_LAG_RAD, e0.roll);
+        fa.fix_linearization(true);
+        assert_eq!(fa.linearization_attitude(), first);
+        assert_eq!(fa.filter.p, p0);
+        // 3 deg of heading and 0.3 deg of roll: the heading is taken, the
+        // roll (within MAX_LINEARIZATION_TURN_RAD) is not
+        let turn = 3.0 * DEG;
+        set_heading(&mut fa, e0.heading + turn, e0.roll + 0.3 * DEG);
+        fa.fix_linearization(true);
+        let e1 = euler_from_quat(&fa.linearization_attitude());
+        assert!((e1.heading - (e0.heading + turn)).abs() < 1e-9, "{e1:?}");
+        assert!((e1.roll - e0.roll).abs() < 1e-9 && (e1.pitch - e0.pitch).abs() < 1e-9);
+        let r = dcm_from_quat(&fa.linearization_attitude()) * dcm_from_quat(&first).transpose();
+        let rz = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), turn).into_inner();
+        assert!((r - rz).abs().max() < 1e-12, "{r}");
+        let mut t = SMatrix::<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>::identity();
+        t.fixed_view_mut::<3, 3>(ATT, ATT).copy_from(&rz);
+        t.fixed_view_mut::<3, 3>(VEL, VEL).copy_from(&rz);
+        let expected = t * p0 * t.transpose();
+        let p = fa.filter.p;
+        for i in 0..STATES_WITH_BIASES {
+            for j in 0..STATES_WITH_BIASES {
+                let scale = (p0[(i, i)] * p0[(j, j)]).sqrt().max(1e-300);
+                assert!((p[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * scale, "({i}, {j})");
+                assert_eq!(p[(i, j)], p[(j, i)]);
+            }
+        }
+        // the body-frame blocks are the same numbers
+        for i in ACCEL_BIAS..STATES_WITH_BIASES {
+            assert_eq!(p[(i, i)], p0[(i, i)]);
+        }
     }
 
     /// An accelerometer bias put back at a station grows by the random

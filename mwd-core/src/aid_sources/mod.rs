@@ -14,16 +14,16 @@
 
 mod axial_speed;
 mod drilling_toolface;
+mod earth_rate;
 mod heading_reference;
 mod non_holonomic;
-mod vertical_earth_rate;
 mod zero_position;
 mod zero_velocity;
 
 pub use axial_speed::{AxialSpeed, AXIAL_SPEED_VARIANCE};
 pub use drilling_toolface::{DrillingToolface, ForceBlock, TOOLFACE_BLOCK_SAMPLES};
+pub use earth_rate::{attitude_rows, long_run_variance, predicted_rates, EarthRate};
 pub use heading_reference::{HeadingReference, HeadingReferenceError};
 pub use non_holonomic::{BhaCrossMotion, NonHolonomic, CROSS_AXES, DRILLING_VARIANCE};
-pub use vertical_earth_rate::VerticalEarthRate;
 pub use zero_position::ZeroPosition;
 pub use zero_velocity::ZeroVelocity;

@@ -18,7 +18,11 @@
 //!    at rest (the string in the slips at a connection), each cycle gets a
 //!    zero-velocity update (the filter re-levels through it: the velocity
 //!    error is driven by the tilt error times g, derivation section 3),
-//!    and when motion resumes (or after [`MAX_STATION_SAMPLES`]) the
+//!    every block of [`SURVEY_SETTLE_EPOCHS`] still cycles gets a rate
+//!    gyrocompass (the x and z gyros' block means against the earth rate
+//!    at the filter's attitude: heading, tilt and both rate biases,
+//!    `aid_sources::EarthRate`, derivation section 4e), and when motion
+//!    resumes (or after [`MAX_STATION_SAMPLES`]) the
 //!    navigator hands out a station survey ([`Navigator::take_station`]):
 //!    inclination, azimuth and toolface of the last still cycle with their
 //!    covariance (`super::station`). No zero-position update: the probe's
@@ -46,7 +50,7 @@ use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::{Hysteresis, StillDetector};
 use super::tie_in::{TieIn, TieInTilt};
 use crate::aid_sources::{
-    AxialSpeed, DrillingToolface, ForceBlock, NonHolonomic, VerticalEarthRate,
+    long_run_variance, AxialSpeed, DrillingToolface, EarthRate, ForceBlock, NonHolonomic,
     AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
 };
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
@@ -188,8 +192,8 @@ pub const SURVEY_SETTLE_EPOCHS: u32 = 40;
 pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 
 /// The fewest still cycles with both gyros in a block of
-/// [`SURVEY_SETTLE_EPOCHS`] whose mean makes a vertical-earth-rate bias
-/// update (`aid_sources::VerticalEarthRate`): three quarters of the block.
+/// [`SURVEY_SETTLE_EPOCHS`] whose means make a rate-gyrocompass update
+/// (`aid_sources::EarthRate`): three quarters of the block.
 pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 
 /// The filter's settings for a still probe at `position` whose coarse
@@ -229,12 +233,11 @@ struct Station {
     /// cycles, and the one before it: what the station sends.
     checkpoint: Option<StationSurvey>,
     settled: Option<StationSurvey>,
-    /// Sums over the still cycles for the vertical-earth-rate update: the
-    /// residual m and d_x, d_z (`aid_sources::VerticalEarthRate`).
-    vertical_sum: f64,
-    down_sum: [f64; 2],
+    /// Sums of the x and z gyros' readings over the block's still cycles
+    /// for the rate gyrocompass (`aid_sources::EarthRate`).
+    gyro_sum: [f64; 2],
     /// Still cycles in those sums.
-    vertical_epochs: u32,
+    gyro_epochs: u32,
 }
 
 /// The probe's navigation, one raw sample at a time.
@@ -284,8 +287,9 @@ pub struct Navigator {
     station_zupt_variance: f64,
     /// A finished station, until taken.
     finished_station: Option<StationSurvey>,
-    /// This still cycle's vertical-earth-rate residual and d_x, d_z.
-    vertical_residual: Option<(f64, [f64; 2])>,
+    /// This still cycle's x and z gyro readings, for the rate gyrocompass
+    /// (a zero-velocity cycle with both parts).
+    still_gyro: Option<[f64; 2]>,
     /// The roll was held for drilling since the last still cycle.
     drilled_since_station: bool,
     /// The last navigation cycle was still (its roll held).
@@ -367,7 +371,7 @@ impl Navigator {
             max_station_samples: MAX_STATION_SAMPLES,
             station_zupt_variance: STATION_ZUPT_VARIANCE,
             finished_station: None,
-            vertical_residual: None,
+            still_gyro: None,
             drilled_since_station: false,
             was_still: false,
             drilling_cycles: 0,
@@ -478,9 +482,8 @@ impl Navigator {
                 epochs: 0,
                 quality_sum: 0.0,
                 survey: StationSurvey::default(),
-                vertical_sum: 0.0,
-                down_sum: [0.0; 2],
-                vertical_epochs: 0,
+                gyro_sum: [0.0; 2],
+                gyro_epochs: 0,
                 checkpoint: None,
                 settled: None,
             });
@@ -490,20 +493,19 @@ impl Navigator {
         };
         station.epochs += 1;
         station.quality_sum += quality;
-        if let Some((m, d)) = self.vertical_residual {
-            station.vertical_sum += m;
-            station.down_sum[0] += d[0];
-            station.down_sum[1] += d[1];
-            station.vertical_epochs += 1;
+        if let Some(g) = self.still_gyro {
+            station.gyro_sum[0] += g[0];
+            station.gyro_sum[1] += g[1];
+            station.gyro_epochs += 1;
         }
         let block_done = station.epochs % SURVEY_SETTLE_EPOCHS == 0;
         if block_done {
-            // Each block's mean is one vertical-earth-rate update, before
+            // Each block's means are one rate-gyrocompass update, before
             // the block's survey is taken, so a station's survey holds the
-            // rate biases (and through them the heading drift of the
-            // drilling before it) from all its still cycles but the last
-            // block's.
-            self.update_rate_biases();
+            // heading and the rate biases (and through them the heading
+            // drift of the drilling before it) from all its still cycles
+            // but the last block's.
+            self.gyrocompass_block();
         }
         let survey = self.station_survey();
         let number = self.stations;
@@ -538,42 +540,43 @@ impl Navigator {
         }
     }
 
-    /// The vertical-earth-rate update of the x and z rate biases from the
-    /// still cycles summed since the last one (`aid_sources::VerticalEarthRate`),
-    /// which it clears: one update per block of [`SURVEY_SETTLE_EPOCHS`]
-    /// still cycles. The block means' gyro noise is independent from block
-    /// to block (the AR models' correlation is a few samples long); their
-    /// attitude terms are not, but at Omega sigma_tilt (< 0.1 deg/h) they
-    /// are far below the block's noise (~38 deg/h for 2 s of SCC1300).
-    fn update_rate_biases(&mut self) {
+    /// The rate gyrocompass (`aid_sources::EarthRate`, derivation section
+    /// 4e) from the still cycles' gyro sums since the last one, which it
+    /// clears: one update per block of [`SURVEY_SETTLE_EPOCHS`] still
+    /// cycles, in the block's last still cycle (after its step and
+    /// zero-velocity update, before its survey checkpoint). The residual
+    /// is the block means less the earth rate at the attitude of now (the
+    /// tool is still: its true rate is the same in every cycle, so the
+    /// means' error is the filter's attitude error of now, not a mix of
+    /// the block's estimates, which the zero-velocity updates moved); the
+    /// attitude rows are taken at the error model's linearisation point
+    /// (fixed from the station's second block on, derivation section 4i).
+    /// R is the gyros' noise only: the attitude error is a state of the
+    /// row. The blocks' gyro noise is independent from block to block (the
+    /// AR models' memory is a few samples).
+    fn gyrocompass_block(&mut self) {
         let Some(station) = self.station.as_mut() else {
             return;
         };
-        let n = station.vertical_epochs;
-        let (sum, down_sum) = (station.vertical_sum, station.down_sum);
-        station.vertical_sum = 0.0;
-        station.down_sum = [0.0; 2];
-        station.vertical_epochs = 0;
+        let n = station.gyro_epochs;
+        let sum = station.gyro_sum;
+        station.gyro_sum = [0.0; 2];
+        station.gyro_epochs = 0;
         if n < MIN_BIAS_UPDATE_SAMPLES || self.covariance_invalid {
             return;
         }
-        let d = down_sum.map(|v| v / f64::from(n));
-        let tilt = self.filter.euler_std();
-        let cos_inclination = dcm_from_quat(&self.filter.state().attitude)[(2, 1)];
-        let variance = VerticalEarthRate::<f32>::variance(
-            d,
-            GYRO_AXES.map(|axis| gyro_long_run_variance(self.noise, axis)),
+        let mean = sum.map(|v| v / f64::from(n));
+        let state = self.filter.state();
+        let omega = earth_rate_n(state.position.lat);
+        let measurement = EarthRate::from_block(
+            mean,
             n,
-            tilt.x.max(tilt.y),
-            cos_inclination,
-            tilt.z.min(core::f64::consts::PI),
+            &dcm_from_quat(&state.attitude),
+            &dcm_from_quat(&self.filter.linearization_attitude()),
+            &omega,
+            GYRO_AXES.map(|axis| long_run_variance(&self.noise.gyro[axis], SAMPLE_INTERVAL_S)),
         );
-        let measurement = VerticalEarthRate {
-            vertical_residual: (sum / f64::from(n)) as f32,
-            down_in_gyro_plane: d.map(|v| v as f32),
-            variance: variance as f32,
-        };
-        self.filter.aid(&measurement);
+        self.filter.aid(&measurement.cast::<f32>());
     }
 
     /// The station survey at this cycle: the filter's attitude as drilling
@@ -831,8 +834,7 @@ impl Navigator {
                 if still && !self.drilled_since_station {
                     self.rest_accel_bias = filter.accel_bias();
                 }
-                self.vertical_residual = (update && missing_gyro.is_none())
-                    .then(|| vertical_residual(filter.state(), &sample));
+                self.still_gyro = (update && missing_gyro.is_none()).then_some(sample.gyro);
                 self.held = Some(imu);
                 if still {
                     self.flags |= nav_flags::STILL;
@@ -1209,20 +1211,6 @@ fn add_tool_axis_variance(filter: &mut Filter, variance: f64) {
     filter.add_attitude_noise(&(t * t.transpose() * variance));
 }
 
-/// One still cycle's vertical-earth-rate residual m = d_x (g_x - w_x) +
-/// d_z (g_z - w_z) and (d_x, d_z), d = C_n^b e_D, w = C_n^b omega_ie^n
-/// (`aid_sources::VerticalEarthRate`).
-fn vertical_residual(state: &NavState, sample: &ProbeSample) -> (f64, [f64; 2]) {
-    let c_nb = dcm_from_quat(&state.attitude).transpose();
-    let down = c_nb.column(2).into_owned();
-    let w = c_nb * earth_rate_n(state.position.lat);
-    let d = GYRO_AXES.map(|a| down[a]);
-    let m = (0..2)
-        .map(|k| d[k] * (sample.gyro[k] - w[GYRO_AXES[k]]))
-        .sum();
-    (m, d)
-}
-
 /// The accelerometer roll of `sample` less the solution's roll (rad,
 /// wrapped; 0 where the roll is not defined: tool near vertical).
 fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
@@ -1232,25 +1220,6 @@ fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
     }
     let roll = euler_from_quat(&state.attitude).roll;
     crate::conventions::wrap_pi(levelling.roll - roll)
-}
-
-/// A gyro's long-run variance per sample, (rad/s)^2: white density^2 /
-/// dt, its AR model's zero-frequency share sigma_e^2 / (1 + sum a_i)^2 and
-/// the bias instability's 2 sigma^2 tau / dt (the variance of an n-sample
-/// mean is this over n for large n). The instability is in: navigating,
-/// the filter's rate-bias states are the constant part only
-/// (`fine_alignment::BiasWalk::InstabilityAsRateNoise`), and a station's
-/// means hold its value of the moment.
-fn gyro_long_run_variance(budget: &ImuNoise, axis: usize) -> f64 {
-    let noise = budget.gyro[axis];
-    let white = square(noise.white_density) / SAMPLE_INTERVAL_S;
-    let coloured = noise.coloured.map_or(0.0, |ar| {
-        let gain = 1.0 + ar.coefficients.iter().sum::<f64>();
-        ar.noise_variance / square(gain)
-    });
-    let instability =
-        2.0 * square(noise.bias_instability) * noise.correlation_time / SAMPLE_INTERVAL_S;
-    white + coloured + instability
 }
 
 #[cfg(test)]
