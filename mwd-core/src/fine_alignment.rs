@@ -1220,18 +1220,23 @@ mod tests {
         fa.hold_tool_axis(true);
         fa.fix_linearization(true);
         let first = fa.linearization_attitude();
-        let set_heading = |fa: &mut FineAlignment<f64, STATES_WITH_BIASES>, heading: f64, roll: f64| {
-            let mut state = *fa.state();
-            let mut e = euler_from_quat(&state.attitude);
-            e.heading = heading;
-            e.roll = roll;
-            state.attitude = quat_from_euler(&e);
-            fa.strapdown.reset(state);
-        };
+        let set_heading =
+            |fa: &mut FineAlignment<f64, STATES_WITH_BIASES>, heading: f64, roll: f64| {
+                let mut state = *fa.state();
+                let mut e = euler_from_quat(&state.attitude);
+                e.heading = heading;
+                e.roll = roll;
+                state.attitude = quat_from_euler(&e);
+                fa.strapdown.reset(state);
+            };
         let e0 = euler_from_quat(&first);
         // within the lag: nothing moves
         let p0 = fa.filter.p;
-        set_heading(&mut fa, e0.heading + 0.9 * MAX_LINEARIZATION_HEADING_LAG_RAD, e0.roll);
+        set_heading(
+            &mut fa,
+            e0.heading + 0.9 * MAX_LINEARIZATION_HEADING_LAG_RAD,
+            e0.roll,
+        );
         fa.fix_linearization(true);
         assert_eq!(fa.linearization_attitude(), first);
         assert_eq!(fa.filter.p, p0);
@@ -1254,7 +1259,10 @@ mod tests {
         for i in 0..STATES_WITH_BIASES {
             for j in 0..STATES_WITH_BIASES {
                 let scale = (p0[(i, i)] * p0[(j, j)]).sqrt().max(1e-300);
-                assert!((p[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * scale, "({i}, {j})");
+                assert!(
+                    (p[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * scale,
+                    "({i}, {j})"
+                );
                 assert_eq!(p[(i, j)], p[(j, i)]);
             }
         }
