@@ -217,9 +217,8 @@ impl DashboardState {
                     self.stations_dropped += 1;
                 }
                 self.stations.push_back(*station);
-                let before = self.azimuth_track.before(station.start_sample);
-                self.stations_azi_before.push_back(before);
-                self.azimuth_track.forget_before(station.end_sample);
+                let start = self.azimuth_track.station_start(station);
+                self.stations_azi_before.push_back(start);
                 let list: Vec<StationSurvey> = self.stations.iter().copied().collect();
                 let before: Vec<Option<f64>> = self.stations_azi_before.iter().copied().collect();
                 self.stations_view =

@@ -309,7 +309,9 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     navigator.set_noise_budget(config.grade.budget_ref());
     let mut tied = false;
     let mut stations = Vec::new();
+    // each station's azimuth sigma at its start, for the survey's chain
     let mut track = AzimuthSigmaTrack::default();
+    let mut azi_before = Vec::new();
     let mut samples = 0;
     let sim = DrillingSimulator::new(&drilling, model.clone(), SAMPLE_INTERVAL_S);
     // the last sample's true means and whether the run ends still
@@ -337,6 +339,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
             continue;
         }
         if let Some(station) = navigator.take_station() {
+            azi_before.push(track.station_start(&station));
             stations.push(station);
         }
     }
@@ -360,6 +363,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
             )?);
             samples += 1;
             if let Some(station) = navigator.take_station() {
+                azi_before.push(track.station_start(&station));
                 stations.push(station);
                 break;
             }
@@ -396,10 +400,6 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         north: tie_on.nev().x,
         east: tie_on.nev().y,
     };
-    let azi_before: Vec<_> = stations
-        .iter()
-        .map(|s| track.before(s.start_sample))
-        .collect();
     let survey = drilling::survey(
         &stations,
         &azi_before,

@@ -96,9 +96,18 @@ impl AzimuthSigmaTrack {
         self.points.push((s.sample_counter, s.attitude_std[2]));
     }
 
-    /// Forgets the solutions before `sample` (a live display keeps only
-    /// what a station still to come can start from).
-    pub fn forget_before(&mut self, sample: u32) {
+    /// A station just taken from the stream: its start's sigma
+    /// ([`before`](Self::before) its `start_sample`), and the solutions
+    /// before its end forgotten, so that a live stream or a long run keeps
+    /// only what a station still to come can start from.
+    pub fn station_start(&mut self, station: &StationSurvey) -> Option<f64> {
+        let start = self.before(station.start_sample);
+        self.forget_before(station.end_sample);
+        start
+    }
+
+    /// Forgets the solutions before `sample`.
+    fn forget_before(&mut self, sample: u32) {
         let k = self.points.partition_point(|&(c, _)| c < sample);
         self.points.drain(..k);
     }
@@ -452,13 +461,18 @@ mod tests {
     }
 
     #[test]
-    fn forgetting_keeps_what_a_later_station_can_start_from() {
+    fn a_taken_station_keeps_only_what_a_later_station_can_start_from() {
         let mut track: AzimuthSigmaTrack = (0..50)
             .map(|k| solution(k, 0.5))
             .collect::<Vec<_>>()
             .iter()
             .collect();
-        track.forget_before(40);
+        let station = StationSurvey {
+            start_sample: 30,
+            end_sample: 40,
+            ..StationSurvey::default()
+        };
+        assert_eq!(track.station_start(&station), Some(0.5));
         assert_eq!(track.points.len(), 10);
         assert_eq!(track.before(45), Some(0.5));
         assert_eq!(track.before(40), None);
