@@ -8,7 +8,7 @@ mod common;
 use common::{run, s, scratch};
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::depth_log::DepthLog;
-use host_sim::survey_listing::drilling::{depth_terms, survey};
+use host_sim::survey_listing::drilling::{survey, survey_terms};
 use host_sim::survey_listing::drilling_text::listing;
 use host_sim::survey_listing::TieOnInput;
 use mwd_core::protocol::frame::station_flags;
@@ -70,12 +70,12 @@ const TIE: TieOnInput = TieOnInput {
 };
 
 #[test]
-fn synthetic_stations_are_positioned_with_the_random_walk_and_depth_uncertainty() {
+fn synthetic_stations_are_positioned_with_the_random_walk_depth_and_method_uncertainty() {
     let sig = [0.1, 0.2, 0.3, 0.4];
     let stations: Vec<StationSurvey> = (0..4)
         .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, sig[k]))
         .collect();
-    let terms = depth_terms().unwrap();
+    let terms = survey_terms().unwrap();
     let out = survey(&stations, &[], &log(), TIE, &terms, &site()).unwrap();
     assert_eq!(out.rows.len(), 4);
     for (k, r) in out.rows.iter().enumerate() {
@@ -95,6 +95,12 @@ fn synthetic_stations_are_positioned_with_the_random_walk_and_depth_uncertainty(
             var_n += h[j] * h[k] * s2[j].min(s2[k]);
         }
     }
+    // the method's long-course-length terms (XCLA across the hole, XCLH
+    // vertical, random per leg): the legs do not turn, so each weighs the
+    // tortuosity floor, 0.167 L (1 deg / 100 ft) L, on the three 10 m legs
+    let xcl_leg = 0.167 * 10.0 * (1.0f64.to_radians() / 30.48) * 10.0;
+    let var_xcl = 3.0 * xcl_leg * xcl_leg;
+    var_n += var_xcl;
     let c = out.rows[3].row.cov.unwrap();
     // (the frame's sigmas are f32: 1e-7 relative)
     assert!((c[0] - var_n).abs() < 1e-6 * var_n, "{} vs {var_n}", c[0]);
@@ -110,7 +116,7 @@ fn synthetic_stations_are_positioned_with_the_random_walk_and_depth_uncertainty(
         (560e-6 * 30.0f64).powi(2) + (2.5e-7 * 30.0 * 2000.0f64).powi(2) + shortening.powi(2);
     assert!((c[1] - var_e).abs() < 1e-6 * var_e, "{} vs {var_e}", c[1]);
     // vertical: the inclination, random per station
-    let var_v = 0.05f64.to_radians().powi(2) * h.iter().map(|x| x * x).sum::<f64>();
+    let var_v = 0.05f64.to_radians().powi(2) * h.iter().map(|x| x * x).sum::<f64>() + var_xcl;
     assert!((c[2] - var_v).abs() < 1e-6 * var_v);
 }
 
@@ -121,7 +127,7 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
         .collect();
     stations[2].flags |= station_flags::AZIMUTH_UNDETERMINED;
     stations[2].angles_std[1] = f32::INFINITY;
-    let terms = depth_terms().unwrap();
+    let terms = survey_terms().unwrap();
     let out = survey(&stations, &[], &log(), TIE, &terms, &site()).unwrap();
     let determined: Vec<bool> = out.rows.iter().map(|r| r.position_determined).collect();
     assert_eq!(determined, [true, true, false, false]);
@@ -140,7 +146,7 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
 
 #[test]
 fn a_station_outside_the_log_or_a_log_that_is_not_one_is_refused() {
-    let terms = depth_terms().unwrap();
+    let terms = survey_terms().unwrap();
     let late = [station(1, 100.0, 0.1), station(2, 500.0, 0.1)];
     let err = survey(&late, &[], &log(), TIE, &terms, &site()).unwrap_err();
     assert!(

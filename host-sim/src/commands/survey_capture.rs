@@ -91,7 +91,7 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         latitude: resolved.latitude,
         gyro_noise_reduction: 1.0,
     };
-    let terms = drilling::depth_terms()?;
+    let terms = drilling::survey_terms()?;
     let track: AzimuthSigmaTrack = capture
         .frames
         .iter()

@@ -29,7 +29,7 @@ impl SurveySetup {
     pub fn new(depth: Option<DepthLog>, latitude_deg: f64) -> anyhow::Result<Self> {
         Ok(Self {
             depth,
-            terms: drilling::depth_terms()?,
+            terms: drilling::survey_terms()?,
             site: Site {
                 gravity: 9.806_65,
                 b_total: 0.0,

@@ -59,7 +59,7 @@ impl RunConfig {
     /// stretch drawn from the probe tool model's DSFS and DSTG, the survey
     /// with those depth terms at the plan's latitude.
     pub fn new(plan: BuiltPlan, tie_in_azimuth_sigma: f64, grade: Grade) -> Result<Self> {
-        let terms = drilling::depth_terms()?;
+        let terms = drilling::survey_terms()?;
         let magnitude = |w: &str| {
             terms
                 .iter()
@@ -109,6 +109,19 @@ impl PositionCheck {
     pub fn error_horizontal(&self) -> f64 {
         self.error_ne[0].hypot(self.error_ne[1])
     }
+
+    /// The error's squared Mahalanobis distance in the covariance;
+    /// `None` where the covariance is singular or not a number.
+    pub fn mahalanobis2(&self) -> Option<f64> {
+        let [nn, ee, ne] = self.cov_ne;
+        let [n, e] = self.error_ne;
+        let det = nn * ee - ne * ne;
+        // also catches NaN
+        if det.is_nan() || det <= 0.0 {
+            return None;
+        }
+        Some((ee * n * n - 2.0 * ne * n * e + nn * e * e) / det)
+    }
 }
 
 /// A station survey and the truth at its last still sample.
@@ -132,6 +145,8 @@ pub struct TdCheck {
     pub d2: f64,
     /// That covariance (m^2): north-north, east-east, north-east.
     pub cov_ne: [f64; 3],
+    /// The survey method's part of it (XCLA, XCLH), same layout.
+    pub method_cov_ne: [f64; 3],
 }
 
 impl TdCheck {
@@ -139,6 +154,25 @@ impl TdCheck {
         PositionCheck {
             error_ne: self.error_ne,
             cov_ne: self.cov_ne,
+        }
+    }
+
+    /// The TD without the survey method: the error less the method's own
+    /// (`method_error_ne`, [`RunOutcome::method_td_error_ne`]) against the
+    /// covariance less the method's terms. What the sensors and the depth
+    /// log did, against what the probe and the depth terms predict.
+    pub fn without_method(&self, method_error_ne: [f64; 2]) -> PositionCheck {
+        PositionCheck {
+            error_ne: std::array::from_fn(|j| self.error_ne[j] - method_error_ne[j]),
+            cov_ne: std::array::from_fn(|j| self.cov_ne[j] - self.method_cov_ne[j]),
+        }
+    }
+
+    /// The survey method's part alone: its own error against its terms.
+    pub fn method_only(&self, method_error_ne: [f64; 2]) -> PositionCheck {
+        PositionCheck {
+            error_ne: method_error_ne,
+            cov_ne: self.method_cov_ne,
         }
     }
 }
@@ -152,11 +186,12 @@ pub struct RunOutcome {
     /// undetermined (`td_note` says which).
     pub td: Option<TdCheck>,
     pub td_note: Option<String>,
-    /// The survey method's own TD horizontal error (m): minimum curvature
-    /// through the true MD and angles at the survey's stations against
-    /// the drilled path's TD (the path changes its curvature between
-    /// stations). No sensor is in it, and no sigma covers it.
-    pub method_td_error_m: Option<f64>,
+    /// The survey method's own TD error, north and east (m): minimum
+    /// curvature through the true MD and angles at the survey's stations
+    /// against the drilled path's TD (the path changes its curvature
+    /// between stations). No sensor is in it; the survey's XCLA and XCLH
+    /// terms are its envelope.
+    pub method_td_error_ne: Option<[f64; 2]>,
     /// Simulated samples, each one navigator epoch.
     pub samples: usize,
     /// Wall time of the run on its thread (s).
@@ -165,6 +200,13 @@ pub struct RunOutcome {
     /// ([`thread_cpu_s`]): on a shared machine the wall time is not the
     /// work.
     pub cpu_s: Option<f64>,
+}
+
+impl RunOutcome {
+    /// The survey method's own TD horizontal error (m).
+    pub fn method_td_error_m(&self) -> Option<f64> {
+        self.method_td_error_ne.map(|[n, e]| n.hypot(e))
+    }
 }
 
 /// The calling thread's CPU time so far (s): Linux's
@@ -408,7 +450,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         &config.terms,
         &config.site,
     );
-    let (td, td_note, method_td_error_m) = match survey {
+    let (td, td_note, method_td_error_ne) = match survey {
         Ok(survey) => {
             attach_positions(&mut checks, &survey, &drilling);
             let (td, note) = td_check(&survey, &drilling, end_md);
@@ -422,17 +464,17 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
         stations: checks,
         td,
         td_note,
-        method_td_error_m,
+        method_td_error_ne,
         samples,
         elapsed_s: started.elapsed().as_secs_f64(),
         cpu_s: cpu_start.zip(thread_cpu_s()).map(|(a, b)| b - a),
     })
 }
 
-/// The horizontal distance between the drilled path's position at the
-/// survey's last station and minimum curvature through the true MD and
-/// angles at its stations from the true tie-on position.
-fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<f64> {
+/// Minimum curvature through the true MD and angles at the survey's
+/// stations from the true tie-on position, less the drilled path's
+/// position at its last station: north and east (m).
+fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<[f64; 2]> {
     let truths: Vec<_> = survey
         .rows
         .iter()
@@ -460,12 +502,18 @@ fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<f64> 
     };
     let (rows, _) = compute(&file, AzimuthReference::True, tie, None).ok()?;
     let end = rows.last()?;
-    Some((end.north_m - last.point.nev.x).hypot(end.east_m - last.point.nev.y))
+    Some([end.north_m - last.point.nev.x, end.east_m - last.point.nev.y])
 }
 
 /// The NE covariance of a survey row, if its position is determined.
 fn cov_ne(row: &drilling::DrillingRow) -> Option<[f64; 3]> {
     let c = row.row.cov.filter(|_| row.position_determined)?;
+    Some([c[0], c[1], c[3]])
+}
+
+/// The survey method's part of [`cov_ne`].
+fn method_cov_ne(row: &drilling::DrillingRow) -> Option<[f64; 3]> {
+    let c = row.method_cov.filter(|_| row.position_determined)?;
     Some([c[0], c[1], c[3]])
 }
 
@@ -511,22 +559,22 @@ fn td_check(
     let Some(c) = cov_ne(last) else {
         return (None, Some("TD position undetermined".into()));
     };
-    let e = [
-        last.row.north_m - truth.point.nev.x,
-        last.row.east_m - truth.point.nev.y,
-    ];
-    let [nn, ee, ne] = c;
-    let det = nn * ee - ne * ne;
-    // also catches NaN
-    if det.is_nan() || det <= 0.0 {
+    let position = PositionCheck {
+        error_ne: [
+            last.row.north_m - truth.point.nev.x,
+            last.row.east_m - truth.point.nev.y,
+        ],
+        cov_ne: c,
+    };
+    let Some(d2) = position.mahalanobis2() else {
         return (None, Some("TD covariance singular".into()));
-    }
-    let d2 = (ee * e[0] * e[0] - 2.0 * ne * e[0] * e[1] + nn * e[1] * e[1]) / det;
+    };
     (
         Some(TdCheck {
-            error_ne: e,
+            error_ne: position.error_ne,
             d2,
             cov_ne: c,
+            method_cov_ne: method_cov_ne(last).unwrap_or([0.0; 3]),
         }),
         None,
     )

@@ -34,9 +34,11 @@ pub struct CovariancePrediction {
     pub along_md: Vec<(f64, Option<f64>, Option<f64>)>,
     /// The survey method's own TD horizontal error on this well (m):
     /// minimum curvature through the true angles at the stations against
-    /// the drilled path ([`RunOutcome::method_td_error_m`]). The predicted
-    /// sigma has no term for it (docs/lateral-study.md).
+    /// the drilled path ([`RunOutcome::method_td_error_m`]); the XCLA and
+    /// XCLH terms' predicted 1-sigma, and the TD 1-sigma without them.
     pub method_td_error_m: Option<f64>,
+    pub td_method_1_sigma_m: Option<f64>,
+    pub td_without_method_1_sigma_m: Option<f64>,
     /// Why there is no TD figure, if there is none.
     pub td_note: Option<String>,
     pub cpu_s: Option<f64>,
@@ -77,7 +79,11 @@ impl CovariancePrediction {
             rms_station_inclination_sigma_deg: rms(&inc),
             azimuth_undetermined_stations: undetermined,
             along_md,
-            method_td_error_m: o.method_td_error_m,
+            method_td_error_m: o.method_td_error_m(),
+            td_method_1_sigma_m: o.td.map(|t| t.method_only([0.0; 2]).sigma_horizontal()),
+            td_without_method_1_sigma_m: o
+                .td
+                .map(|t| t.without_method([0.0; 2]).sigma_horizontal()),
             td_note: o.td_note.clone(),
             cpu_s: o.cpu_s,
             wall_s: o.elapsed_s,
@@ -97,6 +103,9 @@ pub struct Agreement {
     pub td_ratio: Option<f64>,
     /// RMS predicted station azimuth sigma / RMS station azimuth error.
     pub azimuth_ratio: Option<f64>,
+    /// The same as `td_ratio` without the survey method on either side
+    /// ([`TdSummary::without_method`](super::lateral_summary::TdSummary)).
+    pub td_without_method_ratio: Option<f64>,
     pub within_10_percent: Option<bool>,
 }
 
@@ -110,11 +119,16 @@ pub fn agreement(c: &CovariancePrediction, m: &GradeWellSummary) -> Agreement {
     };
     let td_ratio = ratio(c.td_horizontal_1_sigma_m, m.td.rms_horizontal_error_m);
     let azimuth_ratio = ratio(c.rms_station_azimuth_sigma_deg, m.rms_station_azimuth_deg);
+    let td_without_method_ratio = ratio(
+        c.td_without_method_1_sigma_m,
+        m.td.without_method.rms_horizontal_error_m,
+    );
     Agreement {
         grade: c.grade.clone(),
         well: c.well.clone(),
         td_ratio,
         azimuth_ratio,
+        td_without_method_ratio,
         within_10_percent: td_ratio.map(|r| (r - 1.0).abs() <= AGREEMENT_TOLERANCE),
     }
 }

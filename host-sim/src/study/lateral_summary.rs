@@ -38,6 +38,24 @@ pub struct TdSummary {
     /// lateral (MD from the tie-on to TD).
     pub semi_major_1_sigma_m: Option<f64>,
     pub semi_major_1_sigma_per_1000_m: Option<f64>,
+    /// Without the survey method ([`TdCheck::without_method`]): each TD
+    /// error less minimum curvature's own through the true angles, against
+    /// the covariance less the XCLA/XCLH terms. The method's error is the
+    /// same in every run of one plan, so a Monte Carlo cannot check its
+    /// terms; this checks the rest.
+    pub without_method: MethodSplit,
+    /// The method's own TD error (RMS over runs, m) and its terms'
+    /// predicted 1-sigma (RMS of sqrt(trace)).
+    pub method_rms_error_m: Option<f64>,
+    pub method_predicted_1_sigma_m: Option<f64>,
+}
+
+/// The TD statistics of the sensors' part alone ([`TdSummary`]).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct MethodSplit {
+    pub rms_horizontal_error_m: Option<f64>,
+    pub predicted_1_sigma_m: Option<f64>,
+    pub inside_95_ellipse: Fraction,
 }
 
 /// Whether the requirement is met; `None`: undetermined (no cases).
@@ -176,6 +194,9 @@ pub fn summarise(
     let (mut azi_inside, mut inc_inside) = (0, 0);
     let (mut td_err, mut td_sigma, mut td_major) = (Vec::new(), Vec::new(), Vec::new());
     let mut td_inside = 0;
+    // the split: (errors, sigmas, inside) without the method; the method's
+    let (mut sensor_err, mut sensor_sigma, mut sensor_inside) = (Vec::new(), Vec::new(), 0);
+    let (mut method_err, mut method_sigma) = (Vec::new(), Vec::new());
     let k2 = scale_2d(0.95).powi(2);
     let mut unchecked: BTreeMap<String, usize> = BTreeMap::new();
     let mut by_station: BTreeMap<u16, Tally> = BTreeMap::new();
@@ -227,6 +248,15 @@ pub fn summarise(
                 td_sigma.push(p.sigma_horizontal());
                 td_major.push(p.semi_major());
                 td_inside += usize::from(t.d2 <= k2);
+                if let Some(m) = o.method_td_error_ne {
+                    let rest = t.without_method(m);
+                    sensor_err.push(rest.error_horizontal());
+                    sensor_sigma.push(rest.sigma_horizontal());
+                    sensor_inside += usize::from(rest.mahalanobis2().is_some_and(|d| d <= k2));
+                    let own = t.method_only(m);
+                    method_err.push(own.error_horizontal());
+                    method_sigma.push(own.sigma_horizontal());
+                }
             }
             (None, note) => {
                 let reason = note.clone().unwrap_or_else(|| "unknown".into());
@@ -256,6 +286,13 @@ pub fn summarise(
         inside_95_ellipse: Fraction::of(td_inside, td_err.len()),
         semi_major_1_sigma_m: major,
         semi_major_1_sigma_per_1000_m: per_1000(major),
+        without_method: MethodSplit {
+            rms_horizontal_error_m: rms(&sensor_err),
+            predicted_1_sigma_m: rms(&sensor_sigma),
+            inside_95_ellipse: Fraction::of(sensor_inside, sensor_err.len()),
+        },
+        method_rms_error_m: rms(&method_err),
+        method_predicted_1_sigma_m: rms(&method_sigma),
     };
     s.td_unchecked = unchecked.into_iter().collect();
     s.along_md = by_station.iter().map(|(n, t)| t.along(*n)).collect();
@@ -334,9 +371,10 @@ mod tests {
                 error_ne,
                 d2,
                 cov_ne: [4.0, 1.0, 0.0],
+                method_cov_ne: [0.0; 3],
             }),
             td_note: None,
-            method_td_error_m: None,
+            method_td_error_ne: None,
             samples: 1000,
             elapsed_s: 0.5,
             cpu_s: Some(0.25),
@@ -382,6 +420,34 @@ mod tests {
         // leaves the position requirement unmet whatever the figures
         assert_eq!(s.requirement.attitude_met, Some(false));
         assert_eq!(s.requirement.position_met, Some(false));
+    }
+
+    #[test]
+    fn the_method_split_takes_the_methods_error_and_terms_out() {
+        let mut o = outcome(1, [3.0, 4.0], 1.0);
+        // the method's own error 3 m north, its terms 1 m^2 north
+        o.method_td_error_ne = Some([3.0, 0.0]);
+        if let Some(t) = o.td.as_mut() {
+            t.method_cov_ne = [1.0, 0.0, 0.0];
+        }
+        let mut p = outcome(2, [0.0, 0.5], 0.1);
+        p.method_td_error_ne = Some([0.0, 0.0]);
+        let s = summarise("g", "w", 100.0, &[(1, Ok(o)), (2, Ok(p))]);
+        let w = &s.td.without_method;
+        // run 1: 4 m east against 1 m^2 east: d2 = 16, outside; run 2:
+        // 0.5 m against 1 m^2 (its covariance whole): inside
+        assert!((w.rms_horizontal_error_m.unwrap() - (16.25f64 / 2.0).sqrt()).abs() < 1e-12);
+        assert!((w.predicted_1_sigma_m.unwrap() - ((4.0f64 + 5.0) / 2.0).sqrt()).abs() < 1e-12);
+        assert_eq!((w.inside_95_ellipse.inside, w.inside_95_ellipse.total), (1, 2));
+        assert!((s.td.method_rms_error_m.unwrap() - (9.0f64 / 2.0).sqrt()).abs() < 1e-12);
+        assert!((s.td.method_predicted_1_sigma_m.unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
+        // a run without the method's figure is left out of the split only
+        let mut q = outcome(3, [0.0, 0.5], 0.1);
+        q.method_td_error_ne = None;
+        let s = summarise("g", "w", 100.0, &[(3, Ok(q))]);
+        assert_eq!(s.td.runs_checked, 1);
+        assert_eq!(s.td.without_method.inside_95_ellipse.total, 0);
+        assert_eq!(s.td.without_method.rms_horizontal_error_m, None);
     }
 
     #[test]

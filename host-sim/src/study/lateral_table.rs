@@ -98,6 +98,52 @@ fn td_row(s: &GradeWellSummary) -> Vec<String> {
     ]
 }
 
+/// The TD split into the survey method's own error and the rest (the
+/// sensors' and the depth log's), each against its part of the covariance.
+fn method_split_table(study: &LateralStudy) -> String {
+    let mut out = String::from(
+        "\nTD without the survey method (error less minimum curvature's own through the true angles; covariance less XCLA/XCLH)\n",
+    );
+    let rows: Vec<Vec<String>> = study
+        .summaries
+        .iter()
+        .map(|s| {
+            let t = &s.td;
+            let w = &t.without_method;
+            let ratio = study
+                .agreement
+                .iter()
+                .find(|a| a.grade == s.grade && a.well == s.well)
+                .and_then(|a| a.td_without_method_ratio);
+            vec![
+                s.grade.clone(),
+                s.well.clone(),
+                num(t.method_rms_error_m, 3),
+                num(t.method_predicted_1_sigma_m, 3),
+                num(w.rms_horizontal_error_m, 3),
+                num(w.predicted_1_sigma_m, 3),
+                fraction(&w.inside_95_ellipse),
+                num(ratio, 2),
+            ]
+        })
+        .collect();
+    out.push_str(&aligned(
+        &[
+            "grade",
+            "well",
+            "method error RMS (m)",
+            "XCL 1s (m)",
+            "rest RMS (m)",
+            "rest pred 1s (m)",
+            "rest inside 95 % ellipse",
+            "covariance analysis / MC (rest)",
+        ],
+        &rows,
+        2,
+    ));
+    out
+}
+
 /// The terminal tables: stations and the attitude requirement, TD and the
 /// position requirement, then the error growth along MD per grade and well.
 pub fn table(study: &LateralStudy) -> String {
@@ -145,6 +191,7 @@ pub fn table(study: &LateralStudy) -> String {
         &rows,
         2,
     ));
+    out.push_str(&method_split_table(study));
     for s in &study.summaries {
         for (reason, n) in &s.td_unchecked {
             out.push_str(&format!(
@@ -332,6 +379,12 @@ pub fn csv(study: &LateralStudy) -> String {
         "td_inside_95_ellipse_se",
         "td_semi_major_1_sigma_m",
         "td_semi_major_1_sigma_per_1000_m",
+        "td_method_rms_error_m",
+        "td_method_predicted_1_sigma_m",
+        "td_without_method_rms_error_m",
+        "td_without_method_predicted_1_sigma_m",
+        "td_without_method_inside_95_ellipse_k",
+        "td_without_method_inside_95_ellipse_n",
         "attitude_error_deg",
         "attitude_met",
         "rms_td_error_per_1000_m",
@@ -372,6 +425,12 @@ pub fn csv(study: &LateralStudy) -> String {
             f(t.inside_95_ellipse.standard_error),
             f(t.semi_major_1_sigma_m),
             f(t.semi_major_1_sigma_per_1000_m),
+            f(t.method_rms_error_m),
+            f(t.method_predicted_1_sigma_m),
+            f(t.without_method.rms_horizontal_error_m),
+            f(t.without_method.predicted_1_sigma_m),
+            t.without_method.inside_95_ellipse.inside.to_string(),
+            t.without_method.inside_95_ellipse.total.to_string(),
             f(s.requirement.attitude_error_deg),
             b(s.requirement.attitude_met),
             f(s.requirement.rms_td_error_per_1000_m),

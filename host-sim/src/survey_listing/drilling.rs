@@ -30,6 +30,9 @@ pub struct DrillingRow {
     /// MD, inclination, azimuth, positions; `cov` only where the position
     /// is determined.
     pub row: Row,
+    /// The part of `row.cov` from the survey method's terms (XCLA, XCLH:
+    /// [`survey_terms`]), where the position is determined.
+    pub method_cov: Option<Cov6>,
     pub azimuth_determined: bool,
     /// Every station up to this one has a determined azimuth: N/E/TVD and
     /// their covariance mean something.
@@ -56,16 +59,21 @@ pub struct DrillingSurvey {
 /// The probe's tool model (docs/probe-tool-model.md): a capture survey's.
 pub const MODEL_NAME: &str = "PROBE-SCC1300";
 
-/// The depth terms of the probe's tool model (DSFS, DSTG): the depth log's
-/// scale and stretch errors, one place for their magnitudes.
-pub fn depth_terms() -> Result<Vec<ErrorTerm>> {
+/// The survey's error sources other than the probe's angles, from the
+/// probe's tool model (one place for their magnitudes): the depth log's
+/// scale and stretch (DSFS, DSTG) and the minimum-curvature method's
+/// long-course-length terms (XCLA, XCLH, SPE 187249): one arc per stand
+/// cannot follow a path that changes its curvature inside the stand
+/// (docs/drilling-survey.md).
+pub fn survey_terms() -> Result<Vec<ErrorTerm>> {
     let model = super::model(MODEL_NAME)?;
+    let wanted = ["DSF", "DST", "XCLA", "XCLH"];
     let terms: Vec<ErrorTerm> = super::terms(model)?
         .into_iter()
-        .filter(|t| t.weighting == "DSF" || t.weighting == "DST")
+        .filter(|t| wanted.contains(&t.weighting.as_str()))
         .collect();
-    if terms.len() != 2 {
-        bail!("the PROBE-SCC1300 table has no DSF and DST terms");
+    if terms.len() != wanted.len() {
+        bail!("the PROBE-SCC1300 table lacks one of the DSF, DST, XCLA and XCLH terms");
     }
     Ok(terms)
 }
@@ -240,11 +248,12 @@ pub fn survey(
         .zip(rows)
         .enumerate()
         .map(|(k, ((s, time_s, ..), mut row))| {
-            row.cov = covs.get(k).copied();
+            row.cov = covs.get(k).map(|c| c.total);
             DrillingRow {
                 survey: *s,
                 time_s: *time_s,
                 row,
+                method_cov: covs.get(k).map(|c| c.method),
                 azimuth_determined: sigmas[k].is_some(),
                 position_determined: k < covs.len(),
             }
@@ -257,16 +266,32 @@ pub fn survey(
     })
 }
 
+/// A position's NEV covariance, and the survey method's part of it.
+#[derive(Clone, Copy, Debug)]
+pub struct PositionCovariance {
+    pub total: Cov6,
+    /// From the method's terms alone (XCLA, XCLH): the part no sensor
+    /// makes, which a Monte Carlo of one drilled path cannot sample.
+    pub method: Cov6,
+}
+
+/// Whether a term is the survey method's (the long-course-length terms)
+/// rather than the depth log's.
+fn is_method_term(t: &ErrorTerm) -> bool {
+    t.weighting.starts_with("XCL")
+}
+
 /// NEV covariance of the rows up to (not including) the first one without
-/// a determined azimuth: the probe's angle errors plus the depth terms,
-/// the latter on MD counted from the tie-on (the log's error at the
-/// tie-on is in the tie-on's MD, not in the positions: module docs).
+/// a determined azimuth: the probe's angle errors plus `terms`
+/// ([`survey_terms`]), the latter on MD counted from the tie-on (the log's
+/// error at the tie-on is in the tie-on's MD, not in the positions: module
+/// docs).
 pub fn covariance(
     rows: &[Row],
     sigmas: &[Option<AngleSigma>],
     terms: &[ErrorTerm],
     site: &Site,
-) -> Result<Vec<Cov6>> {
+) -> Result<Vec<PositionCovariance>> {
     let valid = sigmas.iter().take_while(|s| s.is_some()).count();
     if valid == 0 {
         return Ok(Vec::new());
@@ -291,18 +316,32 @@ pub fn covariance(
             ..*s
         })
         .collect();
-    let mut depth = vec![[0.0; 6]; valid];
+    let mut others = vec![[0.0; 6]; valid];
+    let mut method = vec![[0.0; 6]; valid];
     if valid > 1 {
         let result = survey_error::run(terms, &from_tie_on, site);
         if !result.missing.is_empty() {
-            bail!("depth terms not implemented: {}", result.missing.join(", "));
+            bail!("survey terms not implemented: {}", result.missing.join(", "));
         }
-        depth = result.total;
+        others = result.total;
+        for t in terms.iter().filter(|t| is_method_term(t)) {
+            let Some(covs) = result.per_source.get(&t.code) else {
+                continue;
+            };
+            for (m, c) in method.iter_mut().zip(covs) {
+                for j in 0..6 {
+                    m[j] += c[j];
+                }
+            }
+        }
     }
     Ok(angles
         .iter()
-        .zip(&depth)
-        .map(|(a, d)| std::array::from_fn(|j| a[j] + d[j]))
+        .zip(others.iter().zip(&method))
+        .map(|(a, (o, m))| PositionCovariance {
+            total: std::array::from_fn(|j| a[j] + o[j]),
+            method: *m,
+        })
         .collect())
 }
 
@@ -407,7 +446,7 @@ pub fn trajectory(
         .into_iter()
         .enumerate()
         .map(|(k, mut row)| {
-            row.cov = covs.get(k).copied();
+            row.cov = covs.get(k).map(|c| c.total);
             TrajectoryPoint {
                 time_s: row.input.time_s.unwrap_or(f64::NAN),
                 sigma_inc: sig[k][0],

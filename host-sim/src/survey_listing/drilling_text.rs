@@ -26,9 +26,10 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
     );
     let _ = writeln!(
         out,
-        "uncertainty: the probe's station sigmas (azimuth a random walk from the tie-in, inclination \
-         re-levelled per station) and the depth log's scale and stretch (DSFS, DSTG); angles 1-sigma; \
-         ellipse at {:.1} % (k = {:.4})",
+        "uncertainty: the probe's station sigmas (azimuth carried from station to station as the \
+         probe re-finds it, inclination re-levelled per station), the depth log's scale and stretch \
+         (DSFS, DSTG) and the minimum-curvature method's long course lengths (XCLA, XCLH); angles \
+         1-sigma; ellipse at {:.1} % (k = {:.4})",
         100.0 * confidence,
         scale_2d(confidence)
     );
