@@ -502,7 +502,10 @@ fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<[f64;
     };
     let (rows, _) = compute(&file, AzimuthReference::True, tie, None).ok()?;
     let end = rows.last()?;
-    Some([end.north_m - last.point.nev.x, end.east_m - last.point.nev.y])
+    Some([
+        end.north_m - last.point.nev.x,
+        end.east_m - last.point.nev.y,
+    ])
 }
 
 /// The NE covariance of a survey row, if its position is determined.

@@ -438,7 +438,10 @@ mod tests {
         // 0.5 m against 1 m^2 (its covariance whole): inside
         assert!((w.rms_horizontal_error_m.unwrap() - (16.25f64 / 2.0).sqrt()).abs() < 1e-12);
         assert!((w.predicted_1_sigma_m.unwrap() - ((4.0f64 + 5.0) / 2.0).sqrt()).abs() < 1e-12);
-        assert_eq!((w.inside_95_ellipse.inside, w.inside_95_ellipse.total), (1, 2));
+        assert_eq!(
+            (w.inside_95_ellipse.inside, w.inside_95_ellipse.total),
+            (1, 2)
+        );
         assert!((s.td.method_rms_error_m.unwrap() - (9.0f64 / 2.0).sqrt()).abs() < 1e-12);
         assert!((s.td.method_predicted_1_sigma_m.unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
         // a run without the method's figure is left out of the split only

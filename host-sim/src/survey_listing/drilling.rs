@@ -321,7 +321,10 @@ pub fn covariance(
     if valid > 1 {
         let result = survey_error::run(terms, &from_tie_on, site);
         if !result.missing.is_empty() {
-            bail!("survey terms not implemented: {}", result.missing.join(", "));
+            bail!(
+                "survey terms not implemented: {}",
+                result.missing.join(", ")
+            );
         }
         others = result.total;
         for t in terms.iter().filter(|t| is_method_term(t)) {
