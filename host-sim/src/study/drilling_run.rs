@@ -57,7 +57,7 @@ pub struct RunConfig {
 impl RunConfig {
     /// A calibrated run of `plan` with `grade`: the depth log's scale and
     /// stretch drawn from the probe tool model's DSFS and DSTG, the survey
-    /// with those depth terms at the plan's latitude.
+    /// with its terms ([`drilling::survey_terms`]) at the plan's latitude.
     pub fn new(plan: BuiltPlan, tie_in_azimuth_sigma: f64, grade: Grade) -> Result<Self> {
         let terms = drilling::survey_terms()?;
         let magnitude = |w: &str| {
@@ -508,23 +508,21 @@ fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<[f64;
     ])
 }
 
-/// The NE covariance of a survey row, if its position is determined.
-fn cov_ne(row: &drilling::DrillingRow) -> Option<[f64; 3]> {
-    let c = row.row.cov.filter(|_| row.position_determined)?;
-    Some([c[0], c[1], c[3]])
-}
-
-/// The survey method's part of [`cov_ne`].
-fn method_cov_ne(row: &drilling::DrillingRow) -> Option<[f64; 3]> {
-    let c = row.method_cov.filter(|_| row.position_determined)?;
-    Some([c[0], c[1], c[3]])
+/// The NE covariance of a survey row (north-north, east-east, north-east)
+/// and the survey method's part of it, if its position is determined.
+fn cov_ne(row: &drilling::DrillingRow) -> Option<([f64; 3], [f64; 3])> {
+    let ne = |c: [f64; 6]| [c[0], c[1], c[3]];
+    let total = row.row.cov.filter(|_| row.position_determined)?;
+    Some((ne(total), ne(row.method_cov?)))
 }
 
 /// Each surveyed station's position against the truth at its last still
 /// sample (the station the survey row is made of: same end sample).
 fn attach_positions(checks: &mut [StationCheck], survey: &DrillingSurvey, drilling: &Drilling) {
     for row in &survey.rows {
-        let Some(cov) = cov_ne(row) else { continue };
+        let Some((cov, _)) = cov_ne(row) else {
+            continue;
+        };
         let Some(check) = checks
             .iter_mut()
             .find(|c| c.survey.end_sample == row.survey.end_sample)
@@ -559,7 +557,7 @@ fn td_check(
             Some(format!("last station at MD {:.1} m, not at TD", truth.md)),
         );
     }
-    let Some(c) = cov_ne(last) else {
+    let Some((c, method_c)) = cov_ne(last) else {
         return (None, Some("TD position undetermined".into()));
     };
     let position = PositionCheck {
@@ -577,7 +575,7 @@ fn td_check(
             error_ne: position.error_ne,
             d2,
             cov_ne: c,
-            method_cov_ne: method_cov_ne(last).unwrap_or([0.0; 3]),
+            method_cov_ne: method_c,
         }),
         None,
     )

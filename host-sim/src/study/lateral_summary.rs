@@ -43,16 +43,17 @@ pub struct TdSummary {
     /// the covariance less the XCLA/XCLH terms. The method's error is the
     /// same in every run of one plan, so a Monte Carlo cannot check its
     /// terms; this checks the rest.
-    pub without_method: MethodSplit,
+    pub without_method: TdWithoutMethod,
     /// The method's own TD error (RMS over runs, m) and its terms'
     /// predicted 1-sigma (RMS of sqrt(trace)).
     pub method_rms_error_m: Option<f64>,
     pub method_predicted_1_sigma_m: Option<f64>,
 }
 
-/// The TD statistics of the sensors' part alone ([`TdSummary`]).
+/// The TD statistics without the survey method: the sensors' and the
+/// depth log's part ([`TdSummary::without_method`]).
 #[derive(Clone, Debug, Default, Serialize)]
-pub struct MethodSplit {
+pub struct TdWithoutMethod {
     pub rms_horizontal_error_m: Option<f64>,
     pub predicted_1_sigma_m: Option<f64>,
     pub inside_95_ellipse: Fraction,
@@ -286,7 +287,7 @@ pub fn summarise(
         inside_95_ellipse: Fraction::of(td_inside, td_err.len()),
         semi_major_1_sigma_m: major,
         semi_major_1_sigma_per_1000_m: per_1000(major),
-        without_method: MethodSplit {
+        without_method: TdWithoutMethod {
             rms_horizontal_error_m: rms(&sensor_err),
             predicted_1_sigma_m: rms(&sensor_sigma),
             inside_95_ellipse: Fraction::of(sensor_inside, sensor_err.len()),
