@@ -1,0 +1,482 @@
+use super::*;
+extern crate std;
+use super::super::still::DETECTION_DELAY_SAMPLES;
+use crate::calibration::TriadCalibration;
+use crate::protocol::frame::raw_flags;
+use crate::protocol::RawPart;
+use crate::sensor_units::{
+    m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
+};
+
+/// A still probe feeling `force` (body axes, m/s^2), no rotation (the
+/// hil-mock generator's static probe, which has no earth rate).
+fn still_sample(n: u32, force: [f32; 3]) -> RawSample {
+    let parts = PART_MOUNTINGS.map(|mounting| RawPart {
+        accel: mounting.body_to_sensor(force).map(m_s2_to_accel_count),
+        flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
+        ..RawPart::default()
+    });
+    RawSample {
+        time_us: u64::from(n) * 50_000,
+        sample_counter: n,
+        parts,
+    }
+}
+
+/// Level: gravity's reaction on body +z.
+pub(super) fn level_sample(n: u32) -> RawSample {
+    still_sample(n, [0.0, 0.0, STANDARD_GRAVITY_M_S2])
+}
+
+pub(super) const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
+
+#[test]
+fn a_body_sample_steps_as_its_raw_frame_does() {
+    let position = Position::paper_site();
+    let (mut by_raw, mut by_sample) = (Navigator::new(position), Navigator::new(position));
+    // Tilted, so the alignment and the filter have work to do.
+    let tilted = |n| still_sample(n, [0.3, 0.5, STANDARD_GRAVITY_M_S2 - 0.02]);
+    for n in 0..ALL_ALIGNMENT + 40 {
+        let raw = tilted(n);
+        let sample = match reading(&raw, &ProbeCalibration::default()) {
+            Reading::Both(sample) => sample,
+            other => panic!("{other:?}"),
+        };
+        let a = by_raw.step(&raw);
+        let b = by_sample.step_sample(raw.time_us, raw.sample_counter, &sample);
+        assert_eq!(std::format!("{a:?}"), std::format!("{b:?}"), "sample {n}");
+    }
+    assert_eq!(by_raw.filter().state(), by_sample.filter().state());
+}
+
+#[test]
+fn a_quieter_budget_gives_smaller_sigmas() {
+    static QUIET: ImuNoise = {
+        let mut noise = ImuNoise::scc1300();
+        let mut axis = 0;
+        while axis < 3 {
+            noise.gyro[axis].white_density /= 100.0;
+            noise.gyro[axis].bias_instability /= 100.0;
+            noise.gyro[axis].residual_bias /= 100.0;
+            noise.gyro[axis].coloured = None;
+            axis += 2;
+        }
+        noise
+    };
+    let position = Position::paper_site();
+    let (mut scc1300, mut quiet) = (Navigator::new(position), Navigator::new(position));
+    quiet.set_noise_budget(&QUIET);
+    assert_eq!(scc1300.noise_budget(), &ImuNoise::scc1300());
+    let (mut a, mut b) = (None, None);
+    for n in 0..ALL_ALIGNMENT {
+        a = Some(scc1300.step(&level_sample(n)));
+        b = Some(quiet.step(&level_sample(n)));
+    }
+    let (a, b) = (a.unwrap(), b.unwrap());
+    assert_eq!(
+        (a.mode, b.mode),
+        (nav_mode::NAVIGATING, nav_mode::NAVIGATING)
+    );
+    // Velocity sigmas are the accelerometers' (the same budget); the
+    // filter's covariance stays healthy with the still AR blocks.
+    assert!(
+        b.velocity_std.iter().all(|s| s.is_finite() && *s > 0.0),
+        "{b:?}"
+    );
+    let gyro_bias = |n: &Navigator, i: usize| {
+        n.filter().filter().p[(
+            crate::error_model::GYRO_BIAS + i,
+            crate::error_model::GYRO_BIAS + i,
+        )]
+    };
+    assert!(gyro_bias(&quiet, 0) < 1e-3 * gyro_bias(&scc1300, 0));
+}
+
+#[test]
+fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
+    let mut navigator = Navigator::new(Position::paper_site());
+    for n in 0..ALIGNMENT_SAMPLES - 1 {
+        let s = navigator.step(&level_sample(n));
+        assert_eq!((s.mode, s.flags), (nav_mode::COARSE_ALIGNMENT, 0));
+        assert!(s.velocity_std[0].is_nan());
+        // No solution yet: the attitude and velocity are placeholders,
+        // and look like them.
+        assert!(s.attitude.iter().chain(&s.velocity_ned).all(|a| a.is_nan()));
+    }
+    // A sample with no valid part is flagged and does not count.
+    let mut bad = level_sample(99);
+    bad.parts[0].flags = 0;
+    bad.parts[1].flags = 0;
+    let s = navigator.step(&bad);
+    assert_eq!(s.flags, nav_flags::SENSOR_DEGRADED);
+    assert!(!navigator.is_aligned());
+
+    // The coarse alignment ends: the filter takes over.
+    let first = navigator.step(&level_sample(100));
+    assert!(navigator.is_aligned() && !navigator.is_navigating());
+    assert_eq!(first.mode, nav_mode::FINE_ALIGNMENT);
+    assert!(first.attitude_std[0] > 0.0 && first.attitude_std[1] > 0.0);
+    let mut last = first;
+    for n in 101..=ALL_ALIGNMENT {
+        last = navigator.step(&level_sample(n));
+        assert_eq!(last.sample_counter, n);
+        assert!(last.attitude[0].abs() < 1e-3 && last.attitude[1].abs() < 1e-3);
+        if n < ALL_ALIGNMENT {
+            assert_eq!(last.mode, nav_mode::FINE_ALIGNMENT, "sample {n}");
+            assert_eq!(last.flags, nav_flags::ZUPT_APPLIED, "sample {n}");
+        }
+    }
+    // After 60 s the probe navigates; the zero updates are over.
+    assert!(navigator.is_navigating());
+    assert_eq!(last.mode, nav_mode::NAVIGATING);
+    // No earth rate in these samples: the heading stays unknown, and
+    // the frames say so rather than quoting the filter's small-angle
+    // azimuth sigma.
+    assert!(last.attitude_std[2].is_infinite(), "{last:?}");
+    // The fine alignment converged in velocity and position; the tilt
+    // sigmas stay at the floor the accelerometer bias sets (at rest
+    // tilt and bias are inseparable: sigma_tilt >= sigma_b / g,
+    // docs/filter-derivation.md section 3b), a little above it as the
+    // bias random walk grows.
+    let floor = (AugmentedModel::paper().biases.accel[0].initial_sigma
+        / f64::from(STANDARD_GRAVITY_M_S2)) as f32;
+    for axis in 0..2 {
+        let sigma = last.attitude_std[axis];
+        assert!(
+            sigma >= 0.99 * floor && sigma < 1.5 * first.attitude_std[axis],
+            "floor {floor}: {first:?} -> {last:?}"
+        );
+    }
+    for i in 0..3 {
+        assert!(
+            last.velocity_std[i] < 0.2 * first.velocity_std[i],
+            "{last:?}"
+        );
+        assert!(
+            last.position_std_ned[i] < 0.2 * first.position_std_ned[i],
+            "{last:?}"
+        );
+    }
+
+    // Navigating (turning, so not still) without zero updates, the
+    // uncertainties grow.
+    let mut later = last;
+    for n in ALL_ALIGNMENT + 1..ALL_ALIGNMENT + 200 {
+        later = navigator.step(&turning_sample(n, 3.0));
+        assert_eq!(later.mode, nav_mode::NAVIGATING);
+        assert_eq!(later.flags & nav_flags::ZUPT_APPLIED, 0);
+    }
+    assert!(
+        later.velocity_std[0] > 2.0 * last.velocity_std[0],
+        "{later:?}"
+    );
+    assert!(
+        later.position_std_ned[0] > last.position_std_ned[0],
+        "{later:?}"
+    );
+}
+
+#[test]
+fn the_calibration_removes_an_accelerometer_bias_before_alignment() {
+    // 10 counts (~0.15 m/s^2) of bias on body x tilt an uncalibrated
+    // probe by ~0.9 deg in roll; the calibration takes it out.
+    let bias = 10.0 * STANDARD_GRAVITY_M_S2 / 650.0;
+    let biased = |n| still_sample(n, [bias, 0.0, STANDARD_GRAVITY_M_S2]);
+    let triad = TriadCalibration {
+        bias: [f64::from(bias), 0.0, 0.0],
+        ..TriadCalibration::IDENTITY
+    };
+    let calibration = ProbeCalibration {
+        accel: [triad; 2],
+        ..ProbeCalibration::default()
+    };
+    let mut plain = Navigator::new(Position::paper_site());
+    let mut calibrated = Navigator::with_calibration(Position::paper_site(), calibration);
+    let (mut a, mut b) = (NavSolution::default(), NavSolution::default());
+    for n in 0..=ALIGNMENT_SAMPLES {
+        a = plain.step(&biased(n));
+        b = calibrated.step(&biased(n));
+    }
+    let tilt = (bias / STANDARD_GRAVITY_M_S2).atan();
+    assert!((a.attitude[0].abs() - tilt).abs() < 0.05 * tilt, "{a:?}");
+    assert!(b.attitude[0].abs() < 0.02 * tilt, "{b:?}");
+}
+
+/// A level probe turning about body z (up) at `deg_s`, samples `n`.
+pub(super) fn turning_sample(n: u32, deg_s: f32) -> RawSample {
+    let mut raw = level_sample(n);
+    for (part, mounting) in raw.parts.iter_mut().zip(PART_MOUNTINGS) {
+        let rate = mounting.gyro_rate_from_body([0.0, 0.0, deg_s.to_radians()]);
+        part.gyro_rate = rad_s_to_gyro_count(rate);
+    }
+    raw
+}
+
+fn aligned_navigator() -> Navigator {
+    let mut navigator = Navigator::new(Position::paper_site());
+    for n in 0..=ALL_ALIGNMENT {
+        navigator.step(&level_sample(n));
+    }
+    assert!(navigator.is_navigating());
+    navigator
+}
+
+/// A probe turning at 3 deg/s with 1 s of invalid
+/// samples ended with a permanent 3 deg heading offset and unchanged
+/// sigmas (the gap was not propagated).
+#[test]
+fn a_sensor_gap_is_propagated_with_the_held_rates_and_flagged() {
+    let (mut reference, mut gapped) = (aligned_navigator(), aligned_navigator());
+    let start = ALL_ALIGNMENT + 1;
+    let gap = start + 100..start + 120;
+    let (mut a, mut b) = (NavSolution::default(), NavSolution::default());
+    for n in start..start + 200 {
+        let raw = turning_sample(n, 3.0);
+        a = reference.step(&raw);
+        let mut raw = raw;
+        if gap.contains(&n) {
+            raw.parts.iter_mut().for_each(|p| p.flags = 0);
+        }
+        b = gapped.step(&raw);
+        if gap.contains(&n) {
+            assert_ne!(b.flags & nav_flags::SENSOR_DEGRADED, 0);
+        }
+        if n >= gap.start {
+            // Navigation has no aid: coasting until the next alignment.
+            assert_ne!(b.flags & nav_flags::COASTING, 0, "sample {n}");
+        } else {
+            assert_eq!(b.flags & nav_flags::COASTING, 0, "sample {n}");
+        }
+    }
+    assert_eq!(a.flags & nav_flags::COASTING, 0);
+    // The turn went on through the gap: the headings agree to well
+    // under the 3 deg the frozen solution lost.
+    let offset = (a.attitude[2] - b.attitude[2]).to_degrees();
+    assert!(offset.abs() < 0.1, "heading offset {offset} deg");
+    // The held rates' uncertainty was added: the gap's solution is
+    // less certain (the heading's sigma in the frames is infinite in
+    // both, the coarse alignment having had no earth rate; the
+    // filter's own shows the growth).
+    let (sa, sb) = (reference.filter().euler_std(), gapped.filter().euler_std());
+    // 20 missed steps of a rate held within 1 deg/s: (20 x 0.05 x
+    // 1 deg)^2 = (1 deg)^2 more heading variance.
+    let added = sb.z * sb.z - sa.z * sa.z;
+    assert!(added > 0.8f64.to_radians().powi(2), "{sa:?} vs {sb:?}");
+    for axis in 0..2 {
+        assert!(
+            b.attitude_std[axis] > a.attitude_std[axis],
+            "{a:?} vs {b:?}"
+        );
+    }
+    for i in 0..3 {
+        assert!(b.velocity_std[i] > a.velocity_std[i], "{a:?} vs {b:?}");
+    }
+}
+
+/// A gap in the fine alignment: coasting until the next zero update.
+#[test]
+fn a_gap_in_the_fine_alignment_coasts_until_the_next_zero_update() {
+    let mut navigator = Navigator::new(Position::paper_site());
+    for n in 0..ALIGNMENT_SAMPLES + 50 {
+        navigator.step(&level_sample(n));
+    }
+    let mut bad = level_sample(ALIGNMENT_SAMPLES + 50);
+    bad.parts.iter_mut().for_each(|p| p.flags = 0);
+    let s = navigator.step(&bad);
+    assert_eq!(s.mode, nav_mode::FINE_ALIGNMENT);
+    assert_ne!(s.flags & nav_flags::COASTING, 0, "{s:?}");
+    assert_eq!(s.flags & nav_flags::ZUPT_APPLIED, 0, "{s:?}");
+    let s = navigator.step(&level_sample(ALIGNMENT_SAMPLES + 51));
+    assert_eq!(s.flags, nav_flags::ZUPT_APPLIED, "{s:?}");
+}
+
+/// With part 1 dead from boot the probe stayed in
+/// its coarse alignment for ever. Now part 2's triad levels the probe
+/// and its gyro carries what it can; the azimuth is not determined.
+#[test]
+fn with_part_1_dead_from_boot_the_healthy_part_levels_and_navigates() {
+    let truth = Euler::new(10.0 * DEG, -5.0 * DEG, 0.0);
+    let force = crate::conventions::specific_force_at_rest(&truth, 9.80665).map(|f| f as f32);
+    let dead = |n| {
+        let mut raw = still_sample(n, [force.x, force.y, force.z]);
+        raw.parts[0] = RawPart {
+            flags: raw_flags::NO_RESPONSE,
+            ..RawPart::default()
+        };
+        raw
+    };
+    let mut navigator = Navigator::new(Position::paper_site());
+    let mut last = NavSolution::default();
+    for n in 0..=ALL_ALIGNMENT + 20 {
+        last = navigator.step(&dead(n));
+        assert_ne!(last.flags & nav_flags::SINGLE_PART, 0, "{last:?}");
+        if n == ALIGNMENT_SAMPLES - 1 || n == ALL_ALIGNMENT {
+            assert!(navigator.is_aligned(), "sample {n}");
+            for (axis, angle) in [truth.roll, truth.pitch].into_iter().enumerate() {
+                let (value, sigma) = (last.attitude[axis], last.attitude_std[axis]);
+                let error = f64::from(value) - angle;
+                assert!(
+                    sigma.is_finite() && error.abs() < 3.0 * f64::from(sigma),
+                    "sample {n}, axis {axis}: {last:?}"
+                );
+            }
+            assert_eq!(last.attitude_std[2], f32::INFINITY, "{last:?}");
+        }
+    }
+    assert!(navigator.is_navigating());
+    assert_eq!(last.mode, nav_mode::NAVIGATING);
+    assert_eq!(last.attitude_std[2], f32::INFINITY);
+    assert!(
+        last.attitude_std[..2].iter().all(|s| s.is_finite()),
+        "{last:?}"
+    );
+}
+
+/// Navigating, a probe that turns, stops for a minute and turns again:
+/// zero-velocity updates from the still detector's delay on, and one
+/// station survey when it moves, with the attitude of the last still
+/// cycle and the filter's uncertainty.
+#[test]
+fn a_stop_in_navigation_gives_zero_updates_and_one_station() {
+    let mut navigator = aligned_navigator();
+    let start = ALL_ALIGNMENT + 1;
+    let still_from = start + 100;
+    let still_to = still_from + 1200; // 60 s
+    let mut moving_end = NavSolution::default();
+    let mut last_still = NavSolution::default();
+    let mut frames = std::vec::Vec::new();
+    let mut stations = std::vec::Vec::new();
+    for n in start..still_to + 50 {
+        let still = (still_from..still_to).contains(&n);
+        let raw = if still {
+            level_sample(n)
+        } else {
+            turning_sample(n, 3.0)
+        };
+        let s = navigator.step(&raw);
+        frames.push(s);
+        stations.extend(navigator.take_station().map(|st| (n, st)));
+        let expect_zupt = still && n >= still_from + DETECTION_DELAY_SAMPLES - 1;
+        assert_eq!(
+            s.flags & (nav_flags::ZUPT_APPLIED | nav_flags::STILL) != 0,
+            expect_zupt,
+            "sample {n}: {s:?}"
+        );
+        if n == still_from - 1 {
+            moving_end = s;
+        }
+        if n == still_to - 1 {
+            last_still = s;
+        }
+    }
+    // The velocity uncertainty grown while turning was taken back
+    // (below the updates' own 1 cm/s), and the filter re-levelled: the
+    // tilt sigmas fell.
+    for i in 0..3 {
+        let (before, after) = (moving_end.velocity_std[i], last_still.velocity_std[i]);
+        assert!(
+            after < 0.01 && after < before,
+            "{moving_end:?} -> {last_still:?}"
+        );
+    }
+    // (The non-holonomic updates while it turned had already levelled
+    // it part of the way.)
+    for i in 0..2 {
+        assert!(
+            last_still.attitude_std[i] < moving_end.attitude_std[i],
+            "{moving_end:?} -> {last_still:?}"
+        );
+    }
+    assert_eq!(stations.len(), 1, "{stations:?}");
+    let (sent_at, st) = stations[0];
+    assert_eq!(sent_at, still_to, "sent with the first moving sample");
+    assert_eq!(st.station, 1);
+    let first_zupt = still_from + DETECTION_DELAY_SAMPLES - 1;
+    assert_eq!(st.start_sample, first_zupt);
+    // The older of the last two checkpoints (`SURVEY_SETTLE_EPOCHS`).
+    let epochs = still_to - first_zupt;
+    let settled = (epochs / SURVEY_SETTLE_EPOCHS - 1) * SURVEY_SETTLE_EPOCHS;
+    assert_eq!(st.end_sample, first_zupt + settled - 1);
+    assert_eq!(st.time_us, u64::from(st.end_sample) * 50_000);
+    let last_still = frames[(st.end_sample - start) as usize];
+    // The level probe: inclination 90 deg; toolface = roll.
+    let [roll, pitch, heading] = last_still.attitude.map(f64::from);
+    let [inc, azi, tf] = st.angles.map(f64::from);
+    assert!(
+        (inc - (core::f64::consts::FRAC_PI_2 + pitch)).abs() < 1e-6,
+        "{st:?}"
+    );
+    assert!(
+        (crate::conventions::wrap_pi(tf - roll)).abs() < 1e-6,
+        "{st:?}"
+    );
+    assert!(
+        (crate::conventions::wrap_pi(azi - heading)).abs() < 1e-6,
+        "{st:?}"
+    );
+    // No earth rate in these samples: no heading was gyrocompassed, so
+    // the azimuth is undetermined, as in the navigation frames.
+    assert_eq!(
+        st.flags,
+        station_flags::MAGNETIC_FREE | station_flags::AZIMUTH_UNDETERMINED
+    );
+    assert_eq!(st.angles_std[1], f32::INFINITY);
+    assert!(st.correlations[0].is_nan() && st.correlations[2].is_nan());
+    assert!(st.correlations[1].abs() <= 1.0, "{st:?}");
+    // Inclination and toolface sigmas: pitch and roll's of the frame.
+    assert!((st.angles_std[0] - last_still.attitude_std[1]).abs() < 1e-3 * st.angles_std[0]);
+    assert!((st.angles_std[2] - last_still.attitude_std[0]).abs() < 1e-3 * st.angles_std[2]);
+    // Noise-free still samples: the quality is the detector's floor.
+    assert!(st.still_quality >= 0.0 && st.still_quality < 0.1, "{st:?}");
+}
+
+/// A stop longer than the longest station: the station is sent then,
+/// the updates stop, and the next station comes after the next move.
+#[test]
+fn a_long_stop_is_sent_at_the_longest_station_and_once() {
+    let mut navigator = aligned_navigator();
+    let start = ALL_ALIGNMENT + 1;
+    let mut stations = std::vec::Vec::new();
+    let still_end = start + MAX_STATION_SAMPLES + 300;
+    for n in start..still_end + 200 {
+        let moving = (still_end..still_end + 20).contains(&n);
+        let raw = if moving {
+            turning_sample(n, 3.0)
+        } else {
+            level_sample(n)
+        };
+        let s = navigator.step(&raw);
+        if n == still_end - 1 {
+            // Past the longest station: still, but no more updates.
+            assert_eq!(
+                s.flags & (nav_flags::ZUPT_APPLIED | nav_flags::STILL),
+                nav_flags::STILL,
+                "{s:?}"
+            );
+        }
+        stations.extend(navigator.take_station().map(|st| (n, st)));
+    }
+    // One station for the long stop, sent when it reached the longest
+    // station while the probe was still still; nothing when it moved.
+    assert_eq!(stations.len(), 1, "{stations:?}");
+    let (at, first) = stations[0];
+    // The detector's window began with the last aligned sample, the
+    // first one navigated.
+    let first_zupt = ALL_ALIGNMENT + DETECTION_DELAY_SAMPLES - 1;
+    assert_eq!(at, first_zupt + MAX_STATION_SAMPLES - 1);
+    assert_eq!(
+        (first.station, first.start_sample, first.end_sample),
+        (1, first_zupt, at - SURVEY_SETTLE_EPOCHS)
+    );
+    assert_ne!(first.flags & station_flags::MAX_DURATION, 0);
+    // The stop after the move started station 2, not ended yet.
+    assert_eq!(navigator.stations(), 2);
+    let mut raw = level_sample(still_end + 200);
+    raw.parts[1].flags = 0;
+    navigator.step(&raw);
+    let second = navigator
+        .take_station()
+        .expect("a single part ends the station");
+    assert_eq!(second.station, 2);
+    assert_eq!(second.flags & station_flags::MAX_DURATION, 0);
+}
