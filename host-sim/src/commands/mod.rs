@@ -112,6 +112,14 @@ pub fn print_text(args: std::fmt::Arguments<'_>) {
     }
 }
 
+/// Writes `value` as pretty JSON (with a final newline) to `path`, the
+/// path named in the error: the studies' `--json` outputs.
+fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
 /// Runs a command; its exit status (only `replay` has others than 0: see
 /// its `--help`).
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {

@@ -112,8 +112,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     );
     out!("{}", table(&summary));
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&summary)? + "\n";
-        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+        super::write_json(path, &summary)?;
     }
     Ok(())
 }
@@ -230,8 +229,7 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     );
     out!("{}", table(&summaries));
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&summaries)? + "\n";
-        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+        super::write_json(path, &summaries)?;
     }
     Ok(())
 }

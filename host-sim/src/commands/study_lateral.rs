@@ -155,8 +155,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
     );
     out!("{}", table(&result));
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&result)? + "\n";
-        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+        super::write_json(path, &result)?;
     }
     if let Some(path) = &args.csv {
         std::fs::write(path, csv(&result))
