@@ -7,9 +7,8 @@ use super::super::SURVEY_SETTLE_EPOCHS;
 use super::*;
 use crate::conventions::{specific_force_at_rest, Euler};
 use crate::earth::Position;
-use crate::protocol::frame::{nav_mode, raw_flags};
-use crate::protocol::{NavSolution, RawPart, RawSample};
-use crate::sensor_units::{m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS};
+use crate::protocol::frame::nav_mode;
+use crate::protocol::{NavSolution, RawSample};
 use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES};
 use std::vec::Vec;
 
@@ -22,19 +21,11 @@ fn sample(n: u32, roll: f64, deg_s: f32) -> RawSample {
     let force = specific_force_at_rest(&Euler::new(roll, 0.0, 0.0), G).map(|f| f as f32);
     // At rest the specific force points up: the turn's axis in body axes.
     let rate = force * (deg_s.to_radians() / G as f32);
-    let parts = PART_MOUNTINGS.map(|mounting| RawPart {
-        accel: mounting
-            .body_to_sensor([force.x, force.y, force.z])
-            .map(m_s2_to_accel_count),
-        gyro_rate: rad_s_to_gyro_count(mounting.gyro_rate_from_body([rate.x, rate.y, rate.z])),
-        flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
-        ..RawPart::default()
-    });
-    RawSample {
-        time_us: u64::from(n) * 50_000,
-        sample_counter: n,
-        parts,
-    }
+    crate::probe::test_support::turning_sample(
+        n,
+        [force.x, force.y, force.z],
+        [rate.x, rate.y, rate.z],
+    )
 }
 
 /// A station's fields as bits (its NaN correlations compare equal).

@@ -16,6 +16,8 @@ pub mod navigator;
 pub mod raw;
 pub mod station;
 pub mod still;
+#[cfg(test)]
+mod test_support;
 pub mod tie_in;
 
 pub use navigator::Navigator;

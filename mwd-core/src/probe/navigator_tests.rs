@@ -4,24 +4,9 @@ use super::super::still::DETECTION_DELAY_SAMPLES;
 use crate::calibration::TriadCalibration;
 use crate::protocol::frame::raw_flags;
 use crate::protocol::RawPart;
-use crate::sensor_units::{
-    m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
-};
+use crate::sensor_units::{rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
 
-/// A still probe feeling `force` (body axes, m/s^2), no rotation (the
-/// hil-mock generator's static probe, which has no earth rate).
-fn still_sample(n: u32, force: [f32; 3]) -> RawSample {
-    let parts = PART_MOUNTINGS.map(|mounting| RawPart {
-        accel: mounting.body_to_sensor(force).map(m_s2_to_accel_count),
-        flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
-        ..RawPart::default()
-    });
-    RawSample {
-        time_us: u64::from(n) * 50_000,
-        sample_counter: n,
-        parts,
-    }
-}
+use super::super::test_support::still_sample;
 
 /// Level: gravity's reaction on body +z.
 pub(super) fn level_sample(n: u32) -> RawSample {

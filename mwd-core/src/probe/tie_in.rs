@@ -231,10 +231,9 @@ mod tests {
     use crate::conventions::{euler_error_jacobian, euler_from_quat, skew, wrap_pi, Euler};
     use crate::earth::Position;
     use crate::probe::Navigator;
-    use crate::protocol::frame::raw_flags;
     use crate::protocol::frame::{nav_flags, nav_mode};
-    use crate::protocol::{RawPart, RawSample};
-    use crate::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+    use crate::protocol::RawSample;
+    use crate::sensor_units::STANDARD_GRAVITY_M_S2;
     use nalgebra::{Rotation3, Vector3};
 
     fn angles(inc_deg: f64, azi_deg: f64, tf_deg: f64) -> DrillingAngles {
@@ -397,18 +396,7 @@ mod tests {
             f64::from(STANDARD_GRAVITY_M_S2),
         )
         .map(|f| f as f32);
-        let parts = PART_MOUNTINGS.map(|mounting| RawPart {
-            accel: mounting
-                .body_to_sensor([force.x, force.y, force.z])
-                .map(m_s2_to_accel_count),
-            flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
-            ..RawPart::default()
-        });
-        RawSample {
-            time_us: u64::from(n) * 50_000,
-            sample_counter: n,
-            parts,
-        }
+        crate::probe::test_support::still_sample(n, [force.x, force.y, force.z])
     }
 
     #[test]
