@@ -9,10 +9,10 @@ use crate::conventions::{specific_force_at_rest, Euler};
 use crate::earth::Position;
 use crate::protocol::frame::nav_mode;
 use crate::protocol::{NavSolution, RawSample};
-use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES};
+use crate::timing::ALIGNMENT_SAMPLES;
 use std::vec::Vec;
 
-const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
+use crate::probe::test_support::{aligned_navigator as aligned, ALL_ALIGNMENT};
 const G: f64 = 9.80665;
 
 /// A level (horizontal) probe at toolface `roll` (rad), turning about the
@@ -41,15 +41,6 @@ fn bits(s: &StationSurvey) -> (u16, u16, u32, u32, [u32; 9]) {
 
 fn still(n: u32) -> RawSample {
     sample(n, 0.0, 0.0)
-}
-
-fn aligned() -> Navigator {
-    let mut navigator = Navigator::new(Position::paper_site());
-    for n in 0..=ALL_ALIGNMENT {
-        navigator.step(&still(n));
-    }
-    assert!(navigator.is_navigating());
-    navigator
 }
 
 #[test]

@@ -3,10 +3,10 @@
 //! samples of a still, level probe: the navigator tests' generator).
 
 extern crate std;
-use super::tests::{level_sample, turning_sample, ALL_ALIGNMENT};
 use super::*;
 use crate::config::default_still_settings;
 use crate::probe::still::{Hysteresis, DETECTION_DELAY_SAMPLES};
+use crate::probe::test_support::{level_sample, level_turning_sample, ALL_ALIGNMENT};
 use std::format;
 use std::vec::Vec;
 
@@ -59,7 +59,7 @@ fn the_default_settings_are_the_constants_to_the_bit() {
     let mut set = navigator(&defaults);
     for n in 0..ALL_ALIGNMENT + 400 {
         let raw = if (ALL_ALIGNMENT + 200..ALL_ALIGNMENT + 220).contains(&n) {
-            turning_sample(n, 3.0)
+            level_turning_sample(n, 3.0)
         } else {
             level_sample(n)
         };

@@ -4,16 +4,11 @@ use super::super::still::DETECTION_DELAY_SAMPLES;
 use crate::calibration::TriadCalibration;
 use crate::protocol::frame::raw_flags;
 use crate::protocol::RawPart;
-use crate::sensor_units::{rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+use crate::sensor_units::STANDARD_GRAVITY_M_S2;
 
-use super::super::test_support::still_sample;
-
-/// Level: gravity's reaction on body +z.
-pub(super) fn level_sample(n: u32) -> RawSample {
-    still_sample(n, [0.0, 0.0, STANDARD_GRAVITY_M_S2])
-}
-
-pub(super) const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
+use super::super::test_support::{
+    aligned_navigator, level_sample, level_turning_sample, still_sample, ALL_ALIGNMENT,
+};
 
 #[test]
 fn a_body_sample_steps_as_its_raw_frame_does() {
@@ -147,7 +142,7 @@ fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
     // uncertainties grow.
     let mut later = last;
     for n in ALL_ALIGNMENT + 1..ALL_ALIGNMENT + 200 {
-        later = navigator.step(&turning_sample(n, 3.0));
+        later = navigator.step(&level_turning_sample(n, 3.0));
         assert_eq!(later.mode, nav_mode::NAVIGATING);
         assert_eq!(later.flags & nav_flags::ZUPT_APPLIED, 0);
     }
@@ -187,25 +182,6 @@ fn the_calibration_removes_an_accelerometer_bias_before_alignment() {
     assert!(b.attitude[0].abs() < 0.02 * tilt, "{b:?}");
 }
 
-/// A level probe turning about body z (up) at `deg_s`, samples `n`.
-pub(super) fn turning_sample(n: u32, deg_s: f32) -> RawSample {
-    let mut raw = level_sample(n);
-    for (part, mounting) in raw.parts.iter_mut().zip(PART_MOUNTINGS) {
-        let rate = mounting.gyro_rate_from_body([0.0, 0.0, deg_s.to_radians()]);
-        part.gyro_rate = rad_s_to_gyro_count(rate);
-    }
-    raw
-}
-
-fn aligned_navigator() -> Navigator {
-    let mut navigator = Navigator::new(Position::paper_site());
-    for n in 0..=ALL_ALIGNMENT {
-        navigator.step(&level_sample(n));
-    }
-    assert!(navigator.is_navigating());
-    navigator
-}
-
 /// A probe turning at 3 deg/s with 1 s of invalid
 /// samples ended with a permanent 3 deg heading offset and unchanged
 /// sigmas (the gap was not propagated).
@@ -216,7 +192,7 @@ fn a_sensor_gap_is_propagated_with_the_held_rates_and_flagged() {
     let gap = start + 100..start + 120;
     let (mut a, mut b) = (NavSolution::default(), NavSolution::default());
     for n in start..start + 200 {
-        let raw = turning_sample(n, 3.0);
+        let raw = level_turning_sample(n, 3.0);
         a = reference.step(&raw);
         let mut raw = raw;
         if gap.contains(&n) {
@@ -336,7 +312,7 @@ fn a_stop_in_navigation_gives_zero_updates_and_one_station() {
         let raw = if still {
             level_sample(n)
         } else {
-            turning_sample(n, 3.0)
+            level_turning_sample(n, 3.0)
         };
         let s = navigator.step(&raw);
         frames.push(s);
@@ -426,7 +402,7 @@ fn a_long_stop_is_sent_at_the_longest_station_and_once() {
     for n in start..still_end + 200 {
         let moving = (still_end..still_end + 20).contains(&n);
         let raw = if moving {
-            turning_sample(n, 3.0)
+            level_turning_sample(n, 3.0)
         } else {
             level_sample(n)
         };

@@ -1,8 +1,16 @@
 //! Helpers for the probe's unit tests (compiled for tests only).
 
+use super::Navigator;
+use crate::earth::Position;
 use crate::protocol::frame::raw_flags;
 use crate::protocol::{RawPart, RawSample};
-use crate::sensor_units::{m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS};
+use crate::sensor_units::{
+    m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
+};
+use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES};
+
+/// Samples from power-on to the end of the fine alignment.
+pub(crate) const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
 
 /// Raw sample `n` of a still probe feeling `force` (body axes, m/s^2) on
 /// both parts, no rotation (the hil-mock generator's static probe, which
@@ -25,4 +33,29 @@ pub(crate) fn turning_sample(n: u32, force: [f32; 3], rate: [f32; 3]) -> RawSamp
         sample_counter: n,
         parts,
     }
+}
+
+/// Level: gravity's reaction on body +z.
+pub(crate) fn level_sample(n: u32) -> RawSample {
+    still_sample(n, [0.0, 0.0, STANDARD_GRAVITY_M_S2])
+}
+
+/// A level probe turning about body z (up) at `deg_s`, sample `n`.
+pub(crate) fn level_turning_sample(n: u32, deg_s: f32) -> RawSample {
+    turning_sample(
+        n,
+        [0.0, 0.0, STANDARD_GRAVITY_M_S2],
+        [0.0, 0.0, deg_s.to_radians()],
+    )
+}
+
+/// A navigator at the paper's site that has aligned on level still
+/// samples and navigates.
+pub(crate) fn aligned_navigator() -> Navigator {
+    let mut navigator = Navigator::new(Position::paper_site());
+    for n in 0..=ALL_ALIGNMENT {
+        navigator.step(&level_sample(n));
+    }
+    assert!(navigator.is_navigating());
+    navigator
 }
