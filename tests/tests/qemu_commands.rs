@@ -47,9 +47,9 @@ use system_tests::{build_firmware_for, require_qemu, wait_or_kill};
 /// Simulated seconds the probe streams before it ends its run.
 const RUN_SECONDS: u32 = 20;
 /// Samples after which the surface starts surveying: the 5 s coarse
-/// alignment and the fine alignment's first second
-/// (`navigator::commands::MIN_FINE_ALIGNMENT_SAMPLES`), with 0.5 s spare.
-const SURVEY_AT_SAMPLE: u32 = 130;
+/// alignment and the fine alignment's first 1.95 s
+/// (`navigator::commands::MIN_FINE_ALIGNMENT_SAMPLES`), with 0.55 s spare.
+const SURVEY_AT_SAMPLE: u32 = 150;
 const DWELL_S: u16 = 3;
 /// Only a hang reaches these.
 const REPLY_TIMEOUT: Duration = Duration::from_secs(3);
@@ -219,7 +219,7 @@ fn the_qemu_probe_starts_surveying_reports_a_dwell_and_takes_a_station_on_reques
         "{reply:?}"
     );
 
-    // 2: start surveying after the fine alignment's first second.
+    // 2: start surveying once the fine alignment may end.
     link.wait_for(FRAME_TIMEOUT, |s| {
         matches!(s, Seen::Raw(c) if *c >= SURVEY_AT_SAMPLE).then_some(())
     });

@@ -39,8 +39,12 @@ use crate::protocol::StationSurvey;
 use crate::timing::SAMPLE_INTERVAL_S;
 
 /// The fewest fine-alignment samples after which "start surveying" ends
-/// the fine alignment: 1 s, one still-detector window of zero-velocity
-/// updates, so the filter has been aided before it runs free. The tilt
+/// the fine alignment: the still detector's delay (1.95 s) of
+/// zero-velocity updates, so the filter has been aided before it runs
+/// free and the detector (which runs through the fine alignment) knows
+/// from the first navigating cycle whether the probe is still (a probe
+/// judged moving lets its roll follow the accelerometer roll, with its
+/// noise in the roll's variance). The tilt
 /// needs no more: the coarse levelling already sits on the
 /// accelerometer-bias floor (derivation section 3b; measured on the
 /// navigator's still samples, roll sigma 0.0610 deg at the first fine
@@ -48,7 +52,7 @@ use crate::timing::SAMPLE_INTERVAL_S;
 /// rest would add is the gyrocompassed heading's refinement, which the
 /// frames' azimuth sigma reports (undetermined beyond 10 deg): ending
 /// early costs azimuth accuracy, honestly shown, not honesty.
-pub const MIN_FINE_ALIGNMENT_SAMPLES: u32 = 20;
+pub const MIN_FINE_ALIGNMENT_SAMPLES: u32 = DETECTION_DELAY_SAMPLES;
 
 /// The smallest toolface change (rad) that makes a still period a new
 /// indexing dwell: 5 deg, half the finest spacing the command allows (36
@@ -128,6 +132,10 @@ impl Navigator {
         self.filter.start_navigation();
         // The roll-derived tool-axis rate starts from the next sample on.
         self.input = crate::mechanization::ProbeInput::new();
+        // The fine alignment held the roll as at rest: should the first
+        // navigating cycle find the probe moving, its roll offset goes
+        // into the variance as after any still period.
+        self.was_still = true;
         self.phase = Phase::Navigating;
     }
 

@@ -127,8 +127,15 @@ fn a_station_is_taken_only_while_still_and_sent_once_per_still_period() {
     }
     // Sent at sample 600 of the still period: the survey of the older of
     // its last two checkpoints, flagged; a repeat sends the same frame.
+    // (Station 1 is the window's, the still cycle at the alignment's end,
+    // sent when the probe first turned.)
+    let window = sent.remove(0);
+    assert_eq!(
+        (window.0, window.1.station, window.1.start_sample),
+        (start, 1, ALL_ALIGNMENT)
+    );
     let first = requested[0];
-    assert_eq!(first.station, 1);
+    assert_eq!(first.station, 2);
     assert_eq!(
         first.flags & station_flags::REQUESTED,
         station_flags::REQUESTED
@@ -145,7 +152,7 @@ fn a_station_is_taken_only_while_still_and_sent_once_per_still_period() {
     // The next still period's station is its own.
     let n = still_to + 500;
     let next = navigator.take_station_now().expect("still again");
-    assert_eq!(next.station, 2);
+    assert_eq!(next.station, 3);
     assert!(next.start_sample > still_to && next.end_sample < n);
 }
 
@@ -174,7 +181,9 @@ fn toolface_indexing_reports_each_new_dwell_and_ends_after_the_last() {
         }
         roll = to_roll;
     };
-    run(&mut navigator, 20, 0.0, 3.0); // moving: no station yet
+    // moving: the window's station (the still cycle at the alignment's
+    // end) goes out
+    run(&mut navigator, 20, 0.0, 3.0);
     assert_eq!(navigator.index_toolface(procedure), Ok(()));
     let dwell = 4 * 20;
     // Position 1 (the toolface it is at), then a roll of 45 deg at 10 deg/s.
@@ -212,12 +221,15 @@ fn toolface_indexing_reports_each_new_dwell_and_ends_after_the_last() {
         assert!(error.abs() < 3.0 * sigma, "dwell {k}: {error} vs {sigma}");
         assert!((k as f64 * 45.0 * DEG - roll).abs() < 1e-9);
     }
-    // Every still period sent one frame: the three dwells, the pause and
-    // the fourth position as ordinary stations when they ended.
+    // Every still period sent one frame: the window's, the three dwells,
+    // the pause and the fourth position as ordinary stations when they
+    // ended.
     let numbers: Vec<u16> = frames.iter().map(|(_, s, _)| s.station).collect();
-    assert_eq!(numbers, [1, 2, 3, 4, 5], "{frames:?}");
-    assert_eq!(frames[2].1.flags & station_flags::INDEXING_DWELL, 0);
-    assert_eq!(frames[4].1.flags & station_flags::INDEXING_DWELL, 0);
+    assert_eq!(numbers, [1, 2, 3, 4, 5, 6], "{frames:?}");
+    assert_eq!(frames[0].1.start_sample, ALL_ALIGNMENT);
+    for k in [0, 3, 5] {
+        assert_eq!(frames[k].1.flags & station_flags::INDEXING_DWELL, 0);
+    }
 }
 
 #[test]

@@ -641,9 +641,18 @@ impl Navigator {
         }
         // Judged on the sample as measured (before the missing gyro's
         // stand-in): with one part out a turn about its axis would not be
-        // seen, so stillness is judged on full samples only.
+        // seen, so stillness is judged on full samples only. Judged in the
+        // fine alignment too, so a probe still at its end navigates on as
+        // still from the first cycle: before, the detector's 1.95 s delay
+        // made those cycles "moving", whose roll follows the accelerometer
+        // roll (~0.3 deg of noise per sample) while its sigma stayed the
+        // levelling's 0.06 deg; the rate gyrocompass then read the
+        // unmodelled roll error (a tilt of the vertical earth rate into
+        // the x and z gyros) as heading and inclination: the window
+        // station's inclination came out 0.085 deg RMS against a 0.047 deg
+        // sigma with a navigation-grade gyro (docs/lateral-study.md).
         let still = match (&self.phase, missing_gyro) {
-            (Phase::Navigating, None) => self.still.update(&sample),
+            (Phase::Fine { .. } | Phase::Navigating, None) => self.still.update(&sample),
             _ => {
                 self.still.reset();
                 false
@@ -1062,7 +1071,8 @@ impl Navigator {
         self.coasting = false;
         self.coarse_single_part = false;
         self.drilled_since_station = false;
-        self.was_still = false;
+        // `was_still` is kept: the roll is the levelling's, held as at the
+        // end of the fine alignment (`enter_navigation`).
         self.drilling_cycles = 0;
         self.last_roll_turn = None;
         self.rest_accel_bias = None;

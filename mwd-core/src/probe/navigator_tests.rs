@@ -293,6 +293,43 @@ fn with_part_1_dead_from_boot_the_healthy_part_levels_and_navigates() {
     );
 }
 
+/// A probe still through the end of its fine alignment is still from its
+/// first navigating cycle on (the still detector ran through the fine
+/// alignment): a zero-velocity update and the roll held, where the
+/// detector's delay used to make ~2 s of "moving" cycles whose roll
+/// followed the accelerometer roll's noise unmodelled.
+#[test]
+fn a_probe_still_at_the_end_of_its_fine_alignment_navigates_on_as_still() {
+    let mut navigator = aligned_navigator();
+    let both = nav_flags::STILL | nav_flags::ZUPT_APPLIED;
+    for n in ALL_ALIGNMENT + 1..ALL_ALIGNMENT + 1 + DETECTION_DELAY_SAMPLES {
+        let s = navigator.step(&level_sample(n));
+        assert_eq!(s.flags & both, both, "sample {n}: {s:?}");
+    }
+}
+
+/// One that moves from its first navigating cycle on: the fine alignment
+/// held its roll as at rest, so, as after any still period, its offset
+/// from the accelerometer roll and two samples' roll noise go into the
+/// roll's variance when it starts to follow the accelerometer roll (the
+/// non-holonomic updates of the cycles after take it down again: a roll
+/// error tilts gravity into the cross-axis velocity they hold at zero).
+#[test]
+fn a_probe_moving_from_its_first_navigating_cycle_gets_the_roll_variance() {
+    let mut navigator = aligned_navigator();
+    let before = navigator.filter().euler_std().x;
+    let s = navigator.step(&level_turning_sample(ALL_ALIGNMENT + 1, 3.0));
+    assert_eq!(s.flags & nav_flags::STILL, 0, "{s:?}");
+    let after = navigator.filter().euler_std().x;
+    // sqrt(2) single-sample roll sigmas (0.48 deg) against the
+    // levelling's ~0.07 deg
+    let expected = SINGLE_SAMPLE_ROLL_SIGMA_RAD * core::f64::consts::SQRT_2;
+    assert!(
+        after > 0.9 * expected && after > 5.0 * before,
+        "roll sigma {before} -> {after} rad"
+    );
+}
+
 /// Navigating, a probe that turns, stops for a minute and turns again:
 /// zero-velocity updates from the still detector's delay on, and one
 /// station survey when it moves, with the attitude of the last still
@@ -348,10 +385,18 @@ fn a_stop_in_navigation_gives_zero_updates_and_one_station() {
             "{moving_end:?} -> {last_still:?}"
         );
     }
-    assert_eq!(stations.len(), 1, "{stations:?}");
-    let (sent_at, st) = stations[0];
+    // Station 1 is the window's: the still cycle at the alignment's end
+    // (the detector ran through the fine alignment), sent when the probe
+    // first turned.
+    assert_eq!(stations.len(), 2, "{stations:?}");
+    let (window_at, window) = stations[0];
+    assert_eq!(
+        (window_at, window.station, window.start_sample),
+        (start, 1, ALL_ALIGNMENT)
+    );
+    let (sent_at, st) = stations[1];
     assert_eq!(sent_at, still_to, "sent with the first moving sample");
-    assert_eq!(st.station, 1);
+    assert_eq!(st.station, 2);
     let first_zupt = still_from + DETECTION_DELAY_SAMPLES - 1;
     assert_eq!(st.start_sample, first_zupt);
     // The older of the last two checkpoints (`SURVEY_SETTLE_EPOCHS`).
@@ -421,9 +466,9 @@ fn a_long_stop_is_sent_at_the_longest_station_and_once() {
     // station while the probe was still still; nothing when it moved.
     assert_eq!(stations.len(), 1, "{stations:?}");
     let (at, first) = stations[0];
-    // The detector's window began with the last aligned sample, the
-    // first one navigated.
-    let first_zupt = ALL_ALIGNMENT + DETECTION_DELAY_SAMPLES - 1;
+    // Still from the first navigated sample on: the detector ran through
+    // the fine alignment.
+    let first_zupt = ALL_ALIGNMENT;
     assert_eq!(at, first_zupt + MAX_STATION_SAMPLES - 1);
     assert_eq!(
         (first.station, first.start_sample, first.end_sample),
