@@ -218,13 +218,26 @@ fn a_replay_takes_the_jobs_site_and_calibration() {
 
 /// A job's still settings reach the replay's navigator: the defaults
 /// written out give the same solutions as no settings (to the bit, as the
-/// probe's parity check needs), a longer entering delay others. 70 s: the
-/// 60 s alignment, then a still probe's first station.
+/// probe's parity check needs), a longer entering delay others. A
+/// toolface turn after the 60 s alignment, then the still period whose
+/// detection the delay shifts (the probe still through the alignment's end
+/// is still from its first navigating cycle, whatever the delay).
 #[test]
 fn a_replay_takes_the_jobs_still_settings() {
     let dir = scratch("still");
     let capture = dir.join("run.bin");
-    ok(&["simulate", "--duration", "70", "-o", s(&capture)], 0);
+    let simulate = [
+        "simulate",
+        "--motion",
+        "toolface",
+        "--dwell",
+        "62",
+        "--step",
+        "90",
+        "--duration",
+        "127",
+    ];
+    ok(&[&simulate[..], &["-o", s(&capture)]].concat(), 0);
     let still = |epochs: u32| {
         format!(
             r#", "still": {{"z_enter": 3.09, "z_stay": 5.199, "enter_epochs": {epochs},

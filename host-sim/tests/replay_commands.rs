@@ -194,13 +194,14 @@ fn replayed(bytes: &[u8], uplink: Option<&[u8]>) -> Replayer {
     replayer
 }
 
-/// Start surveying after sample 130 (the 5 s coarse alignment and 1.5 s of
-/// the fine one), then a station on request: the probe navigates from
-/// sample 131, 69 s before the full alignment would have ended.
+/// Start surveying after sample 150 (the 5 s coarse alignment and 2.5 s of
+/// the fine one, which start surveying may end after the still detector's
+/// 1.95 s), then a station on request: the probe navigates from sample
+/// 151, 52 s before the full alignment would have ended.
 fn early_survey() -> Vec<(u32, Command)> {
     vec![
         (40, Command::StartSurveying), // coarse alignment: NAK not ready
-        (130, Command::StartSurveying),
+        (150, Command::StartSurveying),
         (400, Command::TakeStation),
     ]
 }
@@ -211,8 +212,8 @@ fn an_early_start_surveying_and_a_requested_station_replay_bit_for_bit() {
         let mut probe = Probe::new();
         probe.run(500, lag, &early_survey());
         let (bytes, sent, _) = probe.bytes();
-        assert!(sent.contains(&Sent::Nav(131, nav_mode::NAVIGATING)));
-        assert!(sent.contains(&Sent::Nav(130, nav_mode::FINE_ALIGNMENT)));
+        assert!(sent.contains(&Sent::Nav(151, nav_mode::NAVIGATING)));
+        assert!(sent.contains(&Sent::Nav(150, nav_mode::FINE_ALIGNMENT)));
         let requested = sent
             .iter()
             .filter(|s| matches!(s, Sent::Station(st) if st.flags & station_flags::REQUESTED != 0))
@@ -229,7 +230,7 @@ fn an_early_start_surveying_and_a_requested_station_replay_bit_for_bit() {
             outcomes,
             [
                 (Some(40), CommandOutcome::Refused),
-                (Some(130), CommandOutcome::Replayed),
+                (Some(150), CommandOutcome::Replayed),
                 (Some(400), CommandOutcome::Replayed),
             ],
             "lag {lag}"
@@ -251,7 +252,7 @@ fn an_early_start_surveying_and_a_requested_station_replay_bit_for_bit() {
             (500, 0, 0),
             "lag {lag}"
         );
-        assert_eq!(rows[131].solution.mode, nav_mode::NAVIGATING);
+        assert_eq!(rows[151].solution.mode, nav_mode::NAVIGATING);
     }
 }
 
@@ -264,7 +265,7 @@ fn a_replay_without_the_replies_never_shows_silent_parity() {
     assert_eq!(capture.replies.len(), 3);
     // The telemetry frames alone (the replies' sequence numbers missing):
     // the 60 s alignment is assumed, and the probe navigating from sample
-    // 131 says a reply was probably lost.
+    // 151 says a reply was probably lost.
     let mut replayer = Replayer::new(Position::paper_site());
     capture.frames.iter().for_each(|f| {
         replayer.push(f);
@@ -279,7 +280,7 @@ fn a_replay_without_the_replies_never_shows_silent_parity() {
     let (_, summary) = replayer.finish();
     assert_eq!(
         (summary.matched, summary.mismatched, summary.unchecked),
-        (131, 0, 369)
+        (151, 0, 349)
     );
     // The same reply read as a NAK, nothing lost: a difference.
     capture.replies[1].reply.status = ReplyStatus::Nak(NakReason::NotReady);
@@ -290,12 +291,12 @@ fn a_replay_without_the_replies_never_shows_silent_parity() {
     let loss = replayer.step_losses()[0];
     assert!(loss.reason.is_a_difference(), "{loss:?}");
     let (_, summary) = replayer.finish();
-    assert_eq!((summary.matched, summary.mismatched), (131, 1));
+    assert_eq!((summary.matched, summary.mismatched), (151, 1));
 }
 
 #[test]
 fn a_realign_replays_and_one_with_a_new_site_is_not_compared_after_it() {
-    let realign = [(130, Command::StartSurveying), (300, Command::Realign)];
+    let realign = [(150, Command::StartSurveying), (300, Command::Realign)];
     let mut probe = Probe::new();
     probe.run(450, 1, &realign);
     let (bytes, sent, _) = probe.bytes();
@@ -375,7 +376,7 @@ fn a_lost_reply_shows_as_a_mode_the_replay_is_not_in_never_as_silent_parity() {
     assert_eq!(
         losses,
         [(
-            131,
+            151,
             StepLossReason::ModeDiffers {
                 probe_mode: nav_mode::NAVIGATING,
                 replay_mode: nav_mode::FINE_ALIGNMENT,
@@ -386,7 +387,7 @@ fn a_lost_reply_shows_as_a_mode_the_replay_is_not_in_never_as_silent_parity() {
     let (_, summary) = replayer.finish();
     assert_eq!(
         (summary.matched, summary.mismatched, summary.unchecked),
-        (131, 0, 369)
+        (151, 0, 349)
     );
 }
 
@@ -396,7 +397,7 @@ fn a_lost_reply_to_take_a_station_is_not_called_a_difference() {
     // Still until sample 600, then turning: the still period's station is
     // sent on request at 400, and its end sends nothing more.
     probe.turning_from = Some(600);
-    let commands = [(130, Command::StartSurveying), (400, Command::TakeStation)];
+    let commands = [(150, Command::StartSurveying), (400, Command::TakeStation)];
     probe.run(700, 1, &commands);
     let (bytes, sent, _) = probe.bytes();
     let mut whole = replayed(&bytes, None);
@@ -431,24 +432,24 @@ fn a_lost_reply_to_take_a_station_is_not_called_a_difference() {
 #[test]
 fn a_command_whose_place_was_lost_is_not_guessed() {
     let mut probe = Probe::new();
-    probe.run(300, 0, &[(130, Command::StartSurveying)]);
+    probe.run(300, 0, &[(150, Command::StartSurveying)]);
     let (bytes, sent, _) = probe.bytes();
     // The navigation frame right before the ACK: the replay knows the
-    // command came after sample 129's, not whether after 130's too.
+    // command came after sample 149's, not whether after 150's too.
     let nav = sent
         .iter()
-        .position(|s| *s == Sent::Nav(130, nav_mode::FINE_ALIGNMENT))
+        .position(|s| *s == Sent::Nav(150, nav_mode::FINE_ALIGNMENT))
         .unwrap();
     assert_eq!(nav + 1, reply_index(&sent, 1));
     let replayer = replayed(&capture::without_frame(&bytes, nav), None);
-    assert_eq!(replayer.commands()[0].after_sample, Some(129));
+    assert_eq!(replayer.commands()[0].after_sample, Some(149));
     assert!(!replayer.commands()[0].place_known);
     assert_eq!(
         replayer.step_losses()[0].reason,
         StepLossReason::CommandPlaceUnknown { command_seq: 1 }
     );
     let (_, summary) = replayer.finish();
-    assert_eq!((summary.matched, summary.mismatched), (130, 0));
+    assert_eq!((summary.matched, summary.mismatched), (150, 0));
 }
 
 /// Toolface indexing (2 positions of 3 s) on the still probe: its first
@@ -459,8 +460,8 @@ fn indexing() -> Vec<(u32, Command)> {
         dwell_s: 3,
     };
     vec![
-        (130, Command::StartSurveying),
-        (140, Command::IndexToolface(procedure)),
+        (150, Command::StartSurveying),
+        (160, Command::IndexToolface(procedure)),
         (400, Command::TakeStation),
     ]
 }
@@ -513,7 +514,7 @@ fn the_cli_replays_the_commands_and_exits_by_what_it_could_compare() {
     assert_eq!(full.code, Some(0), "{}{}", full.stdout, full.stderr);
     assert!(
         full.stdout
-            .contains("command 1 start surveying ACK: replayed after sample 130"),
+            .contains("command 1 start surveying ACK: replayed after sample 150"),
         "{}",
         full.stdout
     );
