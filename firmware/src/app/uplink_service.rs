@@ -223,7 +223,9 @@ mod tests {
         encode_command, Command, IndexingProcedure, Reply, MAX_COMMAND_WIRE_LEN,
     };
     use mwd_core::protocol::{Decoder, RawPart, RawSample};
-    use mwd_core::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
+    use mwd_core::sensor_units::{
+        m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
+    };
     use std::vec::Vec;
 
     /// A UART that sends at once everything queued.
@@ -277,11 +279,13 @@ mod tests {
         Navigator::new(Position::paper_site())
     }
 
-    /// A still, level probe's sample `n` (no earth rate).
-    fn still(n: u32) -> RawSample {
+    /// A level probe's sample `n` (no earth rate), turning about the
+    /// vertical at `rate` (rad/s).
+    fn level(n: u32, rate: f32) -> RawSample {
         let force = [0.0, 0.0, STANDARD_GRAVITY_M_S2];
         let parts = PART_MOUNTINGS.map(|mounting| RawPart {
             accel: mounting.body_to_sensor(force).map(m_s2_to_accel_count),
+            gyro_rate: rad_s_to_gyro_count(mounting.gyro_rate_from_body([0.0, 0.0, rate])),
             flags: raw_flags::GYRO_VALID | raw_flags::ACCEL_VALID,
             ..RawPart::default()
         });
@@ -290,6 +294,11 @@ mod tests {
             sample_counter: n,
             parts,
         }
+    }
+
+    /// A still, level probe's sample `n`.
+    fn still(n: u32) -> RawSample {
+        level(n, 0.0)
     }
 
     fn command(seq: u16, command: &Command) -> Vec<u8> {
@@ -394,9 +403,11 @@ mod tests {
         let sent = send(3, &Command::StartSurveying, &mut navigator);
         assert_eq!(status(&sent), ReplyStatus::Ack);
         assert!(navigator.is_navigating());
-        // Navigating, but the still detector has not seen a second yet.
+        // Navigating and still from its first cycle (the still detector
+        // ran through the fine alignment); then turning: not still.
         navigator.step(&still(n));
-        n += 1;
+        navigator.step(&level(n + 1, 0.05));
+        n += 2;
         let sent = send(4, &Command::TakeStation, &mut navigator);
         assert_eq!(status(&sent), nak(NakReason::NotStill));
         for _ in 0..100 {
@@ -407,7 +418,9 @@ mod tests {
         match sent.as_slice() {
             [Sent::Reply(r), Sent::Station(s)] => {
                 assert_eq!((r.command_seq, r.status), (5, ReplyStatus::Ack));
-                assert_eq!(s.station, 1);
+                // (station 1: the one still cycle before the turn, not
+                // taken from the navigator here: not this still period's)
+                assert_eq!(s.station, 2);
                 assert_ne!(s.flags & station_flags::REQUESTED, 0, "{s:?}");
             }
             other => panic!("{other:?}"),

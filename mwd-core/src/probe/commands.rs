@@ -191,8 +191,12 @@ impl Navigator {
             match self.commands.sent {
                 // Already sent by request or as a dwell.
                 Some(sent) if sent.station == finished.station => self.finished_station = None,
-                // Sent at the longest station: a request repeats it.
-                _ if still => self.commands.sent = Some(finished),
+                // Sent at the longest station: a request repeats it (a
+                // still period's end still waiting to be taken is not
+                // this one's).
+                _ if still && finished.flags & station_flags::MAX_DURATION != 0 => {
+                    self.commands.sent = Some(finished)
+                }
                 _ => {}
             }
         }
