@@ -357,4 +357,25 @@ fn an_invalid_variance_gives_a_nan_sigma_and_fails_the_health_check() {
     assert!(kf.covariance_is_healthy(1e6));
     // Growth beyond the bound.
     assert!(!kf.covariance_is_healthy(8.0));
+    // A NaN correlation is not a healthy one.
+    kf.p[(0, 2)] = f32::NAN;
+    kf.p[(2, 0)] = f32::NAN;
+    assert!(!kf.covariance_is_healthy(1e6));
+}
+
+/// A quiet gyro's states have variances of 1e-20 and below, whose
+/// products are below f32's smallest normal number: the check must still
+/// tell a correlation beyond 1 from one within it.
+#[test]
+fn the_health_check_judges_tiny_variances_as_it_judges_large_ones() {
+    let mut kf = KalmanFilter::<f32, 3>::from_diagonal(&SVector::from([1e-22, 4e-24, 1.0]));
+    // sqrt(1e-22) sqrt(4e-24); the product of the variances, 4e-46, is 0
+    // in f32, and so is the square of any such correlation.
+    let bound = 1e-11f32 * 2e-12;
+    kf.p[(0, 1)] = 0.999 * bound;
+    kf.p[(1, 0)] = 0.999 * bound;
+    assert!(kf.covariance_is_healthy(1e6));
+    kf.p[(0, 1)] = -1.01 * bound;
+    kf.p[(1, 0)] = -1.01 * bound;
+    assert!(!kf.covariance_is_healthy(1e6));
 }
