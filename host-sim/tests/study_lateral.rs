@@ -5,7 +5,7 @@ mod common;
 
 use common::{refused, run, s, scratch};
 use host_sim::sim::Plan;
-use host_sim::study::drilling_run::{self, RunConfig, RunOutcome};
+use host_sim::study::drilling_run::{self, RunConfig, RunOutcome, Scalar};
 use host_sim::study::grade::Grade;
 use host_sim::study::lateral::{study, StudyConfig, Well};
 use mwd_core::sensor_noise::ImuNoise;
@@ -85,6 +85,7 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
         tie_in_azimuth_sigma: 0.5f64.to_radians(),
         monte_carlo: true,
         sweep: None,
+        scalar: Scalar::F64,
     };
     let calls = std::sync::atomic::AtomicUsize::new(0);
     let result = study(&config, &|| {

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use host_sim::sim::plan::Vibration;
 use host_sim::sim::Plan;
 use host_sim::study::drilling_coverage::{study, table};
-use host_sim::study::drilling_run::RunConfig;
+use host_sim::study::drilling_run::{RunConfig, Scalar};
 use host_sim::study::grade::Grade;
 use std::path::PathBuf;
 
@@ -54,6 +54,10 @@ pub struct CoverageArgs {
     /// deterministic errors (as `simulate`'s captures and the QEMU probe).
     #[arg(long)]
     pub uncalibrated: bool,
+    /// The navigator filter's scalar: f32 computes as the probe does (this
+    /// study stands for it); f64 is faster on x86 hosts.
+    #[arg(long, value_enum, default_value = "f32")]
+    pub scalar: Scalar,
     /// Write the summary here (JSON).
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -80,6 +84,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         Grade::scc1300()?,
     )?;
     config.uncalibrated = args.uncalibrated;
+    config.scalar = args.scalar;
     let threads = args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |t| t as usize,
@@ -98,12 +103,13 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     );
     bar.finish_and_clear();
     outln!(
-        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads{})",
+        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads, filter {}{})",
         args.plan.display(),
         args.runs,
         args.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
+        args.scalar.name(),
         if args.uncalibrated {
             ", uncalibrated"
         } else {

@@ -4,6 +4,7 @@
 
 use super::limits::number_in;
 use anyhow::{Context, Result};
+use host_sim::study::drilling_run::Scalar;
 use host_sim::study::grade;
 use host_sim::study::lateral::{study, DrillingOverrides, StudyConfig, Well};
 use host_sim::study::lateral_covariance::SweepGrid;
@@ -89,6 +90,10 @@ pub struct LateralArgs {
     /// log-spaced values of each.
     #[arg(long, value_parser = clap::value_parser!(u64).range(2..=20))]
     pub sweep: Option<u64>,
+    /// The navigator filter's scalar: f64 gives the probe's f32 figures
+    /// (docs/lateral-study.md), faster on x86 hosts.
+    #[arg(long, value_enum, default_value = "f64")]
+    pub scalar: Scalar,
 }
 
 pub fn run(args: LateralArgs) -> Result<()> {
@@ -127,6 +132,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
         tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
         monte_carlo: !args.covariance_only,
         sweep: args.sweep.map(|n| SweepGrid::default_grid(n as usize)),
+        scalar: args.scalar,
     };
     let pairs = (config.grades.len() * config.wells.len()) as u64;
     let sweep_points = args.sweep.map_or(0, |n| n * n) * config.wells.len() as u64;
@@ -144,13 +150,14 @@ pub fn run(args: LateralArgs) -> Result<()> {
     let names: Vec<&str> = config.grades.iter().map(|g| g.name()).collect();
     let wells: Vec<&str> = config.wells.iter().map(|w| w.label.as_str()).collect();
     outln!(
-        "lateral study: grades {}; wells {}; {} runs each from seed {}; tie-in azimuth sigma {} deg; {} threads; {:.1} s",
+        "lateral study: grades {}; wells {}; {} runs each from seed {}; tie-in azimuth sigma {} deg; {} threads; filter {}; {:.1} s",
         names.join(", "),
         wells.join(", "),
         runs,
         args.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
+        args.scalar.name(),
         result.wall_s
     );
     out!("{}", table(&result));

@@ -8,7 +8,7 @@
 //! met. Summaries are in [`super::lateral_summary`], tables and CSV in
 //! [`super::lateral_table`].
 
-use super::drilling_run::{run, RunConfig, RunOutcome};
+use super::drilling_run::{run, RunConfig, RunOutcome, Scalar};
 use super::grade::Grade;
 use super::lateral_covariance::{
     agreement, predict, Agreement, CovariancePrediction, SweepGrid, SweepResult,
@@ -106,6 +106,8 @@ pub struct StudyConfig {
     /// A sweep of the first grade's gyro bias and ARW on each well
     /// (covariance analysis).
     pub sweep: Option<SweepGrid>,
+    /// The navigator's filter scalar in every run.
+    pub scalar: Scalar,
 }
 
 /// A grade as the output lists it.
@@ -134,6 +136,8 @@ pub struct LateralStudy {
     pub first_seed: u64,
     pub threads: usize,
     pub tie_in_azimuth_sigma_deg: f64,
+    /// The navigator's filter scalar.
+    pub filter_scalar: Scalar,
     pub wall_s: f64,
     pub grades: Vec<GradeInfo>,
     pub wells: Vec<WellInfo>,
@@ -180,11 +184,14 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
     let mut configs = Vec::new();
     for grade in &config.grades {
         for well in &config.wells {
-            configs.push(RunConfig::new(
-                well.plan.clone(),
-                config.tie_in_azimuth_sigma,
-                grade.clone(),
-            )?);
+            configs.push(RunConfig {
+                scalar: config.scalar,
+                ..RunConfig::new(
+                    well.plan.clone(),
+                    config.tie_in_azimuth_sigma,
+                    grade.clone(),
+                )?
+            });
         }
     }
     let jobs = job_list(config, &configs)?;
@@ -298,6 +305,7 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
         first_seed: config.first_seed,
         threads: config.threads,
         tie_in_azimuth_sigma_deg: config.tie_in_azimuth_sigma.to_degrees(),
+        filter_scalar: config.scalar,
         wall_s: started.elapsed().as_secs_f64(),
         grades: config
             .grades

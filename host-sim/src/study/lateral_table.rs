@@ -461,6 +461,7 @@ fn csv_field(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::drilling_run::Scalar;
     use crate::study::lateral_summary::summarise;
 
     fn study() -> LateralStudy {
@@ -469,6 +470,7 @@ mod tests {
             first_seed: 1,
             threads: 1,
             tie_in_azimuth_sigma_deg: 0.5,
+            filter_scalar: Scalar::F64,
             wall_s: 1.0,
             grades: Vec::new(),
             wells: Vec::new(),

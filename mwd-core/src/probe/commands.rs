@@ -32,6 +32,7 @@
 
 use super::{Navigator, Phase, Station};
 use crate::conventions::{wrap_pi, DEG};
+use crate::kalman::FilterScalar;
 use crate::probe::still::DETECTION_DELAY_SAMPLES;
 use crate::protocol::frame::station_flags;
 use crate::protocol::uplink::IndexingProcedure;
@@ -109,7 +110,7 @@ impl Station {
     }
 }
 
-impl Navigator {
+impl<T: FilterScalar> Navigator<T> {
     /// Uplink "start surveying": ends the fine alignment now (see the
     /// module's notes). `Ok` when the probe navigates after it.
     pub fn start_surveying(&mut self) -> Result<(), Refusal> {

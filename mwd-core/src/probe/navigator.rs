@@ -65,7 +65,7 @@ use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
 use crate::fine_alignment::{
     AccelBiasSnapshot, FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior,
 };
-use crate::kalman::UpdateReport;
+use crate::kalman::{FilterScalar, UpdateReport};
 use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
@@ -78,8 +78,11 @@ use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S
 use nalgebra::UnitQuaternion;
 use nalgebra::{Matrix3, Vector3};
 
-/// The probe's filter: f32 (the M4F's FPU), 39 states.
-type Filter = FineAlignment<f32, STATES_WITH_BIASES>;
+/// The navigator's filter, 39 states, in scalar `T`: f32 on the probe
+/// (the M4F's FPU is single precision; the host's replay takes f32 too, to
+/// reproduce the probe bit for bit), f64 in the host's Monte Carlo
+/// studies, where it is faster on x86 and gives the same figures.
+type Filter<T> = FineAlignment<T, STATES_WITH_BIASES>;
 
 /// The largest roll or pitch 1-sigma (rad) for which the solution is
 /// valid: the error model is linear in the attitude error phi
@@ -98,7 +101,8 @@ pub const TILT_SIGMA_LIMIT_RAD: f64 = 3.0 * DEG;
 /// lose the small entries to the rounding of the large ones (f32: 24-bit
 /// mantissa; docs/filter-derivation.md section 5b), so
 /// the check stops it before that rather than report what the roundings
-/// made.
+/// made. An f64 filter is held to the same bound, so it stops where the
+/// probe would.
 pub const VARIANCE_LIMIT: f32 = 1e16;
 
 /// The rate (rad/s) a sample the probe did not measure may be off by: a
@@ -240,8 +244,9 @@ struct Station {
     gyro_epochs: u32,
 }
 
-/// The probe's navigation, one raw sample at a time.
-pub struct Navigator {
+/// The probe's navigation, one raw sample at a time, with its filter in
+/// scalar `T`: the probe's f32 unless told otherwise (see `Filter`).
+pub struct Navigator<T: FilterScalar = f32> {
     position: Position,
     calibration: ProbeCalibration,
     /// The sensors' error budget the filter and the aiding sources model
@@ -251,7 +256,7 @@ pub struct Navigator {
     /// Idle until the coarse alignment ends, then restarted in place from
     /// it: the filter is the probe's largest object (6 KiB of covariance),
     /// and every move of it would be another copy on the stack.
-    filter: Filter,
+    filter: Filter<T>,
     /// The mechanization's input (the tool-axis rate's estimator).
     input: ProbeInput,
     /// 1-sigma of roll, pitch, heading from the coarse alignment (rad),
@@ -314,6 +319,10 @@ pub struct Navigator {
     commands: commands::CommandState,
 }
 
+/// The probe's constructors, f32: on the default type itself, so that
+/// `Navigator::new(..)` needs no annotation (a default type parameter does
+/// not steer inference); another scalar's navigator comes from
+/// [`Navigator::calibrated`].
 impl Navigator {
     /// A navigator for a probe at `position` with uncalibrated sensors.
     pub fn new(position: Position) -> Self {
@@ -332,6 +341,14 @@ impl Navigator {
         navigator
     }
 
+    /// A navigator that corrects every sample with `calibration`, with the
+    /// default still settings.
+    pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
+        Self::calibrated(position, calibration)
+    }
+}
+
+impl<T: FilterScalar> Navigator<T> {
     /// Takes the still detector's and the station's `settings` (the
     /// uplink's, range-checked when decoded): the detector's thresholds are
     /// derived here, once, not per sample. For a navigator that has not
@@ -345,9 +362,9 @@ impl Navigator {
         self.station_zupt_variance = station_zupt_variance(settings.zupt_velocity_sigma);
     }
 
-    /// A navigator that corrects every sample with `calibration`, with the
-    /// default still settings.
-    pub fn with_calibration(position: Position, calibration: ProbeCalibration) -> Self {
+    /// [`Navigator::with_calibration`] in filter scalar `T`, e.g.
+    /// `Navigator::<f64>::calibrated(..)` for the host's studies.
+    pub fn calibrated(position: Position, calibration: ProbeCalibration) -> Self {
         let idle = NavState::at_rest(UnitQuaternion::identity(), position);
         let noise = &SCC1300_NOISE;
         Self {
@@ -439,7 +456,8 @@ impl Navigator {
             }
         };
         if self.is_aligned() && !self.covariance_invalid {
-            self.covariance_invalid = !self.filter.filter().covariance_is_healthy(VARIANCE_LIMIT);
+            let limit = T::of(f64::from(VARIANCE_LIMIT));
+            self.covariance_invalid = !self.filter.filter().covariance_is_healthy(limit);
         }
         if let Some(still) = still {
             self.track_station(still);
@@ -576,7 +594,7 @@ impl Navigator {
             &omega,
             GYRO_AXES.map(|axis| long_run_variance(&self.noise.gyro[axis], SAMPLE_INTERVAL_S)),
         );
-        self.filter.aid(&measurement.cast::<f32>());
+        self.filter.aid(&measurement.cast::<T>());
     }
 
     /// The station survey at this cycle: the filter's attitude as drilling
@@ -767,10 +785,10 @@ impl Navigator {
                     // constraint's noise (the misalignment part, 0.5 m/s x
                     // 1 deg; derivation section 4d).
                     let state = filter.state();
-                    let mut cross = NonHolonomic::at(state, DRILLING_VARIANCE as f32);
-                    cross.attitude_row = [[0.0; 3]; 2];
-                    let mut axial = AxialSpeed::at(state, AXIAL_SPEED_VARIANCE as f32);
-                    axial.attitude_row = [0.0; 3];
+                    let mut cross = NonHolonomic::at(state, T::of(DRILLING_VARIANCE));
+                    cross.attitude_row = [[T::zero(); 3]; 2];
+                    let mut axial = AxialSpeed::at(state, T::of(AXIAL_SPEED_VARIANCE));
+                    axial.attitude_row = [T::zero(); 3];
                     filter.aid(&cross);
                     filter.aid(&axial);
                 }
@@ -992,8 +1010,11 @@ impl Navigator {
             solution.flags |= nav_flags::SOLUTION_INVALID;
         }
         let kalman = filter.filter();
-        solution.velocity_std = core::array::from_fn(|i| kalman.std_dev(VEL + i));
-        solution.position_std_ned = core::array::from_fn(|i| kalman.std_dev(POS + i));
+        // The frames' sigmas are f32 whatever the filter's scalar (the wire
+        // protocol's type).
+        let std_dev = |i: usize| kalman.std_dev(i).as_f64() as f32;
+        solution.velocity_std = core::array::from_fn(|i| std_dev(VEL + i));
+        solution.position_std_ned = core::array::from_fn(|i| std_dev(POS + i));
         solution
     }
 
@@ -1052,16 +1073,18 @@ impl Navigator {
         self.filter.start_navigation();
         // Inclination and toolface are fused with the probe's levelling.
         let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&self.filter.state().attitude));
-        let row = |i: usize| [0, 1, 2].map(|k| jacobian[(i, k)] as f32);
+        let row = |i: usize| [0, 1, 2].map(|k| T::of(jacobian[(i, k)]));
         let tilt = TieInTilt {
             rows: [row(0), row(2)],
             innovation: [
-                (angles.inclination - given.inclination) as f32,
-                crate::conventions::wrap_pi(angles.toolface - given.toolface) as f32,
+                T::of(angles.inclination - given.inclination),
+                T::of(crate::conventions::wrap_pi(
+                    angles.toolface - given.toolface,
+                )),
             ],
             variance: [
-                square(sigma.inclination) as f32,
-                square(sigma.toolface) as f32,
+                T::of(square(sigma.inclination)),
+                T::of(square(sigma.toolface)),
             ],
         };
         self.filter.aid(&tilt);
@@ -1116,13 +1139,13 @@ impl Navigator {
         if !self.is_navigating() || self.covariance_invalid {
             return None;
         }
-        let constraint = NonHolonomic::at(self.filter.state(), DRILLING_VARIANCE as f32);
+        let constraint = NonHolonomic::at(self.filter.state(), T::of(DRILLING_VARIANCE));
         Some(self.filter.aid(&constraint))
     }
 
     /// The filter (idle during the coarse alignment): for analysis, e.g.
     /// the covariance behind the frames' sigmas.
-    pub fn filter(&self) -> &FineAlignment<f32, STATES_WITH_BIASES> {
+    pub fn filter(&self) -> &FineAlignment<T, STATES_WITH_BIASES> {
         &self.filter
     }
 
@@ -1146,7 +1169,7 @@ impl Navigator {
             return None;
         }
         let reference =
-            crate::aid_sources::HeadingReference::<f32>::at(self.filter.state(), azimuth, sigma)
+            crate::aid_sources::HeadingReference::<T>::at(self.filter.state(), azimuth, sigma)
                 .ok()?;
         Some(self.filter.aid(&reference))
     }
@@ -1195,16 +1218,20 @@ const GROSS_TOOLFACE_CHI2: f64 = 16.0;
 /// (`aid_sources::DrillingToolface`, derivation section 4g): an update, or
 /// when the roll is grossly off (a toolface turned on bottom) the block's
 /// roll with its variance about the tool axis.
-fn aid_drilling_toolface(filter: &mut Filter, block: &ForceBlock, noise: &ImuNoise) {
+fn aid_drilling_toolface<T: FilterScalar>(
+    filter: &mut Filter<T>,
+    block: &ForceBlock,
+    noise: &ImuNoise,
+) {
     let budget = noise.accel[0];
     let bias_variance = square(budget.residual_bias) + square(budget.bias_instability);
-    let Some(m) = DrillingToolface::<f32>::at(filter.state(), block, bias_variance) else {
+    let Some(m) = DrillingToolface::<T>::at(filter.state(), block, bias_variance) else {
         return;
     };
-    let h = Vector3::from(m.attitude_row.map(f64::from));
-    let variance = f64::from(m.variance);
+    let h = Vector3::from(m.attitude_row.map(T::as_f64));
+    let variance = m.variance.as_f64();
     let innovation_variance = h.dot(&(filter.attitude_error_covariance() * h)) + variance;
-    if square(f64::from(m.toolface_residual)) > GROSS_TOOLFACE_CHI2 * innovation_variance {
+    if square(m.toolface_residual.as_f64()) > GROSS_TOOLFACE_CHI2 * innovation_variance {
         filter.set_roll(m.block_toolface);
         add_tool_axis_variance(filter, variance);
     } else {
@@ -1215,7 +1242,7 @@ fn aid_drilling_toolface(filter: &mut Filter, block: &ForceBlock, noise: &ImuNoi
 /// Adds `variance` (rad^2) to the attitude error about the tool axis (the
 /// roll): the roll the filter holds or follows may be off by more than its
 /// covariance says (an orienter's turn not sensed, a re-roll).
-fn add_tool_axis_variance(filter: &mut Filter, variance: f64) {
+fn add_tool_axis_variance<T: FilterScalar>(filter: &mut Filter<T>, variance: f64) {
     let c_bn = dcm_from_quat(&filter.state().attitude);
     let t: Vector3<f64> = c_bn.column(1).into_owned();
     filter.add_attitude_noise(&(t * t.transpose() * variance));

@@ -486,3 +486,49 @@ fn a_long_stop_is_sent_at_the_longest_station_and_once() {
     assert_eq!(second.station, 2);
     assert_eq!(second.flags & station_flags::MAX_DURATION, 0);
 }
+
+#[test]
+fn an_f64_filter_gives_the_probes_f32_solutions_to_their_rounding() {
+    // The host's studies run the filter in f64 (faster there); the probe
+    // computes in f32. Alignment, a turn (the moving cycles' constraints),
+    // a station (zero-velocity updates, the rate gyrocompass), a turn.
+    let position = Position::paper_site();
+    let mut single = Navigator::new(position);
+    let mut double = Navigator::<f64>::calibrated(position, ProbeCalibration::default());
+    let turn = ALL_ALIGNMENT + 100;
+    let station = turn + 200;
+    let sample = |n| match n {
+        n if n < ALL_ALIGNMENT || (turn..station).contains(&n) => level_sample(n),
+        n => level_turning_sample(n, 2.0),
+    };
+    let (mut worst_angle, mut worst_sigma) = (0f32, 0f32);
+    let mut stations = 0;
+    for n in 0..station + 100 {
+        let (a, b) = (single.step(&sample(n)), double.step(&sample(n)));
+        assert_eq!((a.mode, a.flags), (b.mode, b.flags), "sample {n}");
+        for (x, y) in a.attitude.iter().zip(&b.attitude) {
+            worst_angle = worst_angle.max((x - y).abs());
+        }
+        let sigmas = |s: &NavSolution| [s.attitude_std, s.velocity_std, s.position_std_ned];
+        for (x, y) in sigmas(&a)
+            .as_flattened()
+            .iter()
+            .zip(sigmas(&b).as_flattened())
+        {
+            worst_sigma = worst_sigma.max((x / y - 1.0).abs());
+        }
+        let (x, y) = (single.take_station(), double.take_station());
+        assert_eq!(x.is_some(), y.is_some(), "sample {n}");
+        if let (Some(x), Some(y)) = (x, y) {
+            stations += 1;
+            assert_eq!((x.flags, x.end_sample), (y.flags, y.end_sample));
+            for (p, q) in x.angles.iter().zip(&y.angles) {
+                assert!((p - q).abs() < 1e-5, "{x:?} {y:?}");
+            }
+        }
+    }
+    assert_eq!(stations, 1);
+    // Measured: 1.8e-7 rad and 1.2e-5.
+    assert!(worst_angle < 1e-6, "{worst_angle} rad");
+    assert!(worst_sigma < 1e-4, "{worst_sigma}");
+}
