@@ -19,7 +19,7 @@ use crate::survey_listing::{
 use anyhow::{anyhow, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
-use mwd_core::kalman::FilterScalar;
+use mwd_core::probe::NavigatorScalar;
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::{Navigator, TieIn};
 use mwd_core::probe_sample::ProbeSample;
@@ -324,7 +324,7 @@ pub(crate) fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Re
 
 /// One measured sample into the navigator: the probe's raw frame for the
 /// SCC1300 part, else the calibrated sample at full resolution.
-fn feed<T: FilterScalar>(
+fn feed<T: NavigatorScalar>(
     navigator: &mut Navigator<T>,
     raw_frames: bool,
     index: usize,
@@ -349,7 +349,7 @@ pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
 }
 
 /// [`run`] with the navigator's filter in `T`.
-fn run_in<T: FilterScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
+fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     let started = std::time::Instant::now();
     let cpu_start = thread_cpu_s();
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x57D7_0000_0000_0013);

@@ -111,9 +111,8 @@ impl Station {
 }
 
 impl<T: FilterScalar> Navigator<T> {
-    /// Uplink "start surveying": ends the fine alignment now (see the
-    /// module's notes). `Ok` when the probe navigates after it.
-    pub fn start_surveying(&mut self) -> Result<(), Refusal> {
+    /// [`Navigator::start_surveying`].
+    pub(super) fn start_surveying_now(&mut self) -> Result<(), Refusal> {
         match self.phase {
             Phase::Coarse(_) => Err(Refusal::NotReady),
             Phase::Fine { samples } if samples < MIN_FINE_ALIGNMENT_SAMPLES => {

@@ -20,6 +20,6 @@ pub mod still;
 mod test_support;
 pub mod tie_in;
 
-pub use navigator::Navigator;
+pub use navigator::{Navigator, NavigatorScalar};
 pub use raw::body_sample;
 pub use tie_in::{TieIn, TieInAngle, TieInError};

@@ -45,6 +45,7 @@
 #[path = "commands.rs"]
 pub mod commands;
 
+use commands::Refusal;
 use super::raw::{reading, Reading};
 use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::{Hysteresis, StillDetector};
@@ -319,6 +320,112 @@ pub struct Navigator<T: FilterScalar = f32> {
     commands: commands::CommandState,
 }
 
+/// The navigator's public entry points that run its filter. Each forwards
+/// to [`NavigatorScalar`], whose implementations below are compiled in this
+/// crate (see there).
+impl<T: NavigatorScalar> Navigator<T> {
+    /// Takes one raw sample and returns the solution after it.
+    pub fn step(&mut self, raw: &RawSample) -> NavSolution {
+        T::step(self, raw)
+    }
+
+    /// Takes one calibrated body-frame sample of both parts (the host's
+    /// studies of gyros other than the SCC1300, whose readings do not fit
+    /// the SCC1300's raw counts: 18 LSB per deg/s would round a
+    /// navigation-grade gyro's earth rate away) and returns the solution.
+    pub fn step_sample(
+        &mut self,
+        time_us: u64,
+        sample_counter: u32,
+        sample: &ProbeSample,
+    ) -> NavSolution {
+        T::step_sample(self, time_us, sample_counter, sample)
+    }
+
+    /// Ties the navigation in to the parent well's survey at the window
+    /// (`super::tie_in`, derivation section 4c).
+    ///
+    /// A probe that has levelled itself (navigating: called between steps
+    /// as soon as [`is_navigating`](Self::is_navigating) first returns true)
+    /// keeps its filter: the azimuth is replaced by the tie-in's (a turn
+    /// about the vertical; the heading error is then the tie-in's alone),
+    /// and the tie-in's inclination and toolface are fused with its own
+    /// levelling as measurements ([`TieInTilt`]), so the levelled tilt keeps
+    /// its correlation with the accelerometer biases it was levelled with.
+    /// (Putting the tie-in's tilt in place of that, as independent, left the
+    /// window station's toolface 4 times outside its sigma in the coverage
+    /// study: the accelerometer bias went into the toolface unseen.)
+    /// Before that (or with an invalid covariance) the filter starts again
+    /// from the tie-in's attitude and sigmas, independent of the sensor
+    /// states, with no zero updates. Drilling mode and stations start
+    /// afresh.
+    pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
+        T::start_from_tie_in(self, tie_in)
+    }
+
+    /// Uplink "start surveying": ends the fine alignment now (see
+    /// `commands`' notes). `Ok` when the probe navigates after it.
+    pub fn start_surveying(&mut self) -> Result<(), Refusal> {
+        T::start_surveying(self)
+    }
+}
+
+/// A scalar the navigator's filter runs in: f32 on the probe, f64 in the
+/// host's studies (`FilterScalar`). Its functions are the navigator's
+/// entry points that run the filter, implemented below for each scalar:
+/// Rust compiles a generic function in the crate that calls it, and the
+/// firmware's own build of the f32 filter came out 27 KB larger and 3 %
+/// slower per cycle than this crate's (docs/budgets.md). Implemented
+/// (concretely, not generically) here, their code is this crate's.
+/// Sealed: only f32 and f64.
+pub trait NavigatorScalar: FilterScalar + sealed::Sealed {
+    /// [`Navigator::step`].
+    fn step(navigator: &mut Navigator<Self>, raw: &RawSample) -> NavSolution;
+    /// [`Navigator::step_sample`].
+    fn step_sample(
+        navigator: &mut Navigator<Self>,
+        time_us: u64,
+        sample_counter: u32,
+        sample: &ProbeSample,
+    ) -> NavSolution;
+    /// [`Navigator::start_from_tie_in`].
+    fn start_from_tie_in(navigator: &mut Navigator<Self>, tie_in: &TieIn);
+    /// [`Navigator::start_surveying`].
+    fn start_surveying(navigator: &mut Navigator<Self>) -> Result<(), Refusal>;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f32 {}
+    impl Sealed for f64 {}
+}
+
+macro_rules! navigator_scalar {
+    ($($scalar:ty),+) => {$(
+        impl NavigatorScalar for $scalar {
+            fn step(navigator: &mut Navigator<Self>, raw: &RawSample) -> NavSolution {
+                navigator.step_raw(raw)
+            }
+            fn step_sample(
+                navigator: &mut Navigator<Self>,
+                time_us: u64,
+                sample_counter: u32,
+                sample: &ProbeSample,
+            ) -> NavSolution {
+                navigator.step_calibrated(time_us, sample_counter, sample)
+            }
+            fn start_from_tie_in(navigator: &mut Navigator<Self>, tie_in: &TieIn) {
+                navigator.tie_in(tie_in)
+            }
+            fn start_surveying(navigator: &mut Navigator<Self>) -> Result<(), Refusal> {
+                navigator.start_surveying_now()
+            }
+        }
+    )+};
+}
+
+navigator_scalar!(f32, f64);
+
 /// The probe's constructors, f32: on the default type itself, so that
 /// `Navigator::new(..)` needs no annotation (a default type parameter does
 /// not steer inference); another scalar's navigator comes from
@@ -416,17 +523,12 @@ impl<T: FilterScalar> Navigator<T> {
         self.noise
     }
 
-    /// Takes one raw sample and returns the solution after it.
-    pub fn step(&mut self, raw: &RawSample) -> NavSolution {
+    fn step_raw(&mut self, raw: &RawSample) -> NavSolution {
         let reading = reading(raw, &self.calibration);
         self.step_reading(raw.time_us, raw.sample_counter, reading)
     }
 
-    /// Takes one calibrated body-frame sample of both parts (the host's
-    /// studies of gyros other than the SCC1300, whose readings do not fit
-    /// the SCC1300's raw counts: 18 LSB per deg/s would round a
-    /// navigation-grade gyro's earth rate away) and returns the solution.
-    pub fn step_sample(
+    fn step_calibrated(
         &mut self,
         time_us: u64,
         sample_counter: u32,
@@ -1018,24 +1120,7 @@ impl<T: FilterScalar> Navigator<T> {
         solution
     }
 
-    /// Ties the navigation in to the parent well's survey at the window
-    /// (`super::tie_in`, derivation section 4c).
-    ///
-    /// A probe that has levelled itself (navigating: called between steps
-    /// as soon as [`is_navigating`](Self::is_navigating) first returns true)
-    /// keeps its filter: the azimuth is replaced by the tie-in's (a turn
-    /// about the vertical; the heading error is then the tie-in's alone),
-    /// and the tie-in's inclination and toolface are fused with its own
-    /// levelling as measurements ([`TieInTilt`]), so the levelled tilt keeps
-    /// its correlation with the accelerometer biases it was levelled with.
-    /// (Putting the tie-in's tilt in place of that, as independent, left the
-    /// window station's toolface 4 times outside its sigma in the coverage
-    /// study: the accelerometer bias went into the toolface unseen.)
-    /// Before that (or with an invalid covariance) the filter starts again
-    /// from the tie-in's attitude and sigmas, independent of the sensor
-    /// states, with no zero updates. Drilling mode and stations start
-    /// afresh.
-    pub fn start_from_tie_in(&mut self, tie_in: &TieIn) {
+    fn tie_in(&mut self, tie_in: &TieIn) {
         if !matches!(self.phase, Phase::Navigating) || self.covariance_invalid {
             self.restart_from_tie_in(tie_in);
             return;
