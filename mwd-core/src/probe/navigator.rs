@@ -45,7 +45,6 @@
 #[path = "commands.rs"]
 pub mod commands;
 
-use commands::Refusal;
 use super::raw::{reading, Reading};
 use super::station::{angle_uncertainty, angles_and_jacobian};
 use super::still::{Hysteresis, StillDetector};
@@ -76,6 +75,7 @@ use crate::protocol::uplink::StillSettings;
 use crate::protocol::{NavSolution, RawSample, StationSurvey};
 use crate::sensor_noise::{ImuNoise, SCC1300_NOISE};
 use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
+use commands::Refusal;
 use nalgebra::UnitQuaternion;
 use nalgebra::{Matrix3, Vector3};
 
