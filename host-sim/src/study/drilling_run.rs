@@ -19,8 +19,8 @@ use crate::survey_listing::{
 use anyhow::{anyhow, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
-use mwd_core::probe::NavigatorScalar;
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
+use mwd_core::probe::NavigatorScalar;
 use mwd_core::probe::{Navigator, TieIn};
 use mwd_core::probe_sample::ProbeSample;
 use mwd_core::protocol::{NavSolution, RawSample, StationSurvey};

@@ -203,6 +203,8 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
     /// positive semi-definite matrix must have non-negative. Cost: N square
     /// roots, then one multiply and compare per entry of the lower triangle
     /// (~N^2/2).
+    // `!(a <= b)`, not `a > b`: a NaN correlation must fail the check.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn covariance_is_healthy(&self, variance_limit: T) -> bool {
         let d = &self.p.data.0; // d[column][row]
         let diagonal: [T; N] = core::array::from_fn(|i| d[i][i]);
