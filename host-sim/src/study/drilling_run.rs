@@ -39,8 +39,8 @@ pub enum Scalar {
     /// stands for the probe).
     #[default]
     F32,
-    /// The same study figures (docs/lateral-study.md), 1.5-1.7 times
-    /// faster on x86 hosts.
+    /// The same study figures (docs/lateral-study.md, "The host's
+    /// speed"), about 1.8 times faster on x86 hosts.
     F64,
 }
 
