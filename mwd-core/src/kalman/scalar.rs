@@ -142,8 +142,9 @@ fn joseph_upper<T: FilterScalar, const N: usize, const R: usize>(
     joseph_last_rows(d, k, c, s, b);
 }
 
-/// The same on the rows `first..N` left over (fewer than a block), upper
-/// triangle, entry by entry.
+/// The same on the rows `first..N`, upper triangle, column by column: on
+/// the probe the rows left over after the blocks (fewer than a block), on
+/// a SIMD host the whole triangle (`first` = 0).
 #[inline(always)]
 fn joseph_last_rows<T: FilterScalar, const N: usize>(
     d: &mut [[T; N]; N],
