@@ -79,6 +79,7 @@ pub fn station_text(s: &StationSurvey) -> String {
         (station_flags::SOLUTION_INVALID, "INVALID"),
         (station_flags::REQUESTED, "requested"),
         (station_flags::INDEXING_DWELL, "indexing dwell"),
+        (station_flags::MOTION_SEEN, "gyros saw it turn"),
     ];
     let flags: Vec<&str> = names
         .iter()

@@ -594,6 +594,22 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         report
     }
 
+    /// The largest normalised innovation squared among `measurement`'s
+    /// scalars at the current solution, each against the covariance of
+    /// now (none of them used): `None` when one is not a finite number.
+    pub fn largest_normalized_innovation<M: Measurement<T>>(&self, measurement: &M) -> Option<T> {
+        let mut largest = T::zero();
+        for k in 0..measurement.len() {
+            let nis = self
+                .filter
+                .normalized_innovation_squared(&measurement.scalar(k)?)?;
+            if nis > largest {
+                largest = nis;
+            }
+        }
+        Some(largest)
+    }
+
     /// Replaces the attitude-error covariance (rad^2, nav frame) and clears
     /// its cross-covariances with every other state: an attitude from
     /// outside the probe's own sensors (a tie-in survey) is independent of

@@ -329,6 +329,43 @@ fn chi_square_gate_rejects_outliers_and_passes_ordinary_data() {
     assert!(f.p[(VEL, VEL)] < before.p[(VEL, VEL)]);
 }
 
+/// The innovation test a caller makes before using a measurement: the
+/// gate's own quantity, with the row's cross terms, the filter untouched.
+#[test]
+fn the_normalized_innovation_squared_is_the_gates_quantity() {
+    let mut f = filter();
+    f.x[VEL] = 0.02;
+    f.p[(VEL, VEL + 1)] = 0.3 * (f.p[(VEL, VEL)] * f.p[(VEL + 1, VEL + 1)]).sqrt();
+    f.p[(VEL + 1, VEL)] = f.p[(VEL, VEL + 1)];
+    let mut h = SparseRow::empty();
+    h.push(VEL, 1.0);
+    h.push(VEL + 1, -2.0);
+    let m = ScalarMeasurement { z: 0.5, h, r: 0.01 };
+    let (a, b, c) = (f.p[(VEL, VEL)], f.p[(VEL + 1, VEL + 1)], f.p[(VEL, VEL + 1)]);
+    let variance = a + 4.0 * b - 4.0 * c + 0.01;
+    let innovation = 0.5 - (0.02 - 2.0 * f.x[VEL + 1]);
+    let before = f.clone();
+    let nis = f.normalized_innovation_squared(&m).expect("finite");
+    assert!((nis / (innovation * innovation / variance) - 1.0).abs() < 1e-5, "{nis}");
+    assert_eq!(f, before);
+    // Just past it the gate rejects the scalar, just short of it accepts.
+    f.gate = Some(nis * 1.001);
+    assert!(f.clone().update_scalar(&m).is_accepted());
+    f.gate = Some(nis * 0.999);
+    assert!(matches!(f.update_scalar(&m), ScalarOutcome::Gated { .. }));
+    // Not a number, or no positive variance: none.
+    let nan = ScalarMeasurement { z: f32::NAN, ..m };
+    assert_eq!(before.normalized_innovation_squared(&nan), None);
+    let mut singular = before.clone();
+    singular.p[(POS, POS)] = 0.0;
+    let exact = ScalarMeasurement {
+        z: 1.0,
+        h: SparseRow::select(POS),
+        r: 0.0,
+    };
+    assert_eq!(singular.normalized_innovation_squared(&exact), None);
+}
+
 /// An invalid variance is never reported as a number: the old
 /// `std_dev` turned a negative or NaN variance into 0, the most confident
 /// sigma there is.

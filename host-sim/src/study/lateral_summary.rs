@@ -108,6 +108,10 @@ pub struct GradeWellSummary {
     /// Flagged invalid (not counted anywhere else).
     pub invalid_stations: usize,
     pub azimuth_undetermined_stations: usize,
+    /// Ended because the gyros saw the tool turn while the still detector
+    /// saw none (`station_flags::MOTION_SEEN`: a slide too smooth for the
+    /// detector); counted with the others too.
+    pub motion_seen_stations: usize,
     pub rms_station_inclination_deg: Option<f64>,
     pub rms_station_azimuth_deg: Option<f64>,
     pub azimuth_within_2_sigma: Fraction,
@@ -215,6 +219,9 @@ pub fn summarise(
         cpu = cpu.zip(o.cpu_s).map(|(a, b)| a + b);
         for st in &o.stations {
             s.stations += 1;
+            if st.survey.flags & station_flags::MOTION_SEEN != 0 {
+                s.motion_seen_stations += 1;
+            }
             let sd = st.survey.angles_std.map(f64::from);
             if st.survey.flags & station_flags::SOLUTION_INVALID != 0 || !sd[0].is_finite() {
                 s.invalid_stations += 1;

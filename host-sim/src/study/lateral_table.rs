@@ -193,6 +193,12 @@ pub fn table(study: &LateralStudy) -> String {
     ));
     out.push_str(&method_split_table(study));
     for s in &study.summaries {
+        if s.motion_seen_stations > 0 {
+            out.push_str(&format!(
+                "  {} {}: {} of {} stations ended when the gyros saw the tool turn while the still detector saw no motion (a smooth slide)\n",
+                s.grade, s.well, s.motion_seen_stations, s.stations
+            ));
+        }
         for (reason, n) in &s.td_unchecked {
             out.push_str(&format!(
                 "  {} {}: TD not checked in {n} runs: {reason}\n",
@@ -366,6 +372,7 @@ pub fn csv(study: &LateralStudy) -> String {
         "stations",
         "invalid_stations",
         "azimuth_undetermined_stations",
+        "motion_seen_stations",
         "rms_station_azimuth_deg",
         "azimuth_within_2_sigma",
         "azimuth_within_2_sigma_se",
@@ -412,6 +419,7 @@ pub fn csv(study: &LateralStudy) -> String {
             s.stations.to_string(),
             s.invalid_stations.to_string(),
             s.azimuth_undetermined_stations.to_string(),
+            s.motion_seen_stations.to_string(),
             f(s.rms_station_azimuth_deg),
             f(s.azimuth_within_2_sigma.fraction),
             f(s.azimuth_within_2_sigma.standard_error),

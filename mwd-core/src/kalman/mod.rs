@@ -184,6 +184,25 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
         report
     }
 
+    /// The normalised innovation squared `(z - h x)^2 / (h P h^T + r)` of
+    /// one scalar at the current estimate, the filter untouched: for a
+    /// consistency test a caller decides on before it uses a measurement
+    /// at all (the rate gyrocompass: `probe::navigator`). `None` where it
+    /// is not a finite number over a positive variance.
+    pub fn normalized_innovation_squared(&self, m: &ScalarMeasurement<T>) -> Option<T> {
+        let mut predicted = T::zero();
+        let mut variance = m.r;
+        for (i, a) in m.h.entries() {
+            predicted += a * *self.x.get(i)?;
+            for (j, b) in m.h.entries() {
+                variance += a * b * *self.p.get((i, j))?;
+            }
+        }
+        let innovation = m.z - predicted;
+        let nis = innovation * innovation / variance;
+        (variance > T::zero() && nis.is_finite()).then_some(nis)
+    }
+
     /// Trace of P.
     pub fn trace(&self) -> T {
         self.p.trace()

@@ -184,6 +184,7 @@ impl<T: FilterScalar> Navigator<T> {
     /// After each navigation cycle's station tracking: keeps the one-frame
     /// rule and reports indexing dwells.
     pub(super) fn follow_commands(&mut self, still: bool) {
+        const ENDED_WHILE_STILL: u16 = station_flags::MAX_DURATION | station_flags::MOTION_SEEN;
         // A frame the station tracking finished (never one of ours, which
         // carry these bits).
         let ours = station_flags::REQUESTED | station_flags::INDEXING_DWELL;
@@ -191,10 +192,10 @@ impl<T: FilterScalar> Navigator<T> {
             match self.commands.sent {
                 // Already sent by request or as a dwell.
                 Some(sent) if sent.station == finished.station => self.finished_station = None,
-                // Sent at the longest station: a request repeats it (a
-                // still period's end still waiting to be taken is not
-                // this one's).
-                _ if still && finished.flags & station_flags::MAX_DURATION != 0 => {
+                // Sent at the longest station, or when the gyros saw the
+                // tool turn: a request repeats it (a still period's end
+                // still waiting to be taken is not this one's).
+                _ if still && finished.flags & ENDED_WHILE_STILL != 0 => {
                     self.commands.sent = Some(finished)
                 }
                 _ => {}

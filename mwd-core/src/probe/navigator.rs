@@ -201,6 +201,24 @@ pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 /// (`aid_sources::EarthRate`): three quarters of the block.
 pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 
+/// The rate gyrocompass's consistency gate: the largest normalised
+/// innovation squared of a block's two scalars (x and z gyro, each against
+/// the filter's covariance before either is used) a still tool passes,
+/// `Z_STAY^2` (`super::still`: two-sided 2e-7 per gyro and block, about 1e-4
+/// over a 1000 m lateral's 280 blocks). A block beyond it is a tool that
+/// turns while the still detector sees no motion: a smooth slide at the
+/// rate of penetration has no acceleration and turns at the build and walk
+/// rates, 5-15 deg/h, which the detector cannot see against the SCC1300's
+/// per-sample noise, but a block mean reads as earth rate (15 deg/h at
+/// most). Unchecked, a quiet slide became an hour of stations whose
+/// gyrocompass turned the heading by tens of degrees under 0.05 deg sigmas
+/// (docs/lateral-study.md, "A slide without vibration"). The block is not
+/// used, and the station ends there ([`station_flags::MOTION_SEEN`]).
+/// Gyros too noisy to see the turn (the SCC1300: a block mean's noise is
+/// ~40 deg/h) pass it, and their gyrocompass weighs it as little as the
+/// noise says.
+pub const EARTH_RATE_GATE: f64 = super::still::Z_STAY * super::still::Z_STAY;
+
 /// The filter's settings for a still probe at `position` whose coarse
 /// alignment has 1-sigma `coarse_sigma` (roll, pitch, heading; rad), with
 /// the sensors' error budget `noise`.
@@ -224,6 +242,16 @@ enum Phase {
     Fine { samples: u32 },
     /// The filter without zero updates, but for station surveys.
     Navigating,
+}
+
+/// What a station's block did with the rate gyrocompass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Gyrocompass {
+    /// Too few still cycles with both gyros, or no valid covariance.
+    Skipped,
+    Used,
+    /// The means failed [`EARTH_RATE_GATE`]: the tool turned.
+    Turning,
 }
 
 /// A station in progress.
@@ -284,7 +312,10 @@ pub struct Navigator<T: FilterScalar = f32> {
     station: Option<Station>,
     /// Stations started since boot.
     stations: u16,
-    /// The current still period reached `max_station_samples`.
+    /// The current still period is no station any more: it reached
+    /// `max_station_samples`, or its gyros saw the tool turn
+    /// ([`EARTH_RATE_GATE`]). No zero-velocity updates until the detector
+    /// sees motion; the moving tool's constraints instead.
     station_capped: bool,
     /// The longest station (samples; default [`MAX_STATION_SAMPLES`]).
     max_station_samples: u32,
@@ -619,13 +650,17 @@ impl<T: FilterScalar> Navigator<T> {
             station.gyro_epochs += 1;
         }
         let block_done = station.epochs % SURVEY_SETTLE_EPOCHS == 0;
-        if block_done {
-            // Each block's means are one rate-gyrocompass update, before
-            // the block's survey is taken, so a station's survey holds the
-            // heading and the rate biases (and through them the heading
-            // drift of the drilling before it) from all its still cycles
-            // but the last block's.
-            self.gyrocompass_block();
+        // Each block's means are one rate-gyrocompass update, before the
+        // block's survey is taken, so a station's survey holds the heading
+        // and the rate biases (and through them the heading drift of the
+        // drilling before it) from all its still cycles but the last
+        // block's.
+        if block_done && self.gyrocompass_block() == Gyrocompass::Turning {
+            // Not still: the station sends its last checkpoint (before
+            // this block) and ends.
+            self.finish_station(station_flags::MOTION_SEEN);
+            self.station_capped = true;
+            return;
         }
         let survey = self.station_survey();
         let number = self.stations;
@@ -674,16 +709,19 @@ impl<T: FilterScalar> Navigator<T> {
     /// R is the gyros' noise only: the attitude error is a state of the
     /// row. The blocks' gyro noise is independent from block to block (the
     /// AR models' memory is a few samples).
-    fn gyrocompass_block(&mut self) {
+    ///
+    /// A block whose means fail [`EARTH_RATE_GATE`] is not used: the tool
+    /// turned ([`Gyrocompass::Turning`]).
+    fn gyrocompass_block(&mut self) -> Gyrocompass {
         let Some(station) = self.station.as_mut() else {
-            return;
+            return Gyrocompass::Skipped;
         };
         let n = station.gyro_epochs;
         let sum = station.gyro_sum;
         station.gyro_sum = [0.0; 2];
         station.gyro_epochs = 0;
         if n < MIN_BIAS_UPDATE_SAMPLES || self.covariance_invalid {
-            return;
+            return Gyrocompass::Skipped;
         }
         let mean = sum.map(|v| v / f64::from(n));
         let state = self.filter.state();
@@ -696,7 +734,17 @@ impl<T: FilterScalar> Navigator<T> {
             &omega,
             GYRO_AXES.map(|axis| long_run_variance(&self.noise.gyro[axis], SAMPLE_INTERVAL_S)),
         );
-        self.filter.aid(&measurement.cast::<T>());
+        let measurement = measurement.cast::<T>();
+        let gate = T::of(EARTH_RATE_GATE);
+        if self
+            .filter
+            .largest_normalized_innovation(&measurement)
+            .is_some_and(|nis| nis > gate)
+        {
+            return Gyrocompass::Turning;
+        }
+        self.filter.aid(&measurement);
+        Gyrocompass::Used
     }
 
     /// The station survey at this cycle: the filter's attitude as drilling
@@ -875,9 +923,15 @@ impl<T: FilterScalar> Navigator<T> {
                 if drilling {
                     filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
                 }
-                if report.sample_used && !still && !self.covariance_invalid {
+                if report.sample_used && !update && !self.covariance_invalid {
                     // Drilling or moving in the hole: the tool moves along
-                    // its axis (derivation sections 4b, 4d).
+                    // its axis (derivation sections 4b, 4d). Also still
+                    // past the station's end (the longest station, or the
+                    // gyros saw it turn): the detector cannot tell a tool
+                    // at rest from one sliding smoothly, and these hold
+                    // for both; free inertial navigation there grew
+                    // velocity errors of tens of m/s in an hour of a quiet
+                    // slide, far outside the error model's linear range.
                     // The rows' attitude terms (v_n x r_a) are dropped:
                     // linearised at the computed velocity, which while
                     // drilling is mostly vibration noise (the true speed,
@@ -1351,3 +1405,7 @@ mod settings_tests;
 #[cfg(test)]
 #[path = "navigator_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "navigator_slide_tests.rs"]
+mod slide_tests;

@@ -176,6 +176,13 @@ pub mod station_flags {
     /// the procedure's dwell time at a toolface that changed from the
     /// previous dwell's (`probe::navigator::commands`).
     pub const INDEXING_DWELL: u16 = 1 << 6;
+    /// Ended because the gyros saw the tool turn while the still detector
+    /// saw no motion (a smooth slide or creep: a block's rate gyrocompass
+    /// failed its consistency test, `probe::navigator::EARTH_RATE_GATE`).
+    /// The survey is the last checkpoint before that block; as after the
+    /// longest station, no further zero-velocity update and no further
+    /// station until the detector sees motion.
+    pub const MOTION_SEEN: u16 = 1 << 7;
 }
 
 /// A station survey (kind 4): the attitude at the end of a still period

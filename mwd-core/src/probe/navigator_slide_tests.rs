@@ -1,0 +1,135 @@
+//! A tool the still detector takes for still while it moves: a slide too
+//! smooth for it (no acceleration, turning at build and walk rates), and a
+//! stop longer than the longest station. The rate gyrocompass's gate ends
+//! the station when quiet gyros see the turn; past a station's end the
+//! moving tool's constraints hold the velocity.
+
+use super::*;
+extern crate std;
+use crate::conventions::{dcm_from_euler, Euler};
+use crate::earth::earth_rate_n;
+use crate::sensor_units::STANDARD_GRAVITY;
+use crate::timing::sample_time_us;
+
+use super::super::test_support::{level_sample, ALL_ALIGNMENT};
+
+/// A GE-2020-like gyro budget (the navigator's SCC1300 budget with the
+/// gyros' noise and biases 300 times smaller): its block means see a
+/// turn of a few deg/h.
+static QUIET: ImuNoise = {
+    let mut noise = ImuNoise::scc1300();
+    let mut axis = 0;
+    while axis < 3 {
+        noise.gyro[axis].white_density /= 300.0;
+        noise.gyro[axis].bias_instability /= 300.0;
+        noise.gyro[axis].residual_bias /= 300.0;
+        noise.gyro[axis].coloured = None;
+        axis += 2;
+    }
+    noise
+};
+
+/// Sample `n` of a level tool heading 60 deg at the paper's site, error
+/// free and at full resolution, turning about the vertical at `turn_deg_h`
+/// on top of the earth's rate (over the minutes of a test the heading
+/// change, under 1 deg, is left out of the earth rate's projection).
+fn sample(n: u32, turn_deg_h: f64) -> (u64, u32, ProbeSample) {
+    let c_bn = dcm_from_euler(&Euler::new(0.0, 0.0, 60f64.to_radians()));
+    let c_nb = c_bn.transpose();
+    let turn = Vector3::new(0.0, 0.0, turn_deg_h.to_radians() / 3600.0);
+    let rate = c_nb * (earth_rate_n(Position::paper_site().lat) + turn);
+    let force = c_nb * Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
+    (
+        sample_time_us(n),
+        n,
+        ProbeSample::new(rate.x, rate.z, force),
+    )
+}
+
+/// Runs a quiet navigator still through its alignment and `still` more
+/// samples, then `turning` samples turning at `turn_deg_h`; returns the
+/// stations sent (with the sample that sent each) and the last solution.
+fn slide(
+    still: u32,
+    turning: u32,
+    turn_deg_h: f64,
+) -> (std::vec::Vec<(u32, StationSurvey)>, NavSolution) {
+    let mut navigator = Navigator::<f64>::calibrated(Position::paper_site(), ProbeCalibration::default());
+    navigator.set_noise_budget(&QUIET);
+    let mut stations = std::vec::Vec::new();
+    let mut last = None;
+    let end = ALL_ALIGNMENT + still + turning;
+    for n in 0..end {
+        let turn = if n >= ALL_ALIGNMENT + still {
+            turn_deg_h
+        } else {
+            0.0
+        };
+        let (time, counter, s) = sample(n, turn);
+        last = Some(navigator.step_sample(time, counter, &s));
+        stations.extend(navigator.take_station().map(|st| (n, st)));
+    }
+    (stations, last.expect("samples were stepped"))
+}
+
+#[test]
+fn a_still_quiet_probe_passes_its_rate_gyrocompass_blocks() {
+    // 4 minutes: the station goes on, with updates, and nothing is sent.
+    let (stations, last) = slide(4800, 0, 0.0);
+    assert!(stations.is_empty(), "{stations:?}");
+    assert_eq!(
+        last.flags & (nav_flags::STILL | nav_flags::ZUPT_APPLIED),
+        nav_flags::STILL | nav_flags::ZUPT_APPLIED,
+        "{last:?}"
+    );
+}
+
+#[test]
+fn a_smooth_turn_the_still_detector_misses_ends_the_station() {
+    // One minute still, then a 10 deg/h walk (a slide through a turn at
+    // 5 deg/30 m and 60 m/h), which the still detector cannot see.
+    let still = 1200;
+    let (stations, last) = slide(still, 1200, 10.0);
+    assert_eq!(stations.len(), 1, "{stations:?}");
+    let (at, station) = stations[0];
+    assert_ne!(station.flags & station_flags::MOTION_SEEN, 0, "{station:?}");
+    assert_eq!(station.flags & station_flags::MAX_DURATION, 0);
+    // Ended at the end of the first block that holds the turn; its survey
+    // is a checkpoint before that block.
+    let turn_from = ALL_ALIGNMENT + still;
+    assert!(at >= turn_from && at < turn_from + SURVEY_SETTLE_EPOCHS, "{at}");
+    assert!(station.end_sample < turn_from, "{station:?}");
+    // Still to the detector, but no zero-velocity updates any more.
+    assert_eq!(
+        last.flags & (nav_flags::STILL | nav_flags::ZUPT_APPLIED),
+        nav_flags::STILL,
+        "{last:?}"
+    );
+}
+
+/// Past the longest station the probe may be at rest or sliding smoothly:
+/// the moving tool's constraints keep its velocity known; free inertial
+/// navigation there (as before) let the velocity sigma grow without bound.
+#[test]
+fn past_the_longest_station_the_velocity_stays_constrained() {
+    let mut navigator = Navigator::new(Position::paper_site());
+    let end = ALL_ALIGNMENT + MAX_STATION_SAMPLES + 12_000;
+    let mut last = None;
+    for n in 0..end {
+        last = Some(navigator.step(&level_sample(n)));
+    }
+    let last = last.expect("samples were stepped");
+    assert_eq!(last.flags & nav_flags::ZUPT_APPLIED, 0, "{last:?}");
+    assert_eq!(last.flags & nav_flags::COVARIANCE_INVALID, 0, "{last:?}");
+    // 10 minutes past the station's end.
+    let speed_sigma = last.velocity_std.iter().map(|s| s * s).sum::<f32>().sqrt();
+    std::eprintln!("{last:?}");
+    assert!(speed_sigma < 0.1, "{last:?}");
+    let speed = last
+        .velocity_ned
+        .iter()
+        .map(|v| v * v)
+        .sum::<f32>()
+        .sqrt();
+    assert!(speed < 3.0 * speed_sigma, "{last:?}");
+}
