@@ -341,12 +341,19 @@ fn the_normalized_innovation_squared_is_the_gates_quantity() {
     h.push(VEL, 1.0);
     h.push(VEL + 1, -2.0);
     let m = ScalarMeasurement { z: 0.5, h, r: 0.01 };
-    let (a, b, c) = (f.p[(VEL, VEL)], f.p[(VEL + 1, VEL + 1)], f.p[(VEL, VEL + 1)]);
+    let (a, b, c) = (
+        f.p[(VEL, VEL)],
+        f.p[(VEL + 1, VEL + 1)],
+        f.p[(VEL, VEL + 1)],
+    );
     let variance = a + 4.0 * b - 4.0 * c + 0.01;
     let innovation = 0.5 - (0.02 - 2.0 * f.x[VEL + 1]);
     let before = f.clone();
     let nis = f.normalized_innovation_squared(&m).expect("finite");
-    assert!((nis / (innovation * innovation / variance) - 1.0).abs() < 1e-5, "{nis}");
+    assert!(
+        (nis / (innovation * innovation / variance) - 1.0).abs() < 1e-5,
+        "{nis}"
+    );
     assert_eq!(f, before);
     // Just past it the gate rejects the scalar, just short of it accepts.
     f.gate = Some(nis * 1.001);

@@ -54,7 +54,8 @@ fn slide(
     turning: u32,
     turn_deg_h: f64,
 ) -> (std::vec::Vec<(u32, StationSurvey)>, NavSolution) {
-    let mut navigator = Navigator::<f64>::calibrated(Position::paper_site(), ProbeCalibration::default());
+    let mut navigator =
+        Navigator::<f64>::calibrated(Position::paper_site(), ProbeCalibration::default());
     navigator.set_noise_budget(&QUIET);
     let mut stations = std::vec::Vec::new();
     let mut last = None;
@@ -97,7 +98,10 @@ fn a_smooth_turn_the_still_detector_misses_ends_the_station() {
     // Ended at the end of the first block that holds the turn; its survey
     // is a checkpoint before that block.
     let turn_from = ALL_ALIGNMENT + still;
-    assert!(at >= turn_from && at < turn_from + SURVEY_SETTLE_EPOCHS, "{at}");
+    assert!(
+        at >= turn_from && at < turn_from + SURVEY_SETTLE_EPOCHS,
+        "{at}"
+    );
     assert!(station.end_sample < turn_from, "{station:?}");
     // Still to the detector, but no zero-velocity updates any more.
     assert_eq!(
@@ -123,13 +127,7 @@ fn past_the_longest_station_the_velocity_stays_constrained() {
     assert_eq!(last.flags & nav_flags::COVARIANCE_INVALID, 0, "{last:?}");
     // 10 minutes past the station's end.
     let speed_sigma = last.velocity_std.iter().map(|s| s * s).sum::<f32>().sqrt();
-    std::eprintln!("{last:?}");
     assert!(speed_sigma < 0.1, "{last:?}");
-    let speed = last
-        .velocity_ned
-        .iter()
-        .map(|v| v * v)
-        .sum::<f32>()
-        .sqrt();
+    let speed = last.velocity_ned.iter().map(|v| v * v).sum::<f32>().sqrt();
     assert!(speed < 3.0 * speed_sigma, "{last:?}");
 }
