@@ -204,8 +204,8 @@ pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 /// The rate gyrocompass's consistency gate: the largest normalised
 /// innovation squared of a block's two scalars (x and z gyro, each against
 /// the filter's covariance before either is used) a still tool passes,
-/// `Z_STAY^2` (`super::still`: two-sided 2e-7 per gyro and block, about 1e-4
-/// over a 1000 m lateral's 280 blocks). A block beyond it is a tool that
+/// `Z_STAY^2` (`super::still`: two-sided 2e-7 per gyro and block, about
+/// 2e-3 over the 5,500 blocks of a 1000 m lateral's 37 stations). A block beyond it is a tool that
 /// turns while the still detector sees no motion: a smooth slide at the
 /// rate of penetration has no acceleration and turns at the build and walk
 /// rates, 5-15 deg/h, which the detector cannot see against the SCC1300's
@@ -214,9 +214,10 @@ pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 /// gyrocompass turned the heading by tens of degrees under 0.05 deg sigmas
 /// (docs/lateral-study.md, "A slide without vibration"). The block is not
 /// used, and the station ends there ([`station_flags::MOTION_SEEN`]).
-/// Gyros too noisy to see the turn (the SCC1300: a block mean's noise is
-/// ~40 deg/h) pass it, and their gyrocompass weighs it as little as the
-/// noise says.
+/// Gyros too noisy to see the turn (a block mean's noise is ~40 deg/h for
+/// the SCC1300, ~5 deg/h for the high-end MEMS grade, whose bias
+/// instability enters as rate noise) pass it, and their gyrocompass weighs
+/// it as little as the noise says.
 pub const EARTH_RATE_GATE: f64 = super::still::Z_STAY * super::still::Z_STAY;
 
 /// The filter's settings for a still probe at `position` whose coarse
