@@ -11,23 +11,11 @@ use crate::earth::earth_rate_n;
 use crate::sensor_units::STANDARD_GRAVITY;
 use crate::timing::sample_time_us;
 
-use super::super::test_support::{level_sample, ALL_ALIGNMENT};
+use super::super::test_support::{level_sample, quieter_gyros, ALL_ALIGNMENT};
 
-/// A GE-2020-like gyro budget (the navigator's SCC1300 budget with the
-/// gyros' noise and biases 300 times smaller): its block means see a
-/// turn of a few deg/h.
-static QUIET: ImuNoise = {
-    let mut noise = ImuNoise::scc1300();
-    let mut axis = 0;
-    while axis < 3 {
-        noise.gyro[axis].white_density /= 300.0;
-        noise.gyro[axis].bias_instability /= 300.0;
-        noise.gyro[axis].residual_bias /= 300.0;
-        noise.gyro[axis].coloured = None;
-        axis += 2;
-    }
-    noise
-};
+/// A GE-2020-like gyro budget (the SCC1300's gyro noise and biases 300
+/// times smaller): its block means see a turn of a few deg/h.
+static QUIET: ImuNoise = quieter_gyros(300.0);
 
 /// Sample `n` of a level tool heading 60 deg at the paper's site, error
 /// free and at full resolution, turning about the vertical at `turn_deg_h`

@@ -7,7 +7,8 @@ use crate::protocol::RawPart;
 use crate::sensor_units::STANDARD_GRAVITY_M_S2;
 
 use super::super::test_support::{
-    aligned_navigator, level_sample, level_turning_sample, still_sample, ALL_ALIGNMENT,
+    aligned_navigator, level_sample, level_turning_sample, quieter_gyros, still_sample,
+    ALL_ALIGNMENT,
 };
 
 #[test]
@@ -31,18 +32,7 @@ fn a_body_sample_steps_as_its_raw_frame_does() {
 
 #[test]
 fn a_quieter_budget_gives_smaller_sigmas() {
-    static QUIET: ImuNoise = {
-        let mut noise = ImuNoise::scc1300();
-        let mut axis = 0;
-        while axis < 3 {
-            noise.gyro[axis].white_density /= 100.0;
-            noise.gyro[axis].bias_instability /= 100.0;
-            noise.gyro[axis].residual_bias /= 100.0;
-            noise.gyro[axis].coloured = None;
-            axis += 2;
-        }
-        noise
-    };
+    static QUIET: ImuNoise = quieter_gyros(100.0);
     let position = Position::paper_site();
     let (mut scc1300, mut quiet) = (Navigator::new(position), Navigator::new(position));
     quiet.set_noise_budget(&QUIET);

@@ -4,6 +4,7 @@ use super::Navigator;
 use crate::earth::Position;
 use crate::protocol::frame::raw_flags;
 use crate::protocol::{RawPart, RawSample};
+use crate::sensor_noise::ImuNoise;
 use crate::sensor_units::{
     m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
 };
@@ -47,6 +48,22 @@ pub(crate) fn level_turning_sample(n: u32, deg_s: f32) -> RawSample {
         [0.0, 0.0, STANDARD_GRAVITY_M_S2],
         [0.0, 0.0, deg_s.to_radians()],
     )
+}
+
+/// The SCC1300's budget with its gyros' (body x and z) white noise, bias
+/// instability and residual bias `factor` times smaller and no coloured
+/// part: a quieter gyro grade.
+pub(crate) const fn quieter_gyros(factor: f64) -> ImuNoise {
+    let mut noise = ImuNoise::scc1300();
+    let mut axis = 0;
+    while axis < 3 {
+        noise.gyro[axis].white_density /= factor;
+        noise.gyro[axis].bias_instability /= factor;
+        noise.gyro[axis].residual_bias /= factor;
+        noise.gyro[axis].coloured = None;
+        axis += 2;
+    }
+    noise
 }
 
 /// A navigator at the paper's site that has aligned on level still
