@@ -26,7 +26,8 @@
 //!    navigator hands out a station survey ([`Navigator::take_station`]):
 //!    inclination, azimuth and toolface of the last still cycle with their
 //!    covariance (`super::station`). No zero-position update: the probe's
-//!    position while drilling is not known.
+//!    position while drilling is not known. The station's cycle is in
+//!    `navigator_station.rs`.
 //!
 //! What the frames say besides the solution (docs/protocol.md, Kind 2;
 //! docs/filter-derivation.md section 5b): during the coarse alignment the
@@ -45,21 +46,23 @@
 #[path = "commands.rs"]
 pub mod commands;
 
+#[path = "navigator_station.rs"]
+mod station_cycle;
+
 use super::raw::{reading, Reading};
-use super::station::{angle_uncertainty, angles_and_jacobian};
+use super::station::angles_and_jacobian;
 use super::still::{Hysteresis, StillDetector};
 use super::tie_in::{TieIn, TieInTilt};
 use crate::aid_sources::{
-    long_run_variance, AxialSpeed, DrillingToolface, EarthRate, ForceBlock, NonHolonomic,
-    AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
+    AxialSpeed, DrillingToolface, ForceBlock, NonHolonomic, AXIAL_SPEED_VARIANCE,
+    DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
 };
 use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
-use crate::attitude::{ToolAxisRate, NEAR_VERTICAL};
+use crate::attitude::ToolAxisRate;
 use crate::calibration::ProbeCalibration;
 use crate::conventions::{
     dcm_from_quat, euler_from_quat, quat_from_euler, DrillingAngles, Euler, DEG,
 };
-use crate::earth::earth_rate_n;
 use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
 use crate::fine_alignment::{
@@ -70,7 +73,6 @@ use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
 use crate::protocol::frame::nav_mode;
-use crate::protocol::frame::station_flags;
 use crate::protocol::uplink::StillSettings;
 use crate::protocol::{NavSolution, RawSample, StationSurvey};
 use crate::sensor_noise::{ImuNoise, SCC1300_NOISE};
@@ -213,7 +215,8 @@ pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
 /// most). Unchecked, a quiet slide became an hour of stations whose
 /// gyrocompass turned the heading by tens of degrees under 0.05 deg sigmas
 /// (docs/lateral-study.md, "A slide without vibration"). The block is not
-/// used, and the station ends there ([`station_flags::MOTION_SEEN`]).
+/// used, and the station ends there (station flag
+/// [`MOTION_SEEN`](crate::protocol::frame::station_flags::MOTION_SEEN)).
 /// Gyros too noisy to see the turn (a block mean's noise is ~40 deg/h for
 /// the SCC1300, ~5 deg/h for the high-end MEMS grade, whose bias
 /// instability enters as rate noise) pass it, and their gyrocompass weighs
@@ -243,16 +246,6 @@ enum Phase {
     Fine { samples: u32 },
     /// The filter without zero updates, but for station surveys.
     Navigating,
-}
-
-/// What a station's block did with the rate gyrocompass.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Gyrocompass {
-    /// Too few still cycles with both gyros, or no valid covariance.
-    Skipped,
-    Used,
-    /// The means failed [`EARTH_RATE_GATE`]: the tool turned.
-    Turning,
 }
 
 /// A station in progress.
@@ -609,188 +602,6 @@ impl<T: FilterScalar> Navigator<T> {
     /// Stations started since boot.
     pub fn stations(&self) -> u16 {
         self.stations
-    }
-
-    /// A navigation cycle, `still` or not: starts, extends or ends the
-    /// station.
-    fn track_station(&mut self, still: bool) {
-        if !still {
-            self.station_capped = false;
-            self.finish_station(0);
-            return;
-        }
-        if self.station_capped {
-            return;
-        }
-        let statistics = self.still.statistics();
-        let quality = statistics
-            .rate
-            .max(statistics.force)
-            .max(statistics.gravity);
-        let start = self.sample_counter;
-        if self.station.is_none() {
-            self.stations = self.stations.wrapping_add(1);
-            self.station = Some(Station {
-                epochs: 0,
-                quality_sum: 0.0,
-                survey: StationSurvey::default(),
-                gyro_sum: [0.0; 2],
-                gyro_epochs: 0,
-                checkpoint: None,
-                settled: None,
-            });
-        }
-        let Some(station) = self.station.as_mut() else {
-            return;
-        };
-        station.epochs += 1;
-        station.quality_sum += quality;
-        if let Some(g) = self.still_gyro {
-            station.gyro_sum[0] += g[0];
-            station.gyro_sum[1] += g[1];
-            station.gyro_epochs += 1;
-        }
-        let block_done = station.epochs % SURVEY_SETTLE_EPOCHS == 0;
-        // Each block's means are one rate-gyrocompass update, before the
-        // block's survey is taken, so a station's survey holds the heading
-        // and the rate biases (and through them the heading drift of the
-        // drilling before it) from all its still cycles but the last
-        // block's.
-        if block_done && self.gyrocompass_block() == Gyrocompass::Turning {
-            // Not still: the station sends its last checkpoint (before
-            // this block) and ends.
-            self.finish_station(station_flags::MOTION_SEEN);
-            self.station_capped = true;
-            return;
-        }
-        let survey = self.station_survey();
-        let number = self.stations;
-        let Some(station) = self.station.as_mut() else {
-            return;
-        };
-        let start_sample = if station.epochs == 1 {
-            start
-        } else {
-            station.survey.start_sample
-        };
-        station.survey = StationSurvey {
-            station: number,
-            start_sample,
-            still_quality: station.quality_sum / station.epochs as f32,
-            ..survey
-        };
-        if block_done {
-            station.settled = station.checkpoint.replace(station.survey);
-        }
-        if station.epochs >= self.max_station_samples {
-            self.finish_station(station_flags::MAX_DURATION);
-            self.station_capped = true;
-        }
-    }
-
-    fn finish_station(&mut self, flags: u16) {
-        if let Some(station) = self.station.take() {
-            let mut survey = station.to_send();
-            survey.flags |= flags;
-            self.finished_station = Some(survey);
-        }
-    }
-
-    /// The rate gyrocompass (`aid_sources::EarthRate`, derivation section
-    /// 4e) from the still cycles' gyro sums since the last one, which it
-    /// clears: one update per block of [`SURVEY_SETTLE_EPOCHS`] still
-    /// cycles, in the block's last still cycle (after its step and
-    /// zero-velocity update, before its survey checkpoint). The residual
-    /// is the block means less the earth rate at the attitude of now (the
-    /// tool is still: its true rate is the same in every cycle, so the
-    /// means' error is the filter's attitude error of now, not a mix of
-    /// the block's estimates, which the zero-velocity updates moved); the
-    /// attitude rows are taken at the error model's linearisation point
-    /// (fixed from the station's second block on, derivation section 4i).
-    /// R is the gyros' noise only: the attitude error is a state of the
-    /// row. The blocks' gyro noise is independent from block to block (the
-    /// AR models' memory is a few samples).
-    ///
-    /// A block whose means fail [`EARTH_RATE_GATE`] is not used: the tool
-    /// turned ([`Gyrocompass::Turning`]).
-    fn gyrocompass_block(&mut self) -> Gyrocompass {
-        let Some(station) = self.station.as_mut() else {
-            return Gyrocompass::Skipped;
-        };
-        let n = station.gyro_epochs;
-        let sum = station.gyro_sum;
-        station.gyro_sum = [0.0; 2];
-        station.gyro_epochs = 0;
-        if n < MIN_BIAS_UPDATE_SAMPLES || self.covariance_invalid {
-            return Gyrocompass::Skipped;
-        }
-        let mean = sum.map(|v| v / f64::from(n));
-        let state = self.filter.state();
-        let omega = earth_rate_n(state.position.lat);
-        let measurement = EarthRate::from_block(
-            mean,
-            n,
-            &dcm_from_quat(&state.attitude),
-            &dcm_from_quat(&self.filter.linearization_attitude()),
-            &omega,
-            GYRO_AXES.map(|axis| long_run_variance(&self.noise.gyro[axis], SAMPLE_INTERVAL_S)),
-        );
-        let measurement = measurement.cast::<T>();
-        let gate = T::of(EARTH_RATE_GATE);
-        if self
-            .filter
-            .largest_normalized_innovation(&measurement)
-            .is_some_and(|nis| nis > gate)
-        {
-            return Gyrocompass::Turning;
-        }
-        self.filter.aid(&measurement);
-        Gyrocompass::Used
-    }
-
-    /// The station survey at this cycle: the filter's attitude as drilling
-    /// angles, their covariance J P_phi J^T (`super::station`), the flags.
-    /// Everything but the station number, start and quality.
-    fn station_survey(&self) -> StationSurvey {
-        let state = self.filter.state();
-        let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
-        let mut flags = station_flags::MAGNETIC_FREE;
-        let inclination = angles.inclination;
-        if !(NEAR_VERTICAL..=core::f64::consts::PI - NEAR_VERTICAL).contains(&inclination) {
-            flags |= station_flags::NEAR_VERTICAL;
-        }
-        let mut survey = StationSurvey {
-            time_us: self.time_us,
-            end_sample: self.sample_counter,
-            angles: [angles.inclination, angles.azimuth, angles.toolface].map(|a| a as f32),
-            angles_std: [f32::NAN; 3],
-            correlations: [f32::NAN; 3],
-            ..StationSurvey::default()
-        };
-        if self.covariance_invalid {
-            survey.flags = flags | station_flags::SOLUTION_INVALID;
-            return survey;
-        }
-        let u = angle_uncertainty(&jacobian, &self.filter.attitude_error_covariance());
-        survey.angles_std = u.sigma.map(|s| s as f32);
-        survey.correlations = u.correlation.map(|r| r as f32);
-        // The navigation frames' rule for the azimuth (see `solution`).
-        let determined = self.coarse_std[2].is_finite()
-            && self.flags & nav_flags::SINGLE_PART == 0
-            && flags & station_flags::NEAR_VERTICAL == 0
-            && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
-        if !determined {
-            flags |= station_flags::AZIMUTH_UNDETERMINED;
-            survey.angles_std[1] = f32::INFINITY;
-            survey.correlations[0] = f32::NAN;
-            survey.correlations[2] = f32::NAN;
-        }
-        let tilt = self.filter.euler_std();
-        if !(tilt.x <= TILT_SIGMA_LIMIT_RAD && tilt.y <= TILT_SIGMA_LIMIT_RAD) {
-            flags |= station_flags::SOLUTION_INVALID;
-        }
-        survey.flags = flags;
-        survey
     }
 
     /// `sample`, with the gyro of index `missing_gyro` (in `GYRO_AXES`)

@@ -7,6 +7,7 @@ use super::*;
 use crate::config::default_still_settings;
 use crate::probe::still::{Hysteresis, DETECTION_DELAY_SAMPLES};
 use crate::probe::test_support::{level_sample, level_turning_sample, ALL_ALIGNMENT};
+use crate::protocol::frame::station_flags;
 use std::format;
 use std::vec::Vec;
 

@@ -5,6 +5,7 @@
 //! moving tool's constraints hold the velocity.
 
 use super::*;
+use crate::protocol::frame::station_flags;
 extern crate std;
 use crate::conventions::{dcm_from_euler, Euler};
 use crate::earth::earth_rate_n;

@@ -1,4 +1,5 @@
 use super::*;
+use crate::protocol::frame::station_flags;
 extern crate std;
 use super::super::still::DETECTION_DELAY_SAMPLES;
 use crate::calibration::TriadCalibration;
