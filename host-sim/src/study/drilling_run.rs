@@ -160,6 +160,10 @@ pub struct StationCheck {
     /// Errors of inclination, azimuth, toolface (rad, wrapped).
     pub error: [f64; 3],
     pub truth_md: f64,
+    /// The azimuth sigma (rad) just before the station's first
+    /// zero-velocity update, as the survey's azimuth chain takes it
+    /// ([`AzimuthSigmaTrack::station_start`]).
+    pub azimuth_sigma_before: Option<f64>,
     /// The survey's position here; `None` where the station is not in
     /// the survey (skipped) or its position is undetermined.
     pub position: Option<PositionCheck>,
@@ -451,7 +455,8 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     }
     let mut checks: Vec<StationCheck> = stations
         .iter()
-        .map(|st| {
+        .zip(&azi_before)
+        .map(|(st, before)| {
             let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
             let a = st.angles.map(f64::from);
             StationCheck {
@@ -462,6 +467,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
                     wrap_pi(a[2] - truth.toolface),
                 ],
                 truth_md: truth.md,
+                azimuth_sigma_before: *before,
                 position: None,
             }
         })

@@ -12,6 +12,7 @@
 
 use super::drilling_coverage::Fraction;
 use super::drilling_run::RunOutcome;
+use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::stats::{median, percentile, rms};
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
@@ -117,6 +118,9 @@ pub struct GradeWellSummary {
     pub azimuth_within_2_sigma: Fraction,
     pub inclination_within_2_sigma: Fraction,
     pub td: TdSummary,
+    /// The stations' azimuth errors' correlation by distance, Monte Carlo
+    /// against the survey's chain (`super::lateral_correlation`).
+    pub azimuth_correlation: Vec<LagCorrelation>,
     /// Runs without a TD check, by reason.
     pub td_unchecked: Vec<(String, usize)>,
     pub requirement: Requirement,
@@ -302,6 +306,8 @@ pub fn summarise(
         method_rms_error_m: rms(&method_err),
         method_predicted_1_sigma_m: rms(&method_sigma),
     };
+    s.azimuth_correlation =
+        azimuth_lag_correlations(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
     s.td_unchecked = unchecked.into_iter().collect();
     s.along_md = by_station.iter().map(|(n, t)| t.along(*n)).collect();
     let ok = s.runs > s.failed_runs.len();
@@ -364,6 +370,7 @@ mod tests {
             },
             error: [0.0005, azimuth_error_deg.to_radians(), 0.0],
             truth_md: 3000.0 + f64::from(number) * 28.0,
+            azimuth_sigma_before: None,
             position: Some(PositionCheck {
                 error_ne: [3.0, 4.0],
                 cov_ne: [9.0, 16.0, 0.0],

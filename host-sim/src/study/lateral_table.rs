@@ -4,6 +4,7 @@
 
 use super::drilling_coverage::Fraction;
 use super::lateral::LateralStudy;
+use super::lateral_correlation::LAGS;
 use super::lateral_summary::{GradeWellSummary, ATTITUDE_LIMIT_DEG, POSITION_LIMIT_M_PER_1000_M};
 
 /// Columns aligned: the first `left` columns to the left, the rest (numbers)
@@ -144,6 +145,32 @@ fn method_split_table(study: &LateralStudy) -> String {
     out
 }
 
+/// The stations' azimuth errors' correlation by distance, Monte Carlo
+/// against the survey's chain (`super::lateral_correlation`).
+fn correlation_table(study: &LateralStudy) -> String {
+    let mut out = String::from(
+        "\nstation azimuth errors' correlation k stations apart: Monte Carlo / the survey's chain (which the TD covariance assumes)\n",
+    );
+    let rows: Vec<Vec<String>> = study
+        .summaries
+        .iter()
+        .map(|s| {
+            let mut row = vec![s.grade.clone(), s.well.clone()];
+            row.extend(
+                s.azimuth_correlation
+                    .iter()
+                    .map(|c| format!("{} / {}", num(c.monte_carlo, 2), num(c.survey_chain, 2))),
+            );
+            row
+        })
+        .collect();
+    let lags: Vec<String> = LAGS.iter().map(|k| format!("k = {k}")).collect();
+    let mut header = vec!["grade", "well"];
+    header.extend(lags.iter().map(String::as_str));
+    out.push_str(&aligned(&header, &rows, 2));
+    out
+}
+
 /// The terminal tables: stations and the attitude requirement, TD and the
 /// position requirement, then the error growth along MD per grade and well.
 pub fn table(study: &LateralStudy) -> String {
@@ -192,6 +219,7 @@ pub fn table(study: &LateralStudy) -> String {
         2,
     ));
     out.push_str(&method_split_table(study));
+    out.push_str(&correlation_table(study));
     for s in &study.summaries {
         if s.motion_seen_stations > 0 {
             out.push_str(&format!(
@@ -407,6 +435,11 @@ pub fn csv(study: &LateralStudy) -> String {
     ];
     let f = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v}"));
     let b = |v: Option<bool>| v.map_or_else(String::new, |v| v.to_string());
+    let mut header: Vec<String> = header.iter().map(|h| h.to_string()).collect();
+    for k in LAGS {
+        header.push(format!("azimuth_correlation_{k}_apart_monte_carlo"));
+        header.push(format!("azimuth_correlation_{k}_apart_survey_chain"));
+    }
     let mut out = header.join(",") + "\n";
     for s in &study.summaries {
         let t = &s.td;
@@ -452,6 +485,12 @@ pub fn csv(study: &LateralStudy) -> String {
             f(s.epochs_per_core_second),
             f(s.epochs_per_thread_wall_second),
         ];
+        let mut fields = fields.to_vec();
+        for k in LAGS {
+            let c = s.azimuth_correlation.iter().find(|c| c.stations_apart == k);
+            fields.push(f(c.and_then(|c| c.monte_carlo)));
+            fields.push(f(c.and_then(|c| c.survey_chain)));
+        }
         out.push_str(&(fields.join(",") + "\n"));
     }
     out

@@ -211,6 +211,26 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
     out
 }
 
+/// The correlation the module's azimuth chain gives the errors of
+/// station `k` and station `k + lag`, for every `k` that has such a
+/// partner: `(s_k / s_(k+lag)) a_(k+1) ... a_(k+lag)` (0 where a sigma is
+/// 0). What the survey's position covariance assumes; `study lateral`
+/// holds it against the Monte Carlo's.
+pub fn azimuth_chain_correlations(sigmas: &[AngleSigma], lag: usize) -> Vec<f64> {
+    let chain = azimuth_chain(sigmas);
+    (0..sigmas.len().saturating_sub(lag))
+        .map(|k| {
+            let (first, later) = (sigmas[k].azi, sigmas[k + lag].azi);
+            if first > 0.0 && later > 0.0 {
+                let carried: f64 = chain[k + 1..=k + lag].iter().map(|l| l.carried).product();
+                first / later * carried
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 /// One link of the azimuth chain `e_k = a_k e_(k-1) + d_k u_k`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct ChainLink {
@@ -369,6 +389,36 @@ mod tests {
         // a start below the previous sigma (0.012 < 0.015 after 0.01):
         // held to s_k / s_(k-1) so the fresh part is not negative
         assert!(chain[3].carried <= 1.0 && chain[3].fresh >= 0.0);
+    }
+
+    #[test]
+    fn the_chains_correlations_are_its_covariances_over_the_sigmas() {
+        let azi = [0.02, 0.03, 0.01, 0.015, 0.005, 0.02];
+        let pre = [None, Some(0.04), Some(0.02), None, Some(0.03), None];
+        let s: Vec<AngleSigma> = azi
+            .iter()
+            .zip(pre)
+            .map(|(&a, b)| AngleSigma {
+                azi_before: b,
+                ..sigma(0.0, a)
+            })
+            .collect();
+        for lag in 1..4 {
+            let r = azimuth_chain_correlations(&s, lag);
+            assert_eq!(r.len(), s.len() - lag);
+            for (k, &rk) in r.iter().enumerate() {
+                let expected = chain_covariance(&s, k, k + lag) / (azi[k] * azi[k + lag]);
+                assert!(
+                    (rk - expected).abs() < 1e-12,
+                    "lag {lag}, {k}: {rk} {expected}"
+                );
+                assert!((0.0..=1.0).contains(&rk));
+            }
+        }
+        // a random walk (growing sigma, no start known): s_j / s_k
+        let walk: Vec<AngleSigma> = [0.01, 0.02, 0.04].map(|a| sigma(0.0, a)).to_vec();
+        assert_eq!(azimuth_chain_correlations(&walk, 2), vec![0.25]);
+        assert!(azimuth_chain_correlations(&walk, 3).is_empty());
     }
 
     #[test]
