@@ -5,9 +5,10 @@
 //! a Markov chain (`survey_error::probe_station`, docs/drilling-survey.md):
 //! the correlation of stations `lag` apart is a product of `lag` carried
 //! fractions, so it decays geometrically. Whether the probe's errors do is
-//! a question for the Monte Carlo: a gyro bias the filter carries from
-//! station to station keeps them correlated longer, and then the TD
-//! ellipse is too small. For each `lag`, over every pair of determined
+//! a question for the Monte Carlo: where the filter carries more from
+//! station to station than the chain holds, they stay correlated longer,
+//! and then the TD ellipse is too small (docs/lateral-study.md, "Why the
+//! high-end grade's TD is over-confident"). For each `lag`, over every pair of determined
 //! stations `lag` apart in every run:
 //!
 //! * Monte Carlo: the pooled correlation of the normalised errors
@@ -19,6 +20,7 @@
 
 use super::drilling_run::RunOutcome;
 use crate::survey_error::probe_station::{azimuth_chain_correlations, AngleSigma};
+use crate::survey_listing::drilling::azimuth_determined;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
 
@@ -41,11 +43,9 @@ fn determined(o: &RunOutcome) -> Vec<(f64, AngleSigma)> {
     o.stations
         .iter()
         .filter(|st| {
-            let flags = st.survey.flags;
-            let sd = st.survey.angles_std[1];
-            flags & (station_flags::SOLUTION_INVALID | station_flags::AZIMUTH_UNDETERMINED) == 0
-                && sd.is_finite()
-                && sd > 0.0
+            st.survey.flags & station_flags::SOLUTION_INVALID == 0
+                && azimuth_determined(&st.survey)
+                && st.survey.angles_std[1] > 0.0
                 && st.error[1].is_finite()
         })
         .map(|st| {
@@ -60,33 +60,45 @@ fn determined(o: &RunOutcome) -> Vec<(f64, AngleSigma)> {
         .collect()
 }
 
+/// Sums over one lag's pairs.
+#[derive(Default)]
+struct PairSums {
+    xy: f64,
+    xx: f64,
+    yy: f64,
+    chain: f64,
+    pairs: usize,
+}
+
 /// The correlations at [`LAGS`] over the runs that finished.
 pub fn azimuth_lag_correlations<'a>(
-    runs: impl IntoIterator<Item = &'a RunOutcome> + Clone,
+    runs: impl IntoIterator<Item = &'a RunOutcome>,
 ) -> Vec<LagCorrelation> {
-    LAGS.iter()
-        .map(|&lag| {
-            let (mut xy, mut xx, mut yy, mut chain, mut pairs) = (0.0, 0.0, 0.0, 0.0, 0);
-            for o in runs.clone() {
-                let stations = determined(o);
-                let sigmas: Vec<AngleSigma> = stations.iter().map(|(_, s)| *s).collect();
-                let model = azimuth_chain_correlations(&sigmas, lag);
-                for (k, r) in model.iter().enumerate() {
-                    let x = stations[k].0 / stations[k].1.azi;
-                    let y = stations[k + lag].0 / stations[k + lag].1.azi;
-                    xy += x * y;
-                    xx += x * x;
-                    yy += y * y;
-                    chain += r;
-                    pairs += 1;
-                }
+    let mut sums: [PairSums; LAGS.len()] = Default::default();
+    for o in runs {
+        let stations = determined(o);
+        let sigmas: Vec<AngleSigma> = stations.iter().map(|(_, s)| *s).collect();
+        let normalised: Vec<f64> = stations.iter().map(|(e, s)| e / s.azi).collect();
+        for (sum, &lag) in sums.iter_mut().zip(&LAGS) {
+            for (k, r) in azimuth_chain_correlations(&sigmas, lag).iter().enumerate() {
+                let (x, y) = (normalised[k], normalised[k + lag]);
+                sum.xy += x * y;
+                sum.xx += x * x;
+                sum.yy += y * y;
+                sum.chain += r;
+                sum.pairs += 1;
             }
-            let norm = (xx * yy).sqrt();
+        }
+    }
+    sums.iter()
+        .zip(LAGS)
+        .map(|(s, lag)| {
+            let norm = (s.xx * s.yy).sqrt();
             LagCorrelation {
                 stations_apart: lag,
-                pairs,
-                monte_carlo: (pairs > 0 && norm > 0.0).then(|| xy / norm),
-                survey_chain: (pairs > 0).then(|| chain / pairs as f64),
+                pairs: s.pairs,
+                monte_carlo: (s.pairs > 0 && norm > 0.0).then(|| s.xy / norm),
+                survey_chain: (s.pairs > 0).then(|| s.chain / s.pairs as f64),
             }
         })
         .collect()

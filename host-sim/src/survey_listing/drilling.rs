@@ -140,7 +140,9 @@ impl<'a> FromIterator<&'a NavSolution> for AzimuthSigmaTrack {
     }
 }
 
-fn azimuth_determined(s: &StationSurvey) -> bool {
+/// The station's azimuth is a number with a finite sigma (the survey's
+/// rule; `study lateral` counts with it too).
+pub(crate) fn azimuth_determined(s: &StationSurvey) -> bool {
     s.flags & station_flags::AZIMUTH_UNDETERMINED == 0 && s.angles_std[1].is_finite()
 }
 
