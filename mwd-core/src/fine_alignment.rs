@@ -20,7 +20,8 @@ use crate::error_model::{
     VEL,
 };
 use crate::kalman::{
-    std_dev_of, FilterScalar, KalmanFilter, Measurement, Transition, UpdateReport,
+    std_dev_of, CrossCovariances, FilterScalar, KalmanFilter, Measurement, Transition,
+    UpdateReport, LINKED, SNAPSHOTS,
 };
 use crate::mechanization::{ImuSample, NavState, Strapdown};
 use crate::sensor_noise::ImuNoise;
@@ -355,6 +356,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             self.q[i] *= T::of(config.ar_noise_scale);
         }
         self.filter.x.fill(T::zero());
+        self.filter.cross.clear_all();
         self.filter.gate = config.gate.map(T::of);
         self.strapdown = Strapdown::new(initial, model.dt);
         self.config = config;
@@ -627,6 +629,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
                 p[(ATT + i, ATT + j)] = T::of(p_phi[(i, j)]);
             }
         }
+        self.filter.cross.forget_states(ATT, 3);
     }
 
     /// Adds `q` (rad^2, nav frame, symmetric positive semi-definite) to the
@@ -689,6 +692,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
         p[(ATT + 2, ATT + 2)] = T::of(variance);
         self.filter.x[ATT + 2] = T::zero();
+        self.filter.cross.forget_states(ATT + 2, 1);
     }
 
     /// Turns the solution about the tool axis so that its roll is `roll`
@@ -738,6 +742,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         if N != STATES_WITH_BIASES {
             return;
         }
+        self.filter.cross.forget_states(ACCEL_BIAS, 3);
         let p = &mut self.filter.p;
         for i in ACCEL_BIAS..ACCEL_BIAS + 3 {
             for j in 0..N {
@@ -908,6 +913,18 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     }
 
     /// Covariance of the attitude error phi (nav frame), rad^2.
+    /// The state's covariance with snapshots of earlier states
+    /// (`kalman::CrossCovariances`).
+    pub fn snapshots(&self) -> &CrossCovariances<T, N> {
+        &self.filter.cross
+    }
+
+    /// Starts snapshot `slot` of `z = L x` now, or empties or moves the
+    /// snapshots (`kalman::CrossCovariances`).
+    pub fn snapshots_mut(&mut self) -> (&SMatrix<T, N, N>, &mut CrossCovariances<T, N>) {
+        (&self.filter.p, &mut self.filter.cross)
+    }
+
     pub fn attitude_error_covariance(&self) -> Matrix3<f64> {
         self.filter
             .p
@@ -1006,7 +1023,21 @@ pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
     }
     let mut s = w.dot(&z);
     let wx = w.dot(&filter.x);
+    // The snapshots' cross-covariances take the same transition M = Phi -
+    // e w^T: Phi G in `predict`, then the held rows less t (w^T G).
+    let mut wg = [T::zero(); SNAPSHOTS * LINKED];
+    for (wgc, column) in wg.iter_mut().zip(filter.cross.columns_mut()) {
+        *wgc = w
+            .iter()
+            .zip(column.iter())
+            .fold(T::zero(), |acc, (a, b)| acc + *a * *b);
+    }
     filter.predict(phi, q);
+    for (wgc, column) in wg.iter().zip(filter.cross.columns_mut()) {
+        for (k, tk) in t.iter().enumerate() {
+            column[ATT + k] -= *tk * *wgc;
+        }
+    }
     phi.apply_to_vector(&mut z);
     // The held row's process noise is zero as well: x' = M x + (I - e e^T)
     // n (the held component is t . phi_k itself, with no sensor behind

@@ -104,7 +104,7 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         .iter()
         .map(|s| track.before(s.start_sample))
         .collect();
-    let survey = drilling::survey(&stations, &azi_before, &depth, tie, &terms, &site)
+    let survey = drilling::survey(&stations, &azi_before, &[], &depth, tie, &terms, &site)
         .with_context(|| format!("{}", args.stations.display()))?;
     let s = &capture.stats;
     let bad = s.crc_errors + s.malformed + s.unknown_kind;

@@ -114,7 +114,15 @@ pub fn stations_json(
                 north: 0.0,
                 east: 0.0,
             };
-            match drilling::survey(stations, azi_before, depth, tie, &setup.terms, &setup.site) {
+            match drilling::survey(
+                stations,
+                azi_before,
+                &[],
+                depth,
+                tie,
+                &setup.terms,
+                &setup.site,
+            ) {
                 Ok(survey) => {
                     for d in &survey.rows {
                         // By number and time: a station's NaN correlations

@@ -21,7 +21,7 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::NavigatorScalar;
-use mwd_core::probe::{Navigator, TieIn};
+use mwd_core::probe::{Navigator, StationLink, TieIn};
 use mwd_core::probe_sample::ProbeSample;
 use mwd_core::protocol::{NavSolution, RawSample, StationSurvey};
 use mwd_core::timing::{sample_time_us, SAMPLE_INTERVAL_S};
@@ -164,6 +164,9 @@ pub struct StationCheck {
     /// zero-velocity update, as the survey's azimuth chain takes it
     /// ([`AzimuthSigmaTrack::station_start`]).
     pub azimuth_sigma_before: Option<f64>,
+    /// The probe's link of this station's errors to the previous
+    /// station's (`mwd_core::probe::station_link`), as the survey takes it.
+    pub link: Option<StationLink>,
     /// The survey's position here; `None` where the station is not in
     /// the survey (skipped) or its position is undetermined.
     pub position: Option<PositionCheck>,
@@ -344,6 +347,17 @@ fn feed<T: NavigatorScalar>(
     })
 }
 
+/// The navigator's link for the station it just finished.
+fn link_of<T: NavigatorScalar>(
+    navigator: &Navigator<T>,
+    station: &StationSurvey,
+) -> Option<StationLink> {
+    navigator
+        .station_link()
+        .filter(|l| l.station == station.station)
+        .copied()
+}
+
 /// Runs seed `seed`, the navigator's filter in `config.scalar`.
 pub fn run(config: &RunConfig, seed: u64) -> Result<RunOutcome> {
     match config.scalar {
@@ -391,11 +405,14 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let mut navigator = Navigator::<T>::calibrated(site, calibration);
     // the SCC1300's is the navigator's own static: unchanged
     navigator.set_noise_budget(config.grade.budget_ref());
+    // the survey's chain in the links' states (`survey_error::link_chain`)
+    navigator.track_station_links(true);
     let mut tied = false;
     let mut stations = Vec::new();
     // each station's azimuth sigma at its start, for the survey's chain
     let mut track = AzimuthSigmaTrack::default();
     let mut azi_before = Vec::new();
+    let mut links = Vec::new();
     let mut samples = 0;
     let sim = DrillingSimulator::new(&drilling, model.clone(), SAMPLE_INTERVAL_S);
     // the last sample's true means and whether the run ends still
@@ -424,6 +441,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         }
         if let Some(station) = navigator.take_station() {
             azi_before.push(track.station_start(&station));
+            links.push(link_of(&navigator, &station));
             stations.push(station);
         }
     }
@@ -448,6 +466,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
             samples += 1;
             if let Some(station) = navigator.take_station() {
                 azi_before.push(track.station_start(&station));
+                links.push(link_of(&navigator, &station));
                 stations.push(station);
                 break;
             }
@@ -456,7 +475,8 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let mut checks: Vec<StationCheck> = stations
         .iter()
         .zip(&azi_before)
-        .map(|(st, before)| {
+        .zip(&links)
+        .map(|((st, before), link)| {
             let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
             let a = st.angles.map(f64::from);
             StationCheck {
@@ -468,6 +488,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
                 ],
                 truth_md: truth.md,
                 azimuth_sigma_before: *before,
+                link: *link,
                 position: None,
             }
         })
@@ -489,6 +510,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let survey = drilling::survey(
         &stations,
         &azi_before,
+        &links,
         &depth,
         tie,
         &config.terms,

@@ -3,13 +3,13 @@
 //!
 //! The survey's TD covariance correlates the stations' azimuth errors as
 //! a Markov chain (`survey_error::probe_station`, docs/drilling-survey.md):
-//! the correlation of stations `lag` apart is a product of `lag` carried
-//! fractions, so it decays geometrically. Whether the probe's errors do is
-//! a question for the Monte Carlo: where the filter carries more from
-//! station to station than the chain holds, they stay correlated longer,
-//! and then the TD ellipse is too small (docs/lateral-study.md, "Why the
-//! high-end grade's TD is over-confident"). For each `lag`, over every pair of determined
-//! stations `lag` apart in every run:
+//! in the azimuth alone, or, with the probe's station links, in the
+//! azimuth and the x and z gyro biases. Whether the probe's errors follow
+//! it is a question for the Monte Carlo: where the filter carries more
+//! from station to station than the chain holds, they stay correlated
+//! longer, and then the TD ellipse is too small (docs/lateral-study.md,
+//! "Why the high-end grade's TD is over-confident"). For each `lag`, over
+//! every pair of determined stations `lag` apart in every run:
 //!
 //! * Monte Carlo: the pooled correlation of the normalised errors
 //!   `x = e / s`, `sum(x_k x_(k+lag)) / sqrt(sum(x_k^2) sum(x_(k+lag)^2))`;
@@ -19,7 +19,7 @@
 //! within the Monte Carlo's spread.
 
 use super::drilling_run::RunOutcome;
-use crate::survey_error::probe_station::{azimuth_chain_correlations, AngleSigma};
+use crate::survey_error::probe_station::{azimuth_chain_correlations, links_in_order, AngleSigma};
 use crate::survey_listing::drilling::azimuth_determined;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -40,7 +40,8 @@ pub struct LagCorrelation {
 /// One run's determined azimuths in station order: (error, sigma, the
 /// survey chain's input), rad.
 fn determined(o: &RunOutcome) -> Vec<(f64, AngleSigma)> {
-    o.stations
+    let kept: Vec<_> = o
+        .stations
         .iter()
         .filter(|st| {
             st.survey.flags & station_flags::SOLUTION_INVALID == 0
@@ -48,12 +49,17 @@ fn determined(o: &RunOutcome) -> Vec<(f64, AngleSigma)> {
                 && st.survey.angles_std[1] > 0.0
                 && st.error[1].is_finite()
         })
-        .map(|st| {
+        .collect();
+    let numbered: Vec<_> = kept.iter().map(|st| (st.survey.station, st.link)).collect();
+    kept.iter()
+        .zip(links_in_order(&numbered))
+        .map(|(st, link)| {
             let sigma = AngleSigma {
                 inc: 0.0,
                 azi: f64::from(st.survey.angles_std[1]),
                 corr_inc_azi: 0.0,
                 azi_before: st.azimuth_sigma_before,
+                link,
             };
             (st.error[1], sigma)
         })
@@ -120,6 +126,7 @@ mod tests {
             error: [0.0, error, 0.0],
             truth_md: 3000.0 + f64::from(number) * 28.0,
             azimuth_sigma_before: before,
+            link: None,
             position: None,
         }
     }

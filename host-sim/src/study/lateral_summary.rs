@@ -371,6 +371,7 @@ mod tests {
             error: [0.0005, azimuth_error_deg.to_radians(), 0.0],
             truth_md: 3000.0 + f64::from(number) * 28.0,
             azimuth_sigma_before: None,
+            link: None,
             position: Some(PositionCheck {
                 error_ne: [3.0, 4.0],
                 cov_ne: [9.0, 16.0, 0.0],

@@ -87,6 +87,7 @@ pub struct ErrorTerm {
     pub propagation: Propagation,
 }
 
+mod link_chain;
 pub mod probe_model;
 pub mod probe_station;
 pub mod probe_weighting;

@@ -25,6 +25,14 @@
 //!   independent sources (positive semi-definite by construction). One
 //!   source per station, from that station on, decaying by the `a`s; the
 //!   first is the tie-in's part;
+//! * azimuth, when the probe's station links are at hand for every
+//!   station ([`AngleSigma::link`]): the chain above forgets in one
+//!   station what the filter's gyro bias estimates carry for several (the
+//!   high-end MEMS grade's stations 2 and 4 apart are correlated 0.16 and
+//!   0.10, the chain says 0.07 and 0.01; docs/lateral-study.md). The chain
+//!   then runs in the link's three error states, azimuth and the x and z
+//!   gyro biases, with the covariances the filter computed
+//!   ([`super::link_chain`]): three sources per station;
 //! * inclination: re-levelled at every station through the zero-velocity
 //!   updates, so random from station to station, except for the part the
 //!   filter correlates with that station's azimuth:
@@ -49,7 +57,9 @@
 //! doubling: [`super::TieOn::Exact`]). Depth errors are separate sources
 //! (the engine's DSF/DST, [`super::run`]).
 
+use super::link_chain::{link_covariance, LinkChain};
 use super::{Cov6, Station};
+use mwd_core::probe::StationLink;
 
 /// One station's angle uncertainty (rad), as the probe sends it. `azi`
 /// must be finite (an undetermined azimuth has no propagation: the caller
@@ -65,6 +75,12 @@ pub struct AngleSigma {
     /// `None` (or not a finite number > 0): the previous station's sigma
     /// (module docs).
     pub azi_before: Option<f64>,
+    /// The station's link to the previous station's errors, as the probe's
+    /// filter computed it (`mwd_core::probe::station_link`). When every
+    /// station has one, linked each to the one before, the azimuth chain
+    /// runs in the link's three error states (`super::link_chain`) instead
+    /// of the azimuth alone.
+    pub link: Option<StationLink>,
 }
 
 /// Why a propagation was refused.
@@ -177,8 +193,22 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
             }
         })
         .collect();
-    let chain = azimuth_chain(sigmas);
-    let mut out = Vec::with_capacity(2 * n);
+    let mut out = Vec::with_capacity(4 * n);
+    if let Some(chain) = link_chain(sigmas) {
+        for azimuth in chain.azimuth_sources() {
+            let weights = azimuth
+                .iter()
+                .zip(&share)
+                .map(|(a, s)| [s * a, *a])
+                .collect();
+            out.push(Source { weights });
+        }
+    }
+    let chain = if out.is_empty() {
+        azimuth_chain(sigmas)
+    } else {
+        Vec::new()
+    };
     for (j, link) in chain.iter().enumerate() {
         if link.fresh == 0.0 {
             continue;
@@ -213,10 +243,25 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
 
 /// The correlation the module's azimuth chain gives the errors of
 /// station `k` and station `k + lag`, for every `k` that has such a
-/// partner: `(s_k / s_(k+lag)) a_(k+1) ... a_(k+lag)` (0 where a sigma is
-/// 0). What the survey's position covariance assumes; `study lateral`
+/// partner: `(s_k / s_(k+lag)) a_(k+1) ... a_(k+lag)`, or with the
+/// stations' links `(A_(k+lag) ... A_(k+1) Sigma_k)[0][0] / (s_k
+/// s_(k+lag))` (0 where a sigma is 0). What the survey's position covariance assumes; `study lateral`
 /// holds it against the Monte Carlo's.
 pub fn azimuth_chain_correlations(sigmas: &[AngleSigma], lag: usize) -> Vec<f64> {
+    if let Some(links) = link_chain(sigmas) {
+        return (0..sigmas.len().saturating_sub(lag))
+            .map(|k| {
+                let (first, later) = (sigmas[k].azi, sigmas[k + lag].azi);
+                let sigma_k = sigmas[k].link.as_ref().map(link_covariance);
+                match sigma_k {
+                    Some(s) if first > 0.0 && later > 0.0 => {
+                        links.azimuth_covariance(&s, k, lag) / (first * later)
+                    }
+                    _ => 0.0,
+                }
+            })
+            .collect();
+    }
     let chain = azimuth_chain(sigmas);
     (0..sigmas.len().saturating_sub(lag))
         .map(|k| {
@@ -229,6 +274,34 @@ pub fn azimuth_chain_correlations(sigmas: &[AngleSigma], lag: usize) -> Vec<f64>
             }
         })
         .collect()
+}
+
+/// Each station's link where it links back to the station before it in
+/// `stations` (station number, link), the first's as it is; `None`
+/// elsewhere (a station the survey skipped breaks the chain, and without
+/// every link the survey keeps its chain in the azimuth alone).
+pub fn links_in_order(stations: &[(u16, Option<StationLink>)]) -> Vec<Option<StationLink>> {
+    stations
+        .iter()
+        .enumerate()
+        .map(|(k, (number, link))| {
+            let link = link.filter(|l| l.station == *number)?;
+            match k.checked_sub(1) {
+                None => Some(link),
+                Some(before) => (link.previous == stations[before].0).then_some(link),
+            }
+        })
+        .collect()
+}
+
+/// The chain in the links' three states, when every station has a link
+/// (each but the first back to the one before, `super::link_chain`).
+fn link_chain(sigmas: &[AngleSigma]) -> Option<LinkChain> {
+    let links: Vec<Option<StationLink>> = sigmas.iter().map(|s| s.link).collect();
+    if links.is_empty() {
+        return None;
+    }
+    LinkChain::new(&links)
 }
 
 /// One link of the azimuth chain `e_k = a_k e_(k-1) + d_k u_k`.
@@ -334,6 +407,7 @@ mod tests {
             azi,
             corr_inc_azi: 0.0,
             azi_before: None,
+            link: None,
         }
     }
 
@@ -350,6 +424,7 @@ mod tests {
     fn every_station_keeps_its_own_azimuth_sigma_whatever_the_chain() {
         let before = |b: Option<f64>| AngleSigma {
             azi_before: b,
+            link: None,
             ..sigma(0.0, 0.0)
         };
         // growing, shrinking, a start below the previous station's sigma,
@@ -400,6 +475,7 @@ mod tests {
             .zip(pre)
             .map(|(&a, b)| AngleSigma {
                 azi_before: b,
+                link: None,
                 ..sigma(0.0, a)
             })
             .collect();
@@ -431,6 +507,7 @@ mod tests {
         let refound: Vec<AngleSigma> = (0..5)
             .map(|_| AngleSigma {
                 azi_before: Some(10.0 * s),
+                link: None,
                 ..sigma(0.0, s)
             })
             .collect();
@@ -500,6 +577,7 @@ mod tests {
                 azi: 0.002,
                 corr_inc_azi: 0.9,
                 azi_before: None,
+                link: None,
             };
             3
         ];
@@ -525,6 +603,76 @@ mod tests {
         assert_eq!(
             angle_covariance(&same, &[sigma(0.0, 0.1); 2]),
             Err(PropagationError::MdNotIncreasing(1))
+        );
+    }
+
+    /// Stations linked by a chain whose biases remember: with the links
+    /// the survey correlates stations 4 apart as the chain does, and the
+    /// sideways position at the end grows; without them (one link that
+    /// does not point back to the station before) it falls back to the
+    /// azimuth chain.
+    #[test]
+    fn with_every_link_the_azimuth_chain_runs_in_the_links_states() {
+        use nalgebra::Matrix3;
+        let a = Matrix3::new(0.3, 2.0e5, -1.0e5, 0.0, 0.95, 0.0, 0.0, 0.0, 0.95);
+        let q = Matrix3::new(4e-4, 0.0, 0.0, 0.0, 1e-13, 0.0, 0.0, 0.0, 1e-13);
+        let arr =
+            |m: Matrix3<f64>| std::array::from_fn(|r| std::array::from_fn(|c| m[(r, c)] as f32));
+        let mut sigma = Matrix3::new(1e-4, 0.0, 0.0, 0.0, 1e-12, 0.0, 0.0, 0.0, 1e-12);
+        let mut sigmas = Vec::new();
+        let mut numbered = Vec::new();
+        for k in 1..=10u16 {
+            let cross = (k > 1).then(|| a * sigma);
+            if k > 1 {
+                sigma = a * sigma * a.transpose() + q;
+            }
+            let link = StationLink {
+                station: k,
+                previous: k - 1,
+                covariance: arr(sigma),
+                cross_previous: cross.map(arr),
+            };
+            numbered.push((k, Some(link)));
+            sigmas.push((sigma, link));
+        }
+        let with: Vec<AngleSigma> = links_in_order(&numbered)
+            .into_iter()
+            .zip(&sigmas)
+            .map(|(link, (s, _))| AngleSigma {
+                inc: 0.001,
+                azi: s[(0, 0)].sqrt(),
+                corr_inc_azi: 0.0,
+                azi_before: None,
+                link,
+            })
+            .collect();
+        assert!(with.iter().all(|s| s.link.is_some()));
+        let mut apart = sigmas[2].0;
+        for _ in 0..4 {
+            apart = a * apart;
+        }
+        let want = apart[(0, 0)] / (with[2].azi * with[6].azi);
+        let got = azimuth_chain_correlations(&with, 4)[2];
+        assert!((got - want).abs() < 1e-4, "{got} against {want}");
+        assert!(want > 0.1, "the test's memory is long: {want}");
+        // station 5's link points elsewhere: no chain in the links' states
+        numbered[4].1.as_mut().unwrap().previous = 9;
+        let broken = links_in_order(&numbered);
+        assert!(broken[4].is_none() && broken[5].is_some());
+        let without: Vec<AngleSigma> = with
+            .iter()
+            .zip(&broken)
+            .map(|(s, l)| AngleSigma { link: *l, ..*s })
+            .collect();
+        let scalar = azimuth_chain_correlations(&without, 4)[2];
+        assert!(scalar < 0.5 * want, "{scalar}");
+        let st = straight(10, 28.0, 90.0, 0.0);
+        let east = |s: &[AngleSigma]| angle_covariance(&st, s).unwrap()[9][1];
+        assert!(
+            east(&with) > 1.1 * east(&without),
+            "{} {}",
+            east(&with),
+            east(&without)
         );
     }
 }

@@ -15,9 +15,10 @@
 
 use super::depth_log::DepthLog;
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
-use crate::survey_error::probe_station::{angle_covariance, AngleSigma};
+use crate::survey_error::probe_station::{angle_covariance, links_in_order, AngleSigma};
 use crate::survey_error::{self, Cov6, ErrorTerm, Site, Station};
 use anyhow::{anyhow, bail, Result};
+use mwd_core::probe::StationLink;
 use mwd_core::protocol::frame::{nav_flags, nav_mode, station_flags};
 use mwd_core::protocol::{NavSolution, StationSurvey};
 
@@ -166,13 +167,14 @@ fn unusable(s: &StationSurvey) -> Option<&'static str> {
 pub fn survey(
     stations: &[StationSurvey],
     azi_before: &[Option<f64>],
+    links: &[Option<StationLink>],
     depth: &DepthLog,
     tie: TieOnInput,
     terms: &[ErrorTerm],
     site: &Site,
 ) -> Result<DrillingSurvey> {
     let mut skipped = Vec::new();
-    let mut kept: Vec<(StationSurvey, f64, f64, Option<f64>)> = Vec::new();
+    let mut kept: Vec<(StationSurvey, f64, f64, Option<f64>, Option<StationLink>)> = Vec::new();
     let (first, last) = depth.span();
     for (k, s) in stations.iter().enumerate() {
         if let Some(reason) = unusable(s) {
@@ -202,7 +204,7 @@ pub fn survey(
         }
         // Not beyond the previous station: the string did not move in
         // between; the later station (more still time behind it) stands.
-        while let Some((previous, _, prev_md, _)) = kept.last() {
+        while let Some((previous, _, prev_md, ..)) = kept.last() {
             if md > *prev_md {
                 break;
             }
@@ -212,9 +214,15 @@ pub fn survey(
             });
             kept.pop();
         }
-        kept.push((*s, time_s, md, azi_before.get(k).copied().flatten()));
+        kept.push((
+            *s,
+            time_s,
+            md,
+            azi_before.get(k).copied().flatten(),
+            links.get(k).copied().flatten(),
+        ));
     }
-    let Some(&(_, _, first_md, _)) = kept.first() else {
+    let Some(&(_, _, first_md, ..)) = kept.first() else {
         bail!("no usable station survey in the capture");
     };
     let md_offset_m = tie.md.map_or(0.0, |md| md - first_md);
@@ -222,7 +230,7 @@ pub fn survey(
         unit: LengthUnit::Metre,
         stations: kept
             .iter()
-            .map(|(s, time_s, md, _)| InputStation {
+            .map(|(s, time_s, md, ..)| InputStation {
                 md: md + md_offset_m,
                 inc_deg: f64::from(s.angles[0]).to_degrees(),
                 azi_deg: f64::from(s.angles[1]).to_degrees(),
@@ -233,14 +241,17 @@ pub fn survey(
     };
     let tie_position = TieOnInput { md: None, ..tie };
     let (rows, _) = compute(&file, AzimuthReference::True, tie_position, None)?;
+    let numbered: Vec<_> = kept.iter().map(|k| (k.0.station, k.4)).collect();
     let sigmas: Vec<Option<AngleSigma>> = kept
         .iter()
-        .map(|(s, _, _, before)| {
+        .zip(links_in_order(&numbered))
+        .map(|((s, _, _, before, _), link)| {
             azimuth_determined(s).then_some(AngleSigma {
                 inc: f64::from(s.angles_std[0]),
                 azi: f64::from(s.angles_std[1]),
                 corr_inc_azi: f64::from(s.correlations[0]),
                 azi_before: *before,
+                link,
             })
         })
         .collect();
@@ -443,6 +454,7 @@ pub fn trajectory(
                 azi: s[1],
                 corr_inc_azi: f64::NAN,
                 azi_before: None,
+                link: None,
             })
         })
         .collect();

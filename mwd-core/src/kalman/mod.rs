@@ -15,10 +15,12 @@
 //!   or a non-positive innovation variance is rejected, and an optional
 //!   chi-square gate on the normalised innovation squared rejects outliers.
 
+mod cross;
 pub mod dense;
 mod measurement;
 mod scalar;
 
+pub use cross::{CrossCovariances, LINKED, SNAPSHOTS};
 pub use measurement::{Measurement, ScalarMeasurement, SparseRow, MAX_ROW_NONZEROS};
 use nalgebra::{RealField, SMatrix, SVector};
 
@@ -118,6 +120,9 @@ pub struct KalmanFilter<T: FilterScalar, const N: usize> {
     /// Chi-square threshold on `innovation^2 / variance` (1 degree of
     /// freedom), e.g. 9 for 3 sigma; `None` disables gating.
     pub gate: Option<T>,
+    /// The state's covariance with snapshots of earlier states, kept
+    /// through every time and measurement update here (`cross`).
+    pub cross: CrossCovariances<T, N>,
 }
 
 impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
@@ -127,6 +132,7 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
             x: SVector::zeros(),
             p: p0,
             gate: None,
+            cross: CrossCovariances::default(),
         }
     }
 
@@ -140,6 +146,7 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
     /// for noise that enters single states).
     pub fn predict<F: Transition<T, N>>(&mut self, phi: &F, q_diag: &SVector<T, N>) {
         phi.apply_to_vector(&mut self.x);
+        self.cross.predict(phi);
         self.propagate_covariance(phi, q_diag);
     }
 
@@ -159,7 +166,8 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
     /// One scalar measurement (eq. 19-21 with a 1 x N row). Leaves the
     /// filter untouched unless the outcome is `Accepted`.
     pub fn update_scalar(&mut self, m: &ScalarMeasurement<T>) -> ScalarOutcome<T> {
-        let outcome = scalar::joseph_update(&mut self.x, &mut self.p, m, self.gate);
+        let outcome =
+            scalar::joseph_update(&mut self.x, &mut self.p, m, self.gate, &mut self.cross);
         if outcome.is_accepted() {
             mirror_upper(&mut self.p);
         }
@@ -172,7 +180,9 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
         let mut report = UpdateReport::default();
         for k in 0..m.len() {
             let outcome = match m.scalar(k) {
-                Some(s) => scalar::joseph_update(&mut self.x, &mut self.p, &s, self.gate),
+                Some(s) => {
+                    scalar::joseph_update(&mut self.x, &mut self.p, &s, self.gate, &mut self.cross)
+                }
                 None => ScalarOutcome::NonFinite,
             };
             report.count(&outcome);

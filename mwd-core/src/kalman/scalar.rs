@@ -1,7 +1,7 @@
 //! Scalar measurement update with a sparse row, Joseph form (eq. 19-21).
 
 use super::measurement::ScalarMeasurement;
-use super::{FilterScalar, ScalarOutcome};
+use super::{CrossCovariances, FilterScalar, ScalarOutcome};
 use nalgebra::{SMatrix, SVector};
 
 /// Updates `x` and `p` with one scalar; on any rejection both are left as
@@ -14,6 +14,7 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     p: &mut SMatrix<T, N, N>,
     m: &ScalarMeasurement<T>,
     gate: Option<T>,
+    cross: &mut CrossCovariances<T, N>,
 ) -> ScalarOutcome<T> {
     let row_finite = m.h.entries().all(|(i, c)| i < N && c.is_finite());
     if !(m.z.is_finite() && m.r.is_finite() && m.r >= T::zero() && row_finite) {
@@ -75,6 +76,9 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     if !finite {
         return ScalarOutcome::Degenerate;
     }
+
+    // The snapshots' cross-covariances take the same gain (`cross`).
+    cross.update(&k, &m.h);
 
     // State, eq. 20.
     for (xi, ki) in x.iter_mut().zip(&k) {

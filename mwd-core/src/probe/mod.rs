@@ -9,12 +9,14 @@
 //!   surveying, take a station now, toolface indexing).
 //! * [`still`]: the still detector.
 //! * [`station`]: a station's drilling angles and their covariance.
+//! * [`station_link`]: a station's errors' link to the previous station's.
 //! * [`tie_in`]: a start from a parent well's survey instead of the
 //!   static alignment.
 
 pub mod navigator;
 pub mod raw;
 pub mod station;
+pub mod station_link;
 pub mod still;
 #[cfg(test)]
 mod test_support;
@@ -22,4 +24,5 @@ pub mod tie_in;
 
 pub use navigator::{Navigator, NavigatorScalar};
 pub use raw::body_sample;
+pub use station_link::StationLink;
 pub use tie_in::{TieIn, TieInAngle, TieInError};

@@ -51,6 +51,7 @@ mod station_cycle;
 
 use super::raw::{reading, Reading};
 use super::station::angles_and_jacobian;
+use super::station_link::StationLink;
 use super::still::{Hysteresis, StillDetector};
 use super::tie_in::{TieIn, TieInTilt};
 use crate::aid_sources::{
@@ -260,6 +261,11 @@ struct Station {
     /// cycles, and the one before it: what the station sends.
     checkpoint: Option<StationSurvey>,
     settled: Option<StationSurvey>,
+    /// Their links to the previous station (`station_link`; `None` where
+    /// the covariance was not valid).
+    link: Option<StationLink>,
+    checkpoint_link: Option<StationLink>,
+    settled_link: Option<StationLink>,
     /// Sums of the x and z gyros' readings over the block's still cycles
     /// for the rate gyrocompass (`aid_sources::EarthRate`).
     gyro_sum: [f64; 2],
@@ -318,6 +324,12 @@ pub struct Navigator<T: FilterScalar = f32> {
     station_zupt_variance: f64,
     /// A finished station, until taken.
     finished_station: Option<StationSurvey>,
+    /// The link of the last station finished, and the station whose sent
+    /// survey the filter's `station_link::PREVIOUS` snapshot is of.
+    finished_link: Option<StationLink>,
+    linked_station: u16,
+    /// [`track_station_links`](Self::track_station_links).
+    station_links: bool,
     /// This still cycle's x and z gyro readings, for the rate gyrocompass
     /// (a zero-velocity cycle with both parts).
     still_gyro: Option<[f64; 2]>,
@@ -520,6 +532,9 @@ impl<T: FilterScalar> Navigator<T> {
             max_station_samples: MAX_STATION_SAMPLES,
             station_zupt_variance: STATION_ZUPT_VARIANCE,
             finished_station: None,
+            finished_link: None,
+            linked_station: 0,
+            station_links: false,
             still_gyro: None,
             drilled_since_station: false,
             was_still: false,
@@ -541,6 +556,19 @@ impl<T: FilterScalar> Navigator<T> {
     /// grades use it (the probe flies the SCC1300).
     pub fn set_noise_budget(&mut self, noise: &'static ImuNoise) {
         self.noise = noise;
+    }
+
+    /// Whether the filter keeps the station links (`station_link`): off by
+    /// default. No frame carries them yet, and on the probe they cost a
+    /// drilling cycle ~14,500 instructions (the QEMU drilling run's worst
+    /// cycle 405,120, over the 10 % budget: docs/budgets.md); the host's
+    /// studies turn them on. Off, the snapshots already kept are dropped.
+    pub fn track_station_links(&mut self, on: bool) {
+        self.station_links = on;
+        if !on {
+            self.filter.snapshots_mut().1.clear_all();
+            self.finished_link = None;
+        }
     }
 
     /// The sensors' error budget the navigator models.
@@ -597,6 +625,15 @@ impl<T: FilterScalar> Navigator<T> {
     /// any: the probe sends it after that step's navigation frame.
     pub fn take_station(&mut self) -> Option<StationSurvey> {
         self.finished_station.take()
+    }
+
+    /// The link to the previous station of the last station the station
+    /// tracking finished (`station_link`), once it is taken: `None` when
+    /// its covariance was not valid or it was too short to have two
+    /// checkpoints. A station sent on request or as an indexing dwell has
+    /// none; match on `StationLink::station`.
+    pub fn station_link(&self) -> Option<&StationLink> {
+        self.finished_link.as_ref()
     }
 
     /// Stations started since boot.

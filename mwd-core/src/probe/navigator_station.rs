@@ -13,8 +13,11 @@ use crate::aid_sources::{long_run_variance, EarthRate};
 use crate::attitude::NEAR_VERTICAL;
 use crate::conventions::dcm_from_quat;
 use crate::earth::earth_rate_n;
-use crate::kalman::FilterScalar;
+use crate::kalman::{FilterScalar, SparseRow, LINKED};
 use crate::probe::station::{angle_uncertainty, angles_and_jacobian};
+use crate::probe::station_link::{
+    link_covariance, link_rows, StationLink, CHECKPOINT, PREVIOUS, SETTLED,
+};
 use crate::probe_sample::GYRO_AXES;
 use crate::protocol::frame::{nav_flags, station_flags};
 use crate::protocol::StationSurvey;
@@ -58,6 +61,9 @@ impl<T: FilterScalar> Navigator<T> {
                 gyro_epochs: 0,
                 checkpoint: None,
                 settled: None,
+                link: None,
+                checkpoint_link: None,
+                settled_link: None,
             });
         }
         let Some(station) = self.station.as_mut() else {
@@ -83,11 +89,24 @@ impl<T: FilterScalar> Navigator<T> {
             self.station_capped = true;
             return;
         }
-        let survey = self.station_survey();
+        let (survey, rows) = self.station_survey();
+        let rows = rows.filter(|_| self.station_links);
         let number = self.stations;
+        let link = rows.as_ref().map(|rows| self.link_now(number, rows));
+        if block_done {
+            // The checkpoint before becomes the settled one, and this
+            // cycle's a new checkpoint (`station_link`).
+            let (p, snapshots) = self.filter.snapshots_mut();
+            snapshots.move_to(CHECKPOINT, SETTLED);
+            match &rows {
+                Some(rows) => snapshots.start(CHECKPOINT, p, rows),
+                None => snapshots.clear(CHECKPOINT),
+            }
+        }
         let Some(station) = self.station.as_mut() else {
             return;
         };
+        station.link = link;
         let start_sample = if station.epochs == 1 {
             start
         } else {
@@ -101,6 +120,7 @@ impl<T: FilterScalar> Navigator<T> {
         };
         if block_done {
             station.settled = station.checkpoint.replace(station.survey);
+            station.settled_link = core::mem::replace(&mut station.checkpoint_link, link);
         }
         if station.epochs >= self.max_station_samples {
             self.finish_station(station_flags::MAX_DURATION);
@@ -113,6 +133,38 @@ impl<T: FilterScalar> Navigator<T> {
             let mut survey = station.to_send();
             survey.flags |= flags;
             self.finished_station = Some(survey);
+            // The sent survey's snapshot is the next station's previous
+            // one. A station with fewer than two checkpoints sends its
+            // last still cycle's survey, of which no snapshot was kept
+            // (a station shorter than 4 s): no link, and none to it.
+            let link = station.settled.and(station.settled_link);
+            let (_, snapshots) = self.filter.snapshots_mut();
+            snapshots.move_to(SETTLED, PREVIOUS);
+            snapshots.clear(CHECKPOINT);
+            if link.is_none() {
+                snapshots.clear(PREVIOUS);
+            }
+            self.linked_station = survey.station;
+            self.finished_link = link;
+        }
+    }
+
+    /// The link of the survey at this cycle (`station_link`), from the
+    /// rows of its z.
+    fn link_now(&self, number: u16, rows: &[SparseRow<T>; LINKED]) -> StationLink {
+        let snapshots = self.filter.snapshots();
+        let cross = snapshots
+            .with(PREVIOUS, rows)
+            .map(|m| m.map(|row| row.map(|v| v.as_f64() as f32)));
+        StationLink {
+            station: number,
+            previous: if cross.is_some() {
+                self.linked_station
+            } else {
+                0
+            },
+            covariance: link_covariance(&self.filter.filter().p, rows),
+            cross_previous: cross,
         }
     }
 
@@ -170,8 +222,9 @@ impl<T: FilterScalar> Navigator<T> {
 
     /// The station survey at this cycle: the filter's attitude as drilling
     /// angles, their covariance J P_phi J^T (`super::station`), the flags.
-    /// Everything but the station number, start and quality.
-    fn station_survey(&self) -> StationSurvey {
+    /// Everything but the station number, start and quality. With the rows
+    /// of its link's z (`station_link`) where the covariance is valid.
+    fn station_survey(&self) -> (StationSurvey, Option<[SparseRow<T>; LINKED]>) {
         let state = self.filter.state();
         let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
         let mut flags = station_flags::MAGNETIC_FREE;
@@ -189,7 +242,7 @@ impl<T: FilterScalar> Navigator<T> {
         };
         if self.covariance_invalid {
             survey.flags = flags | station_flags::SOLUTION_INVALID;
-            return survey;
+            return (survey, None);
         }
         let u = angle_uncertainty(&jacobian, &self.filter.attitude_error_covariance());
         survey.angles_std = u.sigma.map(|s| s as f32);
@@ -210,6 +263,6 @@ impl<T: FilterScalar> Navigator<T> {
             flags |= station_flags::SOLUTION_INVALID;
         }
         survey.flags = flags;
-        survey
+        (survey, Some(link_rows(&jacobian)))
     }
 }

@@ -523,3 +523,82 @@ fn an_f64_filter_gives_the_probes_f32_solutions_to_their_rounding() {
     assert!(worst_angle < 1e-6, "{worst_angle} rad");
     assert!(worst_sigma < 1e-4, "{worst_sigma}");
 }
+
+/// Each station's link (`station_link`) ties it to the station before:
+/// none for a station too short for two checkpoints (the window's here,
+/// one cycle) and none to it; each later one to the one before, with a
+/// covariance that is one (symmetric, its diagonal > 0) and a
+/// cross-covariance within it (|rho| <= 1).
+#[test]
+fn consecutive_stations_are_linked() {
+    let mut navigator = aligned_navigator();
+    navigator.track_station_links(true);
+    let start = ALL_ALIGNMENT + 1;
+    let stops = [(start + 100, start + 1300), (start + 1500, start + 2700)];
+    let mut got = std::vec::Vec::new();
+    for n in start..start + 2800 {
+        let still = stops.iter().any(|(a, b)| (*a..*b).contains(&n));
+        let raw = if still {
+            level_sample(n)
+        } else {
+            level_turning_sample(n, 3.0)
+        };
+        navigator.step(&raw);
+        if let Some(st) = navigator.take_station() {
+            got.push((st, navigator.station_link().copied()));
+        }
+    }
+    assert_eq!(got.len(), 3, "{got:?}");
+    assert_eq!(got[0].1, None, "the window's one-cycle station");
+    for (k, (st, link)) in got.iter().enumerate().skip(1) {
+        let link = link.expect("a station of 60 s has its link");
+        assert_eq!(link.station, st.station);
+        let c = link.covariance;
+        for r in 0..3 {
+            assert!(c[r][r] > 0.0 && c[r][r].is_finite(), "{link:?}");
+            for s in 0..3 {
+                assert!((c[r][s] - c[s][r]).abs() <= 1e-9 * (c[r][r] * c[s][s]).sqrt());
+            }
+        }
+        if k == 1 {
+            assert_eq!((link.previous, link.cross_previous), (0, None));
+            continue;
+        }
+        let before = got[k - 1].1.expect("linked");
+        assert_eq!(link.previous, got[k - 1].0.station);
+        let x = link.cross_previous.expect("a cross-covariance");
+        for r in 0..3 {
+            for s in 0..3 {
+                let bound = (c[r][r] * before.covariance[s][s]).sqrt();
+                assert!(x[r][s].abs() <= bound * (1.0 + 1e-6), "{r} {s}: {link:?}");
+            }
+        }
+        // The gyro biases are constants to the filter, which learns little
+        // of them in one station: their errors at two stations are
+        // strongly correlated.
+        let rho = x[1][1] / (c[1][1] * before.covariance[1][1]).sqrt();
+        assert!(rho > 0.5, "rho {rho}");
+    }
+}
+
+/// Off by default (the probe sends no links yet): no link, no snapshot.
+#[test]
+fn station_links_are_off_by_default() {
+    let mut navigator = aligned_navigator();
+    let start = ALL_ALIGNMENT + 1;
+    let mut stations = 0;
+    for n in start..start + 1400 {
+        let raw = if (start + 100..start + 1300).contains(&n) {
+            level_sample(n)
+        } else {
+            level_turning_sample(n, 3.0)
+        };
+        navigator.step(&raw);
+        if navigator.take_station().is_some() {
+            stations += 1;
+            assert_eq!(navigator.station_link(), None);
+        }
+        assert!((0..3).all(|slot| !navigator.filter().snapshots().is_set(slot)));
+    }
+    assert_eq!(stations, 2);
+}
