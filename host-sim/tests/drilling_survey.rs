@@ -76,7 +76,7 @@ fn synthetic_stations_are_positioned_with_the_random_walk_depth_and_method_uncer
         .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, sig[k]))
         .collect();
     let terms = survey_terms().unwrap();
-    let out = survey(&stations, &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
     assert_eq!(out.rows.len(), 4);
     for (k, r) in out.rows.iter().enumerate() {
         assert!((r.row.md_m - (1000.0 + 10.0 * k as f64)).abs() < 1e-9);
@@ -128,7 +128,7 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     stations[2].flags |= station_flags::AZIMUTH_UNDETERMINED;
     stations[2].angles_std[1] = f32::INFINITY;
     let terms = survey_terms().unwrap();
-    let out = survey(&stations, &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
     let determined: Vec<bool> = out.rows.iter().map(|r| r.position_determined).collect();
     assert_eq!(determined, [true, true, false, false]);
     assert!(out.rows[3].azimuth_determined && out.rows[3].row.cov.is_none());
@@ -139,7 +139,7 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     assert!(text.contains("undetermined from station 3"), "{text}");
     // an invalid station is skipped, with its reason
     stations[1].flags |= station_flags::SOLUTION_INVALID;
-    let out = survey(&stations, &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
     assert_eq!(out.rows.len(), 3);
     assert!(out.skipped[0].reason.contains("invalid"));
 }
@@ -148,7 +148,7 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
 fn a_station_outside_the_log_or_a_log_that_is_not_one_is_refused() {
     let terms = survey_terms().unwrap();
     let late = [station(1, 100.0, 0.1), station(2, 500.0, 0.1)];
-    let err = survey(&late, &[], &log(), TIE, &terms, &site()).unwrap_err();
+    let err = survey(&late, &[], &[], &log(), TIE, &terms, &site()).unwrap_err();
     assert!(
         format!("{err:#}").contains("outside the depth log"),
         "{err:#}"
