@@ -118,9 +118,9 @@ impl LinkChain {
                 }
                 let mut weights = vec![0.0; n];
                 weights[j] = v[0];
-                for k in j + 1..n {
-                    v = self.carried[k] * v;
-                    weights[k] = v[0];
+                for (a, w) in self.carried[j + 1..].iter().zip(&mut weights[j + 1..]) {
+                    v = a * v;
+                    *w = v[0];
                 }
                 out.push(weights);
             }
@@ -177,8 +177,8 @@ mod tests {
         let chain = LinkChain::new(&links).unwrap();
         let sources = chain.azimuth_sources();
         let cov = |i: usize, j: usize| -> f64 { sources.iter().map(|w| w[i] * w[j]).sum() };
-        for k in 0..8 {
-            let want = sigmas[k][(0, 0)];
+        for (k, sigma) in sigmas.iter().enumerate() {
+            let want = sigma[(0, 0)];
             assert!((cov(k, k) / want - 1.0).abs() < 1e-4, "station {k}");
         }
         // stations 1 and 5 apart: A^4 Sigma_1

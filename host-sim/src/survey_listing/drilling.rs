@@ -159,11 +159,18 @@ fn unusable(s: &StationSurvey) -> Option<&'static str> {
     None
 }
 
+/// A station the survey keeps: the survey, its time (s) and MD (m), the
+/// azimuth sigma at its start and its link.
+type Kept = (StationSurvey, f64, f64, Option<f64>, Option<StationLink>);
+
 /// The survey of `stations` (in the order the probe sent them) with MD
 /// from `depth`; `tie`: the tie-on's position, and its MD if given;
 /// `azi_before`: each station's azimuth sigma at its start
 /// ([`AzimuthSigmaTrack::before`] its `start_sample`), for the stations'
-/// correlation; shorter than `stations` (empty) where not known.
+/// correlation; shorter than `stations` (empty) where not known; `links`:
+/// each station's link from the probe (`Navigator::station_link`; empty
+/// where not known: no frame carries them yet), for the chain in the
+/// links' states (`survey_error::probe_station`).
 pub fn survey(
     stations: &[StationSurvey],
     azi_before: &[Option<f64>],
@@ -174,7 +181,7 @@ pub fn survey(
     site: &Site,
 ) -> Result<DrillingSurvey> {
     let mut skipped = Vec::new();
-    let mut kept: Vec<(StationSurvey, f64, f64, Option<f64>, Option<StationLink>)> = Vec::new();
+    let mut kept: Vec<Kept> = Vec::new();
     let (first, last) = depth.span();
     for (k, s) in stations.iter().enumerate() {
         if let Some(reason) = unusable(s) {

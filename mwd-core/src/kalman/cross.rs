@@ -145,6 +145,7 @@ mod tests {
     /// filter whose state is augmented with the snapshot z = L x (constant,
     /// noise-free), through time updates and scalar measurements.
     #[test]
+    #[allow(clippy::needless_range_loop)] // (i, c) as in the matrices
     fn the_cross_covariance_follows_an_augmented_filter() {
         let value = |i: usize, j: usize| ((i * 7 + j * 3) % 11) as f64 * 0.1 - 0.5;
         let mut p0 = SMatrix::<f64, N, N>::from_fn(|i, j| value(i, j) * 0.3);

@@ -530,6 +530,7 @@ fn an_f64_filter_gives_the_probes_f32_solutions_to_their_rounding() {
 /// covariance that is one (symmetric, its diagonal > 0) and a
 /// cross-covariance within it (|rho| <= 1).
 #[test]
+#[allow(clippy::needless_range_loop)] // (r, s) as in the matrices
 fn consecutive_stations_are_linked() {
     let mut navigator = aligned_navigator();
     navigator.track_station_links(true);
