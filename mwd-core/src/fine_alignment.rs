@@ -912,7 +912,6 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.rejected_samples
     }
 
-    /// Covariance of the attitude error phi (nav frame), rad^2.
     /// The state's covariance with snapshots of earlier states
     /// (`kalman::CrossCovariances`).
     pub fn snapshots(&self) -> &CrossCovariances<T, N> {
@@ -925,6 +924,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         (&self.filter.p, &mut self.filter.cross)
     }
 
+    /// Covariance of the attitude error phi (nav frame), rad^2.
     pub fn attitude_error_covariance(&self) -> Matrix3<f64> {
         self.filter
             .p
