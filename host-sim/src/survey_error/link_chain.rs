@@ -24,9 +24,10 @@
 use mwd_core::probe::StationLink;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-/// The chain's links, one per station: `A_k` (zero for the first) and
-/// the factor of `Q_k`.
+/// The chain's links, one per station: `Sigma_k`, `A_k` (zero for the
+/// first) and the factor of `Q_k`.
 pub(super) struct LinkChain {
+    sigma: Vec<Matrix3<f64>>,
     carried: Vec<Matrix3<f64>>,
     fresh: Vec<Matrix3<f64>>,
 }
@@ -78,31 +79,35 @@ impl LinkChain {
     /// a station after the first has no link back to the one before, or a
     /// number is not finite.
     pub(super) fn new(links: &[Option<StationLink>]) -> Option<Self> {
+        let mut sigmas: Vec<Matrix3<f64>> = Vec::with_capacity(links.len());
         let mut carried = Vec::with_capacity(links.len());
         let mut fresh = Vec::with_capacity(links.len());
-        let mut previous: Option<Matrix3<f64>> = None;
         for link in links {
             let link = link.as_ref()?;
             let sigma = matrix(&link.covariance);
             if sigma.iter().any(|v| !v.is_finite()) {
                 return None;
             }
-            let (a, q) = match previous {
+            let (a, q) = match sigmas.last() {
                 None => (Matrix3::zeros(), sigma),
                 Some(before) => {
                     let x = matrix(&link.cross_previous?);
                     if x.iter().any(|v| !v.is_finite()) {
                         return None;
                     }
-                    let a = x * pseudo_inverse(&before);
+                    let a = x * pseudo_inverse(before);
                     (a, sigma - a * x.transpose())
                 }
             };
             carried.push(a);
             fresh.push(factor(&q, &sigma));
-            previous = Some(sigma);
+            sigmas.push(sigma);
         }
-        Some(Self { carried, fresh })
+        Some(Self {
+            sigma: sigmas,
+            carried,
+            fresh,
+        })
     }
 
     /// The azimuth error each independent source makes at every station
@@ -129,18 +134,13 @@ impl LinkChain {
     }
 
     /// cov(azimuth_k, azimuth_(k + lag)) from the chain (rad^2).
-    pub(super) fn azimuth_covariance(&self, sigma_k: &Matrix3<f64>, k: usize, lag: usize) -> f64 {
-        let mut m = *sigma_k;
+    pub(super) fn azimuth_covariance(&self, k: usize, lag: usize) -> f64 {
+        let mut m = self.sigma[k];
         for a in &self.carried[k + 1..=k + lag] {
             m = a * m;
         }
         m[(0, 0)]
     }
-}
-
-/// `Sigma_k` of a link.
-pub(super) fn link_covariance(link: &StationLink) -> Matrix3<f64> {
-    matrix(&link.covariance)
 }
 
 #[cfg(test)]
@@ -188,7 +188,7 @@ mod tests {
             "{} against {want}",
             cov(1, 5)
         );
-        assert!((chain.azimuth_covariance(&sigmas[1], 1, 4) / want - 1.0).abs() < 1e-4);
+        assert!((chain.azimuth_covariance(1, 4) / want - 1.0).abs() < 1e-4);
         assert!(
             want.abs() > 0.05 * sigmas[5][(0, 0)],
             "the test's memory is long"

@@ -57,7 +57,7 @@
 //! doubling: [`super::TieOn::Exact`]). Depth errors are separate sources
 //! (the engine's DSF/DST, [`super::run`]).
 
-use super::link_chain::{link_covariance, LinkChain};
+use super::link_chain::LinkChain;
 use super::{Cov6, Station};
 use mwd_core::probe::StationLink;
 
@@ -193,35 +193,17 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
             }
         })
         .collect();
-    let mut out = Vec::with_capacity(4 * n);
-    if let Some(chain) = link_chain(sigmas) {
-        for azimuth in chain.azimuth_sources() {
-            let weights = azimuth
-                .iter()
-                .zip(&share)
-                .map(|(a, s)| [s * a, *a])
-                .collect();
-            out.push(Source { weights });
-        }
-    }
-    let chain = if out.is_empty() {
-        azimuth_chain(sigmas)
-    } else {
-        Vec::new()
+    let azimuth = match link_chain(sigmas) {
+        Some(chain) => chain.azimuth_sources(),
+        None => azimuth_chain_sources(sigmas),
     };
-    for (j, link) in chain.iter().enumerate() {
-        if link.fresh == 0.0 {
-            continue;
-        }
-        // u_j's share of e_k: d_j a_(j+1) ... a_k
-        let mut weights = vec![[0.0, 0.0]; n];
-        let mut w = link.fresh;
-        for k in j..n {
-            if k > j {
-                w *= chain[k].carried;
-            }
-            weights[k] = [share[k] * w, w];
-        }
+    let mut out = Vec::with_capacity(azimuth.len() + n);
+    for azimuth in azimuth {
+        let weights = azimuth
+            .iter()
+            .zip(&share)
+            .map(|(a, s)| [s * a, *a])
+            .collect();
         out.push(Source { weights });
     }
     for (k, s) in sigmas.iter().enumerate() {
@@ -241,6 +223,29 @@ fn sources(sigmas: &[AngleSigma]) -> Vec<Source> {
     out
 }
 
+/// The azimuth error each source of the chain in the azimuth alone makes
+/// at every station (rad): u_j's share of e_k is d_j a_(j+1) ... a_k.
+fn azimuth_chain_sources(sigmas: &[AngleSigma]) -> Vec<Vec<f64>> {
+    let n = sigmas.len();
+    let chain = azimuth_chain(sigmas);
+    let mut out = Vec::with_capacity(n);
+    for (j, link) in chain.iter().enumerate() {
+        if link.fresh == 0.0 {
+            continue;
+        }
+        let mut weights = vec![0.0; n];
+        let mut w = link.fresh;
+        for k in j..n {
+            if k > j {
+                w *= chain[k].carried;
+            }
+            weights[k] = w;
+        }
+        out.push(weights);
+    }
+    out
+}
+
 /// The correlation the module's azimuth chain gives the errors of
 /// station `k` and station `k + lag`, for every `k` that has such a
 /// partner: `(s_k / s_(k+lag)) a_(k+1) ... a_(k+lag)`, or with the
@@ -252,12 +257,10 @@ pub fn azimuth_chain_correlations(sigmas: &[AngleSigma], lag: usize) -> Vec<f64>
         return (0..sigmas.len().saturating_sub(lag))
             .map(|k| {
                 let (first, later) = (sigmas[k].azi, sigmas[k + lag].azi);
-                let sigma_k = sigmas[k].link.as_ref().map(link_covariance);
-                match sigma_k {
-                    Some(s) if first > 0.0 && later > 0.0 => {
-                        links.azimuth_covariance(&s, k, lag) / (first * later)
-                    }
-                    _ => 0.0,
+                if first > 0.0 && later > 0.0 {
+                    links.azimuth_covariance(k, lag) / (first * later)
+                } else {
+                    0.0
                 }
             })
             .collect();
