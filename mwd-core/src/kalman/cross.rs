@@ -17,7 +17,7 @@
 //! filter whose state is augmented with the snapshot (tests below).
 
 use super::{FilterScalar, SparseRow, Transition};
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 /// Combinations per snapshot.
 pub const LINKED: usize = 3;
@@ -102,11 +102,7 @@ impl<T: FilterScalar, const N: usize> CrossCovariances<T, N> {
 
     /// Time update: `G <- Phi G`.
     pub fn predict<F: Transition<T, N>>(&mut self, phi: &F) {
-        for column in self.columns_mut() {
-            let mut v = SVector::<T, N>::from_column_slice(column);
-            phi.apply_to_vector(&mut v);
-            column.copy_from_slice(v.as_slice());
-        }
+        phi.apply_to_columns(self.columns_mut());
     }
 
     /// A scalar update with gain `k` and row `h`: `G <- G - k (h^T G)`.
@@ -137,6 +133,7 @@ mod tests {
     use super::super::dense::DenseTransition;
     use super::super::{KalmanFilter, ScalarMeasurement};
     use super::*;
+    use nalgebra::SVector;
 
     const N: usize = 5;
     const A: usize = N + LINKED;

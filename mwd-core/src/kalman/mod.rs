@@ -21,7 +21,7 @@ mod measurement;
 mod scalar;
 
 pub use cross::{CrossCovariances, LINKED, SNAPSHOTS};
-pub use measurement::{Measurement, ScalarMeasurement, SparseRow, MAX_ROW_NONZEROS};
+pub use measurement::{Measurement, ScalarMeasurement, SparseRow, Stacked, MAX_ROW_NONZEROS};
 use nalgebra::{RealField, SMatrix, SVector};
 
 /// The filter's scalar: f32 or f64.
@@ -63,6 +63,20 @@ pub trait Transition<T: FilterScalar, const N: usize> {
     }
     /// `x <- Phi x`.
     fn apply_to_vector(&self, x: &mut SVector<T, N>);
+    /// `x <- Phi x` for each of `columns` (the snapshots' cross-covariances,
+    /// `cross`). The default goes through [`apply_to_vector`]
+    /// (Self::apply_to_vector) with a copy each way; a transition that can
+    /// work in place does so.
+    fn apply_to_columns<'a>(&self, columns: impl Iterator<Item = &'a mut [T; N]>)
+    where
+        T: 'a,
+    {
+        for column in columns {
+            let mut v = SVector::<T, N>::from_column_slice(column);
+            self.apply_to_vector(&mut v);
+            column.copy_from_slice(v.as_slice());
+        }
+    }
 }
 
 /// What happened to one scalar measurement.

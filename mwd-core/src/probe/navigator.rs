@@ -69,7 +69,7 @@ use crate::error_model::{AugmentedModel, POS, STATES_WITH_BIASES, VEL};
 use crate::fine_alignment::{
     AccelBiasSnapshot, FineAlignment, FineAlignmentConfig, StepNoise, TiltPrior,
 };
-use crate::kalman::{FilterScalar, UpdateReport};
+use crate::kalman::{FilterScalar, Stacked, UpdateReport};
 use crate::mechanization::{ImuSample, NavState, ProbeInput, ToolAxisSource};
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
@@ -794,8 +794,11 @@ impl<T: FilterScalar> Navigator<T> {
                     cross.attitude_row = [[T::zero(); 3]; 2];
                     let mut axial = AxialSpeed::at(state, T::of(AXIAL_SPEED_VARIANCE));
                     axial.attitude_row = [T::zero(); 3];
-                    filter.aid(&cross);
-                    filter.aid(&axial);
+                    // One update: the axial bound's value was computed
+                    // at the solution before the cross-axis correction,
+                    // which a feedback between two updates would have
+                    // moved under it (`kalman::Stacked`).
+                    filter.aid(&Stacked(cross, axial));
                 }
                 if drilling && report.sample_used && !self.covariance_invalid {
                     self.toolface_block.add(&sample.specific_force);
