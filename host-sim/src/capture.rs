@@ -10,7 +10,7 @@ use std::path::Path;
 
 use anyhow::Context;
 use mwd_core::earth::Position;
-use mwd_core::probe::Navigator;
+use mwd_core::probe::{Navigator, TieIn};
 use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
 use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::Reply;
@@ -161,11 +161,14 @@ const SIMULATED_FIRMWARE_VERSION: u16 = 0;
 /// Writes what a probe at `site` sends for simulated `samples`: its boot
 /// event, then per sample the raw frame and the navigation frame its own
 /// navigation code (the same `Navigator` the firmware runs) makes of that
-/// raw frame.
+/// raw frame. A configured `tie_in` is taken as the probe's main loop
+/// takes it, after the first navigating cycle
+/// (`firmware/src/bin/probe_qemu/main.rs`).
 pub fn write_simulated_probe<W: Write>(
     capture: &mut CaptureWriter<W>,
     samples: impl IntoIterator<Item = SimSample>,
     site: Position,
+    mut tie_in: Option<TieIn>,
 ) -> anyhow::Result<()> {
     capture.write(&Payload::Event(Event {
         time_us: 0,
@@ -190,6 +193,10 @@ pub fn write_simulated_probe<W: Write>(
         // As the probe: a finished station after its cycle's navigation.
         if let Some(station) = navigator.take_station() {
             capture.write(&Payload::Station(station))?;
+        }
+        if let Some(t) = tie_in.filter(|_| navigator.is_navigating()) {
+            navigator.start_from_tie_in(&t);
+            tie_in = None;
         }
     }
     Ok(())
@@ -592,7 +599,7 @@ mod tests {
         )
         .take(3);
         let mut w = CaptureWriter::new(Vec::new());
-        write_simulated_probe(&mut w, samples, Position::paper_site()).unwrap();
+        write_simulated_probe(&mut w, samples, Position::paper_site(), None).unwrap();
         let cap = decode_bytes(&w.finish().unwrap());
         let stamps: Vec<u64> = cap
             .frames

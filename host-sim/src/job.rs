@@ -31,9 +31,12 @@
 //! Who reads what: `probe configure` sends the site, tie-in, calibration
 //! and still settings; `survey` takes the site's latitude, the tie-on and
 //! the error model (a capture survey, `--depth`, has the probe's own model
-//! and refuses another); `replay` takes the site, the calibration and the
-//! still settings (its navigator has no tie-in: a capture made with one is compared as
-//! post-processing). Command-line flags override the job. A station
+//! and refuses another), and to replay a capture for its station links
+//! the site, calibration, still settings and tie-in; `replay` takes the
+//! site, the calibration, the still settings and the tie-in (taken after
+//! the first navigating cycle, as the probe takes it; a job's settings
+//! are compared as post-processing: the capture's probe may not have had
+//! them). Command-line flags override the job. A station
 //! survey's first MD must equal the tie-on MD exactly: give the job's
 //! tie-on in the station file's unit (converted from the other unit, an MD
 //! may miss it by a rounding).

@@ -22,6 +22,7 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
+use mwd_core::probe::TieIn;
 use mwd_core::protocol::frame::nav_mode;
 use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
@@ -136,6 +137,8 @@ pub struct LiveOptions {
     pub calibration: ProbeCalibration,
     /// The probe's still settings, for the replay (default: the constants).
     pub still: StillSettings,
+    /// The probe's configured tie-in, for the replay (`Replayer::with_tie_in`).
+    pub tie_in: Option<TieIn>,
 }
 
 impl Default for LiveOptions {
@@ -146,6 +149,7 @@ impl Default for LiveOptions {
             display_interval: Duration::from_millis(250),
             calibration: ProbeCalibration::default(),
             still: default_still_settings(),
+            tie_in: None,
         }
     }
 }
@@ -187,7 +191,8 @@ pub fn run(
     let mut last_byte: Option<Instant> = None;
     let mut last_shown: Option<Instant> = None;
     let mut decoder = Decoder::new();
-    let mut replayer = Replayer::with_settings(position, options.calibration, options.still);
+    let mut replayer = Replayer::with_settings(position, options.calibration, options.still)
+        .with_tie_in(options.tie_in);
     let mut capture = Capture::default();
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];

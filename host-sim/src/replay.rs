@@ -16,7 +16,11 @@
 //! Station surveys (kind 4) are replayed the same way: the replay's
 //! navigator finishes its stations at the same samples, and each is
 //! compared bit for bit with the probe's station of the same number
-//! ([`Replayer::stations`]).
+//! ([`Replayer::stations`]). The replay's navigator keeps the station
+//! links (`Navigator::track_station_links`, which do not feed back: the
+//! solutions and stations are the same with them), so a station replayed
+//! bit for bit also gives the link the probe's filter held but does not
+//! send (the survey's chain, `survey_error::link_chain`).
 //!
 //! The probe's replies to uplink commands (kind 5) tell the replay which
 //! commands changed the navigation and where ([`commands`]): an
@@ -40,7 +44,7 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
-use mwd_core::probe::Navigator;
+use mwd_core::probe::{Navigator, StationLink, TieIn};
 use mwd_core::protocol::decoder::starts_a_run;
 use mwd_core::protocol::frame::{nav_flags, station_flags, MAX_BODY_LEN};
 use mwd_core::protocol::uplink::IndexingProcedure;
@@ -74,6 +78,8 @@ pub struct StationRow {
     /// station replayed out of step.
     pub matches_probe: Option<bool>,
     pub in_step: bool,
+    /// The replay's link of this station to its previous one.
+    pub link: Option<StationLink>,
 }
 
 /// What the replay did with station surveys.
@@ -227,6 +233,12 @@ impl std::fmt::Display for StepLoss {
     }
 }
 
+/// `navigator` keeping its station links ([`StationRow::link`]).
+fn linked(mut navigator: Navigator) -> Navigator {
+    navigator.track_station_links(true);
+    navigator
+}
+
 /// Replays every raw frame of `frames` through the navigation, starting at
 /// `position` (the probe's configured site), with uncalibrated sensors.
 pub fn replay(frames: &[Frame], position: Position) -> (Vec<ReplayRow>, ReplaySummary) {
@@ -260,6 +272,46 @@ pub fn replay_capture(
     replayer.finish()
 }
 
+/// The station links of a capture's station frames (`stations`, in the
+/// capture's order), from its replay with the probe's site, calibration,
+/// still settings and tie-in: one per station when every station frame was
+/// replayed bit for bit, in the same order (the replay's filter then held
+/// the probe's, and its links are the ones the probe's would have kept);
+/// otherwise why not, for the survey to say (it then chains the azimuth
+/// alone).
+pub fn replayed_station_links(
+    capture: &Capture,
+    stations: &[StationSurvey],
+    position: Position,
+    calibration: ProbeCalibration,
+    still: StillSettings,
+    tie_in: Option<TieIn>,
+) -> Result<Vec<Option<StationLink>>, String> {
+    let mut replayer = Replayer::with_settings(position, calibration, still).with_tie_in(tie_in);
+    for received in capture.in_order() {
+        replayer.push_received(received);
+    }
+    let (rows, summary) = replayer.stations();
+    let same = rows.len() == stations.len()
+        && rows.iter().zip(stations).all(|(row, probe)| {
+            row.matches_probe == Some(true)
+                && encoded_payload(&Payload::Station(row.station))
+                    == encoded_payload(&Payload::Station(*probe))
+        });
+    if !same {
+        return Err(format!(
+            "{} of the capture's {} station frames replayed bit for bit ({} replayed, {} \
+             different, {} not compared)",
+            summary.matched,
+            stations.len(),
+            summary.replayed,
+            summary.mismatched,
+            summary.unchecked
+        ));
+    }
+    Ok(rows.iter().map(|r| r.link).collect())
+}
+
 /// Rows of a live replay still waiting for the probe's solution after this
 /// many later samples are written without it: more than the probe's
 /// navigation inbox can hold back (32 samples). Also how many raw frames
@@ -277,6 +329,10 @@ pub struct Replayer {
     calibration: ProbeCalibration,
     /// The probe's still settings (`Navigator::with_settings`).
     still: StillSettings,
+    /// The probe's configured tie-in ([`Replayer::with_tie_in`]), and the
+    /// one this navigator has still to start from.
+    tie_in: Option<TieIn>,
+    tie_in_pending: Option<TieIn>,
     navigator: Navigator,
     rows: Vec<ReplayRow>,
     /// Rows (index into `rows`) of replayed samples the probe's solution
@@ -412,7 +468,9 @@ impl Replayer {
             position,
             calibration,
             still,
-            navigator: Navigator::with_settings(position, calibration, &still),
+            tie_in: None,
+            tie_in_pending: None,
+            navigator: linked(Navigator::with_settings(position, calibration, &still)),
             rows: Vec::new(),
             awaiting_probe: HashMap::new(),
             early_probe: HashMap::new(),
@@ -434,6 +492,18 @@ impl Replayer {
             run: RunState::default(),
             first_config_version: None,
         }
+    }
+
+    /// The probe's configured tie-in (a job's, as `probe configure` sent
+    /// it): the replay's navigator starts from it where the probe's does,
+    /// after the first cycle that navigates (its main loop,
+    /// `firmware/src/bin/probe_qemu/main.rs`), after each boot and
+    /// re-align. A probe that stepped several samples in that pass took it
+    /// later: its solutions then differ from there, and say so.
+    pub fn with_tie_in(mut self, tie_in: Option<TieIn>) -> Self {
+        self.tie_in = tie_in;
+        self.tie_in_pending = tie_in;
+        self
     }
 
     /// Takes one good frame of the downlink, telemetry or reply.
@@ -581,6 +651,13 @@ impl Replayer {
         if let Some(station) = self.navigator.take_station() {
             self.replayed_station(station, counter);
         }
+        if let Some(tie_in) = self
+            .tie_in_pending
+            .filter(|_| self.navigator.is_navigating())
+        {
+            self.navigator.start_from_tie_in(&tie_in);
+            self.tie_in_pending = None;
+        }
         solution
     }
 
@@ -612,10 +689,16 @@ impl Replayer {
         let index = self.station_rows.len();
         // In step as the newest replayed sample was.
         let arrived_in_step = self.rows.last().is_none_or(|r| r.in_step);
+        let link = self
+            .navigator
+            .station_link()
+            .filter(|l| l.station == station.station)
+            .copied();
         self.station_rows.push(StationRow {
             station,
             matches_probe: None,
             in_step: arrived_in_step && self.compared(counter) && self.run.stations_in_step,
+            link,
         });
         match self.early_station.take(station.station) {
             Some(on_board) => self.compare_station(index, &on_board),
@@ -672,7 +755,12 @@ impl Replayer {
 
     /// A boot event: the probe started again, so does the replay.
     fn restart_navigation(&mut self) {
-        self.navigator = Navigator::with_settings(self.position, self.calibration, &self.still);
+        self.navigator = linked(Navigator::with_settings(
+            self.position,
+            self.calibration,
+            &self.still,
+        ));
+        self.tie_in_pending = self.tie_in;
         // Sample counters start again at 0: older partners can never match;
         // a probe solution whose raw frame was lost was not compared.
         self.summary.unchecked += self.early_probe.len() as u64;

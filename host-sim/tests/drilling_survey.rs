@@ -232,6 +232,36 @@ fn a_simulated_short_lateral_is_surveyed_against_its_truth() {
         s(&traj),
     ]);
     assert_eq!(out.code, Some(0), "{}", out.stderr);
+    // the capture replays bit for bit: the survey chains the links the
+    // probe's filter held
+    assert!(
+        out.stdout
+            .contains("station links: from the capture's replay"),
+        "{}",
+        out.stdout
+    );
+    // replayed at another site than the probe's, no station is the
+    // probe's: no links, and the survey says so
+    let elsewhere = run(&[
+        "survey",
+        s(&bin),
+        "--depth",
+        s(&depth),
+        "--site",
+        "30",
+        "126.687898",
+        "124",
+        "--tie-on-md",
+        "3000",
+    ]);
+    assert_eq!(elsewhere.code, Some(0), "{}", elsewhere.stderr);
+    assert!(
+        elsewhere
+            .stdout
+            .contains("station links: none (0 of the capture's"),
+        "{}",
+        elsewhere.stdout
+    );
     let truth = table(&std::fs::read_to_string(&truth).unwrap());
     let stations = table(&std::fs::read_to_string(&csv).unwrap());
     assert!(!stations.is_empty(), "{}", out.stdout);
@@ -296,6 +326,89 @@ fn a_simulated_short_lateral_is_surveyed_against_its_truth() {
     assert_eq!(bad.code, Some(1), "{}", bad.stderr);
     assert!(bad.stderr.contains("not a depth log"), "{}", bad.stderr);
     assert!(!bad.stderr.contains("panicked"));
+}
+
+/// A probe configured with a job's tie-in: its capture replays bit for bit
+/// with the same job (`replay --job` exits 0), and the survey with it
+/// chains the stations through the replay's links; without the job the
+/// replay has no tie-in, differs, and the survey says it has no links.
+#[test]
+fn a_tied_in_capture_is_surveyed_with_the_links_of_its_replay() {
+    let dir = scratch("drilling-survey", "tied-in");
+    let (bin, depth, job) = (
+        dir.join("run.bin"),
+        dir.join("depth.csv"),
+        dir.join("job.json"),
+    );
+    std::fs::write(
+        &job,
+        r#"{ "format": "mwd-job", "version": 1,
+  "site": { "latitude_deg": 45.77755, "longitude_deg": 126.687898, "height_m": 124.0 },
+  "tie_in": { "inclination_deg": 90.0, "azimuth_deg": 120.0, "toolface_deg": 0.0,
+              "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 0.5, "toolface_sigma_deg": 0.3 },
+  "survey": { "tie_on": { "md": 3000.0, "tvd": 2450.0, "north": 420.0, "east": 310.0 } } }"#,
+    )
+    .unwrap();
+    let sim = run(&[
+        "simulate",
+        "--motion",
+        "lateral",
+        "--plan",
+        s(&plan("qemu-short.json")),
+        "--seed",
+        "3",
+        "-o",
+        s(&bin),
+        "--depth-log",
+        s(&depth),
+        "--tie-in-job",
+        s(&job),
+    ]);
+    assert_eq!(sim.code, Some(0), "{}", sim.stderr);
+    let replay = run(&["replay", s(&bin), "--job", s(&job)]);
+    assert_eq!(replay.code, Some(0), "{}{}", replay.stdout, replay.stderr);
+    assert!(replay.stdout.contains(" 0 different"), "{}", replay.stdout);
+    let survey = |with_job: bool| {
+        let mut a = vec!["survey", s(&bin), "--depth", s(&depth)];
+        if with_job {
+            a.extend(["--job", s(&job)]);
+        } else {
+            a.extend(["--tie-on-md", "3000"]);
+        }
+        let out = run(&a);
+        assert_eq!(out.code, Some(0), "{}", out.stderr);
+        out.stdout
+    };
+    let linked = survey(true);
+    assert!(
+        linked.contains("station links: from the capture's replay"),
+        "{linked}"
+    );
+    // the azimuth is the tie-in's, carried: determined at every station
+    assert!(!linked.contains("undetermined"), "{linked}");
+    let unlinked = survey(false);
+    assert!(unlinked.contains("station links: none ("), "{unlinked}");
+    // a job without a tie-in is refused by --tie-in-job, clearly
+    let no_tie_in = dir.join("no-tie-in.json");
+    std::fs::write(
+        &no_tie_in,
+        r#"{ "format": "mwd-job", "version": 1,
+  "site": { "latitude_deg": 45.77755, "longitude_deg": 126.687898, "height_m": 124.0 } }"#,
+    )
+    .unwrap();
+    let bad = run(&[
+        "simulate",
+        "--motion",
+        "lateral",
+        "--plan",
+        s(&plan("qemu-short.json")),
+        "-o",
+        s(&dir.join("bad.bin")),
+        "--tie-in-job",
+        s(&no_tie_in),
+    ]);
+    assert_eq!(bad.code, Some(1), "{}", bad.stderr);
+    assert!(bad.stderr.contains("has no tie_in"), "{}", bad.stderr);
 }
 
 #[test]

@@ -30,6 +30,7 @@ use host_sim::replay::{
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;
+use mwd_core::probe::TieIn;
 use mwd_core::protocol::uplink::{Command as UplinkCommand, StillSettings};
 
 use super::site::SiteArgs;
@@ -106,10 +107,11 @@ pub struct Args {
     /// uncalibrated).
     #[arg(long, value_name = "PATH")]
     pub calibration_file: Option<PathBuf>,
-    /// A job file (host-sim/src/job.rs): its site, calibration and still
-    /// settings, as `probe configure` sent them; --site and --calibration-file override
-    /// it (its site: with --site, not --lat/--lon/--height). The replay
-    /// has no tie-in: the job's is not applied.
+    /// A job file (host-sim/src/job.rs): its site, calibration, still
+    /// settings and tie-in, as `probe configure` sent them; --site and
+    /// --calibration-file override it (its site: with --site, not
+    /// --lat/--lon/--height). The tie-in is taken where the probe takes
+    /// it, after its first navigating cycle.
     #[arg(long, value_name = "JOB.json", conflicts_with_all = ["lat", "lon", "height"])]
     pub job: Option<PathBuf>,
     /// The bytes the host sent the probe during the capture (its uplink
@@ -153,8 +155,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // its next boot or re-align (docs/protocol.md): so does the replay.
     let job_still = job.as_ref().and_then(|j| j.still);
     let still = job_still.unwrap_or_else(default_still_settings);
+    let tie_in = job.as_ref().and_then(|j| j.tie_in);
     let replayed = match (&args.port, &args.file) {
-        (Some(port), _) => replay_live(&args, port, site, calibration, still)?,
+        (Some(port), _) => replay_live(&args, port, site, calibration, still, tie_in)?,
         (None, Some(file)) => {
             let sent = match &args.uplink {
                 Some(log) => {
@@ -164,14 +167,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 }
                 None => Vec::new(),
             };
-            replay_file(file, site, calibration, still, &sent)?
+            replay_file(file, site, calibration, still, tie_in, &sent)?
         }
         (None, None) => anyhow::bail!("give a capture file or --port"),
     };
     // Another calibration or site than the QEMU probe's (none, the
     // paper's site; the site defaults are the paper's to the bit) is
     // post-processing, not a parity check.
-    // A job's tie-in is the probe's, which the replay does not apply.
+    // A job's tie-in, as its calibration: this capture's probe may not
+    // have had it.
     // Still settings other than the defaults: as another calibration.
     let post_processed = args.calibration_file.is_some()
         || job_calibration.is_some()
@@ -187,10 +191,11 @@ fn replay_file(
     site: Position,
     calibration: ProbeCalibration,
     still: StillSettings,
+    tie_in: Option<TieIn>,
     sent: &[(u16, UplinkCommand)],
 ) -> anyhow::Result<Replayed> {
     let capture = capture::read_probe_capture(file)?;
-    let mut replayer = Replayer::with_settings(site, calibration, still);
+    let mut replayer = Replayer::with_settings(site, calibration, still).with_tie_in(tie_in);
     for (seq, command) in sent {
         replayer.knows_sent_command(*seq, command);
     }
@@ -237,6 +242,7 @@ fn replay_live(
     site: Position,
     calibration: ProbeCalibration,
     still: StillSettings,
+    tie_in: Option<TieIn>,
 ) -> anyhow::Result<Replayed> {
     let duration = args.duration.map(|s| seconds("duration", s)).transpose()?;
     let silence = seconds("silence", args.silence)?;
@@ -260,6 +266,7 @@ fn replay_live(
         silence: Some(silence),
         calibration,
         still,
+        tie_in,
         ..LiveOptions::default()
     };
     let sinks = LiveSinks {

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
+use host_sim::job::Job;
 use host_sim::paper_mgwd::PUBLISHED;
 use host_sim::sim::plan::Vibration;
 use host_sim::sim::stream::SensorStreamWriter;
@@ -13,6 +14,7 @@ use host_sim::sim::{
 use host_sim::{capture, samples_csv};
 use mwd_core::conventions::{Euler, DEG};
 use mwd_core::earth::Position;
+use mwd_core::probe::TieIn;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
 use std::io::Write;
@@ -160,6 +162,12 @@ pub struct Args {
     /// `hil_mock::stream`).
     #[arg(long, value_name = "FILE")]
     pub sensor_stream: Option<PathBuf>,
+    /// A .bin capture from a probe configured with this job's tie-in (its
+    /// `tie_in` only; host-sim/src/job.rs), which its navigator takes as
+    /// the probe does, after its first navigating cycle: the capture
+    /// `survey CAPTURE --depth --job JOB.json` replays with the same job.
+    #[arg(long, value_name = "JOB.json")]
+    pub tie_in_job: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -217,7 +225,7 @@ pub fn run(args: Args) -> Result<()> {
                 !to_stdout,
                 "binary captures go to a file, not standard output"
             );
-            let bytes = write_capture(output, samples, site)?;
+            let bytes = write_capture(output, samples, site, tie_in(&args)?)?;
             eprintln!(
                 "wrote a boot event and {n} raw-sample and navigation frames ({bytes} bytes) to {}",
                 output.display()
@@ -280,16 +288,28 @@ fn output_format(args: &Args) -> OutputFormat {
         })
 }
 
-/// Writes the probe's capture of `samples` at `site`; returns its size in
-/// bytes.
+/// `--tie-in-job`'s tie-in.
+fn tie_in(args: &Args) -> Result<Option<TieIn>> {
+    let Some(path) = &args.tie_in_job else {
+        return Ok(None);
+    };
+    match Job::load(path)?.tie_in {
+        Some(t) => Ok(Some(t)),
+        None => anyhow::bail!("{}: the job has no tie_in", path.display()),
+    }
+}
+
+/// Writes the capture of a probe at `site` (tied in to `tie_in`) of
+/// `samples`; returns its size in bytes.
 fn write_capture(
     path: &Path,
     samples: impl Iterator<Item = SimSample>,
     site: Position,
+    tie_in: Option<TieIn>,
 ) -> Result<u64> {
     let mut capture =
         capture::create_capture(path).with_context(|| format!("creating {}", path.display()))?;
-    capture::write_simulated_probe(&mut capture, samples, site)?;
+    capture::write_simulated_probe(&mut capture, samples, site, tie_in)?;
     let bytes = capture.bytes_written();
     capture.finish()?;
     Ok(bytes)
@@ -376,7 +396,7 @@ fn run_lateral(args: &Args) -> Result<()> {
                 !to_stdout,
                 "binary captures go to a file, not standard output"
             );
-            write_capture(output, samples, site)?;
+            write_capture(output, samples, site, tie_in(args)?)?;
         }
         OutputFormat::Csv if to_stdout => {
             match samples_csv::write(std::io::stdout().lock(), samples) {

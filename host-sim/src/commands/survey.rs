@@ -11,6 +11,11 @@ use host_sim::survey_listing::{
     self as listing, ellipse::scale_2d, plot, AzimuthReference, KnownModel, LengthUnit, Row,
     StationFile, TieOnInput,
 };
+use mwd_core::calibration::ProbeCalibration;
+use mwd_core::config::default_still_settings;
+use mwd_core::earth::Position;
+use mwd_core::probe::TieIn;
+use mwd_core::protocol::uplink::StillSettings;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -205,6 +210,18 @@ pub struct Resolved {
     /// Latitude of the site, rad.
     pub latitude: f64,
     pub job: SurveyJob,
+    /// The probe's configuration for a capture's replay (`survey_capture`):
+    /// the site, the job's calibration, still settings and tie-in (else
+    /// none, the probe's defaults, none).
+    pub probe: ProbeSetup,
+}
+
+/// What a capture's replay needs of the probe's configuration.
+pub struct ProbeSetup {
+    pub site: Position,
+    pub calibration: ProbeCalibration,
+    pub still: StillSettings,
+    pub tie_in: Option<TieIn>,
 }
 
 impl Resolved {
@@ -215,9 +232,22 @@ impl Resolved {
             (_, Some(job)) => job.site,
             _ => args.site.position(),
         };
+        let probe = ProbeSetup {
+            site,
+            calibration: job
+                .as_ref()
+                .and_then(|j| j.calibration.as_ref())
+                .map_or_else(ProbeCalibration::default, |(_, c)| *c),
+            still: job
+                .as_ref()
+                .and_then(|j| j.still)
+                .unwrap_or_else(default_still_settings),
+            tie_in: job.as_ref().and_then(|j| j.tie_in),
+        };
         Ok(Self {
             latitude: site.lat,
             job: job.map(|j| j.survey).unwrap_or_default(),
+            probe,
         })
     }
 

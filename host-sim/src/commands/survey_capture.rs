@@ -7,11 +7,14 @@ use super::limits::number_in;
 use super::survey::{Args, Resolved};
 use anyhow::{bail, Context, Result};
 use host_sim::capture::read_probe_capture;
+use host_sim::capture::Capture;
+use host_sim::replay::replayed_station_links;
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::depth_log::DepthLog;
 use host_sim::survey_listing::drilling::AzimuthSigmaTrack;
 use host_sim::survey_listing::{drilling, drilling_text, LengthUnit};
-use mwd_core::protocol::Payload;
+use mwd_core::probe::StationLink;
+use mwd_core::protocol::{Payload, StationSurvey};
 use std::path::PathBuf;
 
 fn step_m(text: &str) -> Result<f64, String> {
@@ -104,8 +107,17 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         .iter()
         .map(|s| track.before(s.start_sample))
         .collect();
-    let survey = drilling::survey(&stations, &azi_before, &[], &depth, tie, &terms, &site)
-        .with_context(|| format!("{}", args.stations.display()))?;
+    let links = capture_links(&capture, &stations, resolved);
+    let survey = drilling::survey(
+        &stations,
+        &azi_before,
+        links.as_deref().unwrap_or(&[]),
+        &depth,
+        tie,
+        &terms,
+        &site,
+    )
+    .with_context(|| format!("{}", args.stations.display()))?;
     let s = &capture.stats;
     let bad = s.crc_errors + s.malformed + s.unknown_kind;
     if bad > 0 || s.lost > 0 {
@@ -113,6 +125,16 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
             "capture: {bad} bad frames skipped, {} frames lost in sequence gaps",
             s.lost
         );
+    }
+    match &links {
+        Ok(_) => outln!(
+            "station links: from the capture's replay (every station frame replayed bit for bit)"
+        ),
+        Err(why) => outln!(
+            "station links: none ({why}); the survey chains the stations' azimuth alone, which \
+             understates the position sigma when the gyro bias estimates tie the stations \
+             (docs/drilling-survey.md)"
+        ),
     }
     out!("{}", drilling_text::listing(&survey, args.confidence));
     let write = |path: &PathBuf, text: String| {
@@ -146,4 +168,22 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         outln!("wrote {} ({} points)", path.display(), points.len());
     }
     Ok(())
+}
+
+/// The stations' links from the capture's replay (`replay::replayed_station_links`),
+/// or why there are none.
+fn capture_links(
+    capture: &Capture,
+    stations: &[StationSurvey],
+    resolved: &Resolved,
+) -> Result<Vec<Option<StationLink>>, String> {
+    let probe = &resolved.probe;
+    replayed_station_links(
+        capture,
+        stations,
+        probe.site,
+        probe.calibration,
+        probe.still,
+        probe.tie_in,
+    )
 }

@@ -276,8 +276,12 @@ impl Replayer {
                 return CommandOutcome::Incomplete;
             }
             Effect::Realign { config_version } => {
-                self.navigator =
-                    Navigator::with_settings(self.position, self.calibration, &self.still);
+                self.navigator = super::linked(Navigator::with_settings(
+                    self.position,
+                    self.calibration,
+                    &self.still,
+                ));
+                self.tie_in_pending = self.tie_in;
                 // The new navigator numbers its stations from 1 again.
                 self.forget_station_partners();
                 self.run.stations_in_step = true;

@@ -270,7 +270,10 @@ fn station_surveys_are_replayed_and_compared_bit_for_bit() {
     };
     let aligned = 1200;
     let mut navigator = Navigator::new(site);
+    // the probe's filter as the replay's, keeping its links (not sent)
+    navigator.track_station_links(true);
     let mut payloads = Vec::new();
+    let mut probe_link = None;
     for n in 0..aligned + 1000 {
         let moving = (aligned..aligned + 100).contains(&n) || n >= aligned + 700;
         let frame = if moving { turning(n) } else { raw(n) };
@@ -279,7 +282,10 @@ fn station_surveys_are_replayed_and_compared_bit_for_bit() {
         };
         payloads.push(Payload::Raw(r));
         payloads.push(Payload::Nav(navigator.step(&r)));
-        payloads.extend(navigator.take_station().map(Payload::Station));
+        if let Some(station) = navigator.take_station() {
+            probe_link = navigator.station_link().copied();
+            payloads.push(Payload::Station(station));
+        }
     }
     let stations: Vec<StationSurvey> = payloads
         .iter()
@@ -309,6 +315,9 @@ fn station_surveys_are_replayed_and_compared_bit_for_bit() {
         }
     );
     assert_eq!(rows[0].matches_probe, Some(true));
+    // The replay's link is the probe's filter's (which it did not send).
+    assert!(probe_link.is_some());
+    assert_eq!(rows[0].link, probe_link);
     // One bit of the probe's toolface sigma changed: caught.
     let changed: Vec<Payload> = payloads
         .into_iter()
@@ -326,4 +335,81 @@ fn station_surveys_are_replayed_and_compared_bit_for_bit() {
     });
     let (_, summary) = replayer.stations();
     assert_eq!((summary.matched, summary.mismatched), (0, 1));
+}
+
+/// A probe configured with a tie-in starts from it after its first
+/// navigating cycle: the replay given the same tie-in does too, and its
+/// solutions and station are the probe's bit for bit; a replay without
+/// it differs from there on.
+#[test]
+fn a_configured_tie_in_is_taken_where_the_probe_takes_it() {
+    use mwd_core::conventions::DrillingAngles;
+    use mwd_core::sensor_units::rad_s_to_gyro_count;
+    let site = Position::paper_site();
+    let tie_in = TieIn::new(
+        DrillingAngles {
+            inclination: std::f64::consts::FRAC_PI_2,
+            azimuth: 2.0,
+            toolface: 0.0,
+        },
+        DrillingAngles {
+            inclination: 0.2f64.to_radians(),
+            azimuth: 0.5f64.to_radians(),
+            toolface: 0.2f64.to_radians(),
+        },
+    )
+    .unwrap();
+    let turning = |n: u32| {
+        let mut frame = raw(n);
+        if let Payload::Raw(r) = &mut frame.payload {
+            for (part, m) in r.parts.iter_mut().zip(PART_MOUNTINGS) {
+                part.gyro_rate = rad_s_to_gyro_count(m.gyro_rate_from_body([0.0, 0.0, 0.05]));
+            }
+        }
+        frame
+    };
+    // the probe's main loop: a step, its station, then the pending tie-in
+    let mut navigator = Navigator::new(site);
+    let mut pending = Some(tie_in);
+    let mut payloads = Vec::new();
+    let mut tied_at = None;
+    for n in 0..2200 {
+        let frame = if (1200..1300).contains(&n) || n >= 1900 {
+            turning(n)
+        } else {
+            raw(n)
+        };
+        let Payload::Raw(r) = frame.payload else {
+            unreachable!()
+        };
+        payloads.push(Payload::Raw(r));
+        payloads.push(Payload::Nav(navigator.step(&r)));
+        payloads.extend(navigator.take_station().map(Payload::Station));
+        if let Some(t) = pending.filter(|_| navigator.is_navigating()) {
+            navigator.start_from_tie_in(&t);
+            pending = None;
+            tied_at = Some(n);
+        }
+    }
+    assert!(tied_at.is_some_and(|n| n < 1200), "{tied_at:?}");
+    let capture = numbered(0, payloads);
+    let replay = |tie_in: Option<TieIn>| {
+        let mut replayer = Replayer::new(site).with_tie_in(tie_in);
+        capture.iter().for_each(|f| {
+            replayer.push(f);
+        });
+        let (_, stations) = replayer.stations();
+        (*replayer.summary(), stations)
+    };
+    let (summary, stations) = replay(Some(tie_in));
+    assert_eq!(summary.mismatched, 0, "{summary:?}");
+    assert_eq!(summary.matched, summary.probe_solutions, "{summary:?}");
+    assert_eq!(
+        (stations.matched, stations.mismatched),
+        (1, 0),
+        "{stations:?}"
+    );
+    let (summary, stations) = replay(None);
+    assert!(summary.mismatched > 0, "{summary:?}");
+    assert_eq!(stations.mismatched, 1, "{stations:?}");
 }
