@@ -23,6 +23,19 @@ fn raw(n: u32) -> Frame {
     }
 }
 
+/// Sample `n` of a probe turning about body z at 0.05 rad/s.
+fn turning(n: u32) -> Frame {
+    let mut frame = raw(n);
+    if let Payload::Raw(r) = &mut frame.payload {
+        for (part, m) in r.parts.iter_mut().zip(PART_MOUNTINGS) {
+            part.gyro_rate = mwd_core::sensor_units::rad_s_to_gyro_count(
+                m.gyro_rate_from_body([0.0, 0.0, 0.05]),
+            );
+        }
+    }
+    frame
+}
+
 #[test]
 fn replay_matches_the_same_code_and_catches_a_changed_solution() {
     let site = Position::paper_site();
@@ -257,17 +270,7 @@ fn a_replay_applies_the_probes_calibration() {
 /// identical; a changed station is caught.
 #[test]
 fn station_surveys_are_replayed_and_compared_bit_for_bit() {
-    use mwd_core::sensor_units::rad_s_to_gyro_count;
     let site = Position::paper_site();
-    let turning = |n: u32| {
-        let mut frame = raw(n);
-        if let Payload::Raw(r) = &mut frame.payload {
-            for (part, m) in r.parts.iter_mut().zip(PART_MOUNTINGS) {
-                part.gyro_rate = rad_s_to_gyro_count(m.gyro_rate_from_body([0.0, 0.0, 0.05]));
-            }
-        }
-        frame
-    };
     let aligned = 1200;
     let mut navigator = Navigator::new(site);
     // the probe's filter as the replay's, keeping its links (not sent)
@@ -344,7 +347,6 @@ fn station_surveys_are_replayed_and_compared_bit_for_bit() {
 #[test]
 fn a_configured_tie_in_is_taken_where_the_probe_takes_it() {
     use mwd_core::conventions::DrillingAngles;
-    use mwd_core::sensor_units::rad_s_to_gyro_count;
     let site = Position::paper_site();
     let tie_in = TieIn::new(
         DrillingAngles {
@@ -359,15 +361,6 @@ fn a_configured_tie_in_is_taken_where_the_probe_takes_it() {
         },
     )
     .unwrap();
-    let turning = |n: u32| {
-        let mut frame = raw(n);
-        if let Payload::Raw(r) = &mut frame.payload {
-            for (part, m) in r.parts.iter_mut().zip(PART_MOUNTINGS) {
-                part.gyro_rate = rad_s_to_gyro_count(m.gyro_rate_from_body([0.0, 0.0, 0.05]));
-            }
-        }
-        frame
-    };
     // the probe's main loop: a step, its station, then the pending tie-in
     let mut navigator = Navigator::new(site);
     let mut pending = Some(tie_in);
