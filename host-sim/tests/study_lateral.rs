@@ -134,16 +134,26 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
     assert_eq!(s.along_md[0].rms_horizontal_error_m, Some(0.0));
     let f = &s.azimuth_within_2_sigma;
     assert!(f.total > 0 && f.inside <= f.total);
-    // the table and the CSV carry it
+    // every station after the window starts from a known azimuth error;
+    // the stretches between them are counted too
+    let c = &s.azimuth_consistency;
+    assert!(c.stations >= 2 && c.drilling_stretches >= 1, "{c:?}");
+    for v in [c.station_correction_ratio, c.drilling_growth_ratio] {
+        assert!(v.is_some_and(|v| v.is_finite() && v > 0.0), "{c:?}");
+    }
+    // the table and the CSV carry it, one field per column
     let text = host_sim::study::lateral_table::table(&result);
     assert!(
-        text.contains("scc1300") && text.contains("along MD"),
+        text.contains("scc1300")
+            && text.contains("along MD")
+            && text.contains("through stations and drilling"),
         "{text}"
     );
-    assert_eq!(
-        host_sim::study::lateral_table::csv(&result).lines().count(),
-        2
-    );
+    let csv = host_sim::study::lateral_table::csv(&result);
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 2);
+    assert_eq!(lines[0].split(',').count(), lines[1].split(',').count());
+    assert!(lines[0].ends_with("drilling_growth_ratio"), "{}", lines[0]);
 }
 
 #[test]

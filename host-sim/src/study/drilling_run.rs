@@ -164,6 +164,9 @@ pub struct StationCheck {
     /// zero-velocity update, as the survey's azimuth chain takes it
     /// ([`AzimuthSigmaTrack::station_start`]).
     pub azimuth_sigma_before: Option<f64>,
+    /// The azimuth error (rad, wrapped) of the same solution: with its
+    /// sigma, where the station starts from (`super::lateral_consistency`).
+    pub azimuth_error_before: Option<f64>,
     /// The probe's link of this station's errors to the previous
     /// station's (`mwd_core::probe::station_link`), as the survey takes it.
     pub link: Option<StationLink>,
@@ -412,6 +415,9 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     // each station's azimuth sigma at its start, for the survey's chain
     let mut track = AzimuthSigmaTrack::default();
     let mut azi_before = Vec::new();
+    // each station's azimuth error at its start (the solution `track` takes)
+    let mut azimuths = AzimuthTrack::default();
+    let mut err_before = Vec::new();
     let mut links = Vec::new();
     let mut samples = 0;
     let sim = DrillingSimulator::new(&drilling, model.clone(), SAMPLE_INTERVAL_S);
@@ -419,7 +425,9 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        track.push(&feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?);
+        let solution = feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?;
+        track.push(&solution);
+        azimuths.push(&solution);
         samples += 1;
         last = Some((
             s.true_rate,
@@ -441,6 +449,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         }
         if let Some(station) = navigator.take_station() {
             azi_before.push(track.station_start(&station));
+            err_before.push(azimuths.error_at_start(&station, &drilling));
             links.push(link_of(&navigator, &station));
             stations.push(station);
         }
@@ -456,16 +465,13 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         });
         for k in 0..MAX_STATION_SAMPLES as usize {
             let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
-            track.push(&feed(
-                &mut navigator,
-                raw_frames,
-                run_samples + k,
-                &gyro,
-                &force,
-            )?);
+            let solution = feed(&mut navigator, raw_frames, run_samples + k, &gyro, &force)?;
+            track.push(&solution);
+            azimuths.push(&solution);
             samples += 1;
             if let Some(station) = navigator.take_station() {
                 azi_before.push(track.station_start(&station));
+                err_before.push(azimuths.error_at_start(&station, &drilling));
                 links.push(link_of(&navigator, &station));
                 stations.push(station);
                 break;
@@ -475,8 +481,9 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let mut checks: Vec<StationCheck> = stations
         .iter()
         .zip(&azi_before)
+        .zip(&err_before)
         .zip(&links)
-        .map(|((st, before), link)| {
+        .map(|(((st, before), err_before), link)| {
             let truth = drilling.truth((f64::from(st.end_sample) + 1.0) * SAMPLE_INTERVAL_S);
             let a = st.angles.map(f64::from);
             StationCheck {
@@ -488,6 +495,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
                 ],
                 truth_md: truth.md,
                 azimuth_sigma_before: *before,
+                azimuth_error_before: *err_before,
                 link: *link,
                 position: None,
             }
@@ -535,6 +543,43 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         elapsed_s: started.elapsed().as_secs_f64(),
         cpu_s: cpu_start.zip(thread_cpu_s()).map(|(a, b)| b - a),
     })
+}
+
+/// The solutions' azimuths since the last station, for the azimuth error
+/// a station starts from (as [`AzimuthSigmaTrack`] keeps their sigmas).
+#[derive(Default)]
+struct AzimuthTrack {
+    /// (sample counter, azimuth in rad), counters increasing.
+    points: Vec<(u32, f32)>,
+}
+
+impl AzimuthTrack {
+    fn push(&mut self, s: &NavSolution) {
+        self.points.push((s.sample_counter, s.attitude[2]));
+    }
+
+    /// The azimuth error of the last solution before the station's first
+    /// sample (no more than a second before it, as the sigma's), against
+    /// the truth at that solution's time; the solutions before the
+    /// station's end are forgotten.
+    fn error_at_start(&mut self, station: &StationSurvey, drilling: &Drilling) -> Option<f64> {
+        let k = self
+            .points
+            .partition_point(|&(c, _)| c < station.start_sample);
+        let error = k
+            .checked_sub(1)
+            .and_then(|i| self.points.get(i))
+            .and_then(|&(c, azimuth)| {
+                let truth = drilling.truth((f64::from(c) + 1.0) * SAMPLE_INTERVAL_S);
+                let error = wrap_pi(f64::from(azimuth) - truth.point.azimuth);
+                (station.start_sample - c <= 20 && error.is_finite()).then_some(error)
+            });
+        let end = self
+            .points
+            .partition_point(|&(c, _)| c < station.end_sample);
+        self.points.drain(..end);
+        error
+    }
 }
 
 /// Minimum curvature through the true MD and angles at the survey's

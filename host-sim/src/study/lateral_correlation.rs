@@ -125,6 +125,7 @@ mod tests {
             },
             error: [0.0, error, 0.0],
             truth_md: 3000.0 + f64::from(number) * 28.0,
+            azimuth_error_before: None,
             azimuth_sigma_before: before,
             link: None,
             position: None,

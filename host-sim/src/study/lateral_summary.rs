@@ -12,6 +12,7 @@
 
 use super::drilling_coverage::Fraction;
 use super::drilling_run::RunOutcome;
+use super::lateral_consistency::{azimuth_consistency, AzimuthConsistency};
 use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::stats::{median, percentile, rms};
 use crate::survey_listing::ellipse::scale_2d;
@@ -121,6 +122,9 @@ pub struct GradeWellSummary {
     /// The stations' azimuth errors' correlation by distance, Monte Carlo
     /// against the survey's chain (`super::lateral_correlation`).
     pub azimuth_correlation: Vec<LagCorrelation>,
+    /// The azimuth sigma's consistency through the stations and the
+    /// drilling between them (`super::lateral_consistency`).
+    pub azimuth_consistency: AzimuthConsistency,
     /// Runs without a TD check, by reason.
     pub td_unchecked: Vec<(String, usize)>,
     pub requirement: Requirement,
@@ -308,6 +312,8 @@ pub fn summarise(
     };
     s.azimuth_correlation =
         azimuth_lag_correlations(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
+    s.azimuth_consistency =
+        azimuth_consistency(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
     s.td_unchecked = unchecked.into_iter().collect();
     s.along_md = by_station.iter().map(|(n, t)| t.along(*n)).collect();
     let ok = s.runs > s.failed_runs.len();
@@ -370,6 +376,7 @@ mod tests {
             },
             error: [0.0005, azimuth_error_deg.to_radians(), 0.0],
             truth_md: 3000.0 + f64::from(number) * 28.0,
+            azimuth_error_before: None,
             azimuth_sigma_before: None,
             link: None,
             position: Some(PositionCheck {

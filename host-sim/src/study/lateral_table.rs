@@ -171,6 +171,44 @@ fn correlation_table(study: &LateralStudy) -> String {
     out
 }
 
+/// The azimuth sigma's consistency through the stations and the drilling
+/// between them (`super::lateral_consistency`).
+fn consistency_table(study: &LateralStudy) -> String {
+    let mut out = String::from(
+        "\nazimuth sigma through stations and drilling (RMS of the normalised change: 1 when the sigma holds; above 1: over-confident)\n",
+    );
+    let rows: Vec<Vec<String>> = study
+        .summaries
+        .iter()
+        .map(|s| {
+            let c = &s.azimuth_consistency;
+            vec![
+                s.grade.clone(),
+                s.well.clone(),
+                c.stations.to_string(),
+                num(c.station_correction_ratio, 2),
+                num(c.station_variance_removed.map(|v| 100.0 * v), 1),
+                c.drilling_stretches.to_string(),
+                num(c.drilling_growth_ratio, 2),
+            ]
+        })
+        .collect();
+    out.push_str(&aligned(
+        &[
+            "grade",
+            "well",
+            "stations",
+            "station correction / its variance",
+            "variance removed (%)",
+            "stretches",
+            "drilling growth / its variance",
+        ],
+        &rows,
+        2,
+    ));
+    out
+}
+
 /// The terminal tables: stations and the attitude requirement, TD and the
 /// position requirement, then the error growth along MD per grade and well.
 pub fn table(study: &LateralStudy) -> String {
@@ -220,6 +258,7 @@ pub fn table(study: &LateralStudy) -> String {
     ));
     out.push_str(&method_split_table(study));
     out.push_str(&correlation_table(study));
+    out.push_str(&consistency_table(study));
     for s in &study.summaries {
         if s.motion_seen_stations > 0 {
             out.push_str(&format!(
@@ -440,6 +479,14 @@ pub fn csv(study: &LateralStudy) -> String {
         header.push(format!("azimuth_correlation_{k}_apart_monte_carlo"));
         header.push(format!("azimuth_correlation_{k}_apart_survey_chain"));
     }
+    header.extend(
+        [
+            "station_correction_ratio",
+            "station_variance_removed",
+            "drilling_growth_ratio",
+        ]
+        .map(String::from),
+    );
     let mut out = header.join(",") + "\n";
     for s in &study.summaries {
         let t = &s.td;
@@ -491,6 +538,10 @@ pub fn csv(study: &LateralStudy) -> String {
             fields.push(f(c.and_then(|c| c.monte_carlo)));
             fields.push(f(c.and_then(|c| c.survey_chain)));
         }
+        let c = &s.azimuth_consistency;
+        fields.push(f(c.station_correction_ratio));
+        fields.push(f(c.station_variance_removed));
+        fields.push(f(c.drilling_growth_ratio));
         out.push_str(&(fields.join(",") + "\n"));
     }
     out

@@ -4,6 +4,7 @@ pub mod drilling_coverage;
 pub mod drilling_run;
 pub mod grade;
 pub mod lateral;
+pub mod lateral_consistency;
 pub mod lateral_correlation;
 pub mod lateral_covariance;
 pub mod lateral_figures;

@@ -1,0 +1,222 @@
+//! Where the azimuth's printed sigma stops holding its error: at the
+//! stations or in the drilling between them ([`super::lateral`]).
+//!
+//! Each determined station gives its azimuth error and sigma at its start
+//! (the last solution before its first still sample,
+//! `StationCheck::azimuth_error_before`) and at its end (the station's).
+//! Two normalised quantities follow, each with an RMS of 1 when the
+//! filter's azimuth variance is right:
+//!
+//! * the station's correction, the azimuth estimate's change over it,
+//!   `d = e_start - e_end`, against `s_start^2 - s_end^2`: a Kalman
+//!   filter's correction is orthogonal to its error after it, so its
+//!   variance is the variance it removes (the gyros' own random walk over
+//!   a 5-min station, 0.25 deg for the SCC1300, is left out: a little on
+//!   the high side of 1 where a station removes little);
+//! * the drilling before it, the error's change from the previous
+//!   station's end, against `s_start(k)^2 - s_end(k-1)^2`: the filter
+//!   takes no azimuth information while drilling (the constraints' attitude
+//!   rows are dropped, docs/filter-derivation.md 4d), so that growth is
+//!   what its model adds.
+//!
+//! The mean fraction of the azimuth variance a station removes,
+//! `1 - s_end^2 / s_start^2`, says how much the station weighs.
+
+use super::drilling_run::{RunOutcome, StationCheck};
+use crate::survey_listing::drilling::azimuth_determined;
+use mwd_core::protocol::frame::station_flags;
+use serde::Serialize;
+
+/// The azimuth's consistency through stations and drilling; `None` where
+/// nothing was counted (undetermined, never 0).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct AzimuthConsistency {
+    pub stations: usize,
+    /// RMS of d / sqrt(s_start^2 - s_end^2) over the stations that
+    /// removed variance.
+    pub station_correction_ratio: Option<f64>,
+    /// Mean of 1 - s_end^2 / s_start^2 over the same stations.
+    pub station_variance_removed: Option<f64>,
+    pub drilling_stretches: usize,
+    /// RMS of the error's change over a drilling stretch against the
+    /// square root of its variance's growth.
+    pub drilling_growth_ratio: Option<f64>,
+}
+
+/// (error, sigma) at a determined station's start and end, rad.
+fn start_and_end(st: &StationCheck) -> Option<((f64, f64), (f64, f64))> {
+    let valid =
+        st.survey.flags & station_flags::SOLUTION_INVALID == 0 && azimuth_determined(&st.survey);
+    let end = (st.error[1], f64::from(st.survey.angles_std[1]));
+    let start = (st.azimuth_error_before?, st.azimuth_sigma_before?);
+    let finite = [start.0, start.1, end.0, end.1]
+        .iter()
+        .all(|v| v.is_finite());
+    (valid && finite).then_some((start, end))
+}
+
+/// Sums of squares and counts.
+#[derive(Default)]
+struct Rms {
+    sum: f64,
+    n: usize,
+}
+
+impl Rms {
+    fn add(&mut self, x: f64) {
+        self.sum += x * x;
+        self.n += 1;
+    }
+    fn value(&self) -> Option<f64> {
+        (self.n > 0).then(|| (self.sum / self.n as f64).sqrt())
+    }
+}
+
+/// The consistency over the runs that finished.
+pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> AzimuthConsistency {
+    let (mut station, mut drilling) = (Rms::default(), Rms::default());
+    let (mut removed, mut stations) = (0.0, 0);
+    for run in runs {
+        let mut previous_end: Option<(u16, (f64, f64))> = None;
+        for st in &run.stations {
+            let Some((start, end)) = start_and_end(st) else {
+                previous_end = None;
+                continue;
+            };
+            let lost = start.1 * start.1 - end.1 * end.1;
+            if lost > 0.0 {
+                station.add((start.0 - end.0) / lost.sqrt());
+                removed += lost / (start.1 * start.1);
+                stations += 1;
+            }
+            // The stretch from the previous station's end, where that
+            // station is the one before this.
+            if let Some((number, (e0, s0))) = previous_end {
+                let grown = start.1 * start.1 - s0 * s0;
+                if number.wrapping_add(1) == st.survey.station && grown > 0.0 {
+                    drilling.add((start.0 - e0) / grown.sqrt());
+                }
+            }
+            previous_end = Some((st.survey.station, end));
+        }
+    }
+    AzimuthConsistency {
+        stations: station.n,
+        station_correction_ratio: station.value(),
+        station_variance_removed: (stations > 0).then(|| removed / stations as f64),
+        drilling_stretches: drilling.n,
+        drilling_growth_ratio: drilling.value(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mwd_core::protocol::StationSurvey;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    fn station(number: u16, start: (f64, f64), end: (f64, f64)) -> StationCheck {
+        StationCheck {
+            survey: StationSurvey {
+                station: number,
+                angles_std: [0.001, end.1 as f32, 0.001],
+                ..StationSurvey::default()
+            },
+            error: [0.0, end.0, 0.0],
+            truth_md: 0.0,
+            azimuth_sigma_before: Some(start.1),
+            azimuth_error_before: Some(start.0),
+            link: None,
+            position: None,
+        }
+    }
+
+    fn run(stations: Vec<StationCheck>) -> RunOutcome {
+        RunOutcome {
+            seed: 0,
+            stations,
+            td: None,
+            td_note: None,
+            method_td_error_ne: None,
+            samples: 0,
+            elapsed_s: 0.0,
+            cpu_s: None,
+        }
+    }
+
+    /// Runs of a scalar Kalman filter: random-walk growth `q` between
+    /// stations, a station measuring the error with variance `r`, the
+    /// filter told `r_told` (the truth is drawn with `r`).
+    fn kalman_runs(r: f64, r_told: f64) -> Vec<RunOutcome> {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
+        let q: f64 = 4.0;
+        (0..400)
+            .map(|_| {
+                let (mut e, mut p): (f64, f64) = (normal(), 1.0);
+                let stations = (1..=6)
+                    .map(|k| {
+                        e += q.sqrt() * normal();
+                        p += q;
+                        let start = (e, p.sqrt());
+                        let z = e + r.sqrt() * normal();
+                        let gain = p / (p + r_told);
+                        e -= gain * z;
+                        p *= 1.0 - gain;
+                        station(k, start, (e, p.sqrt()))
+                    })
+                    .collect();
+                run(stations)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_consistent_filter_scores_one_at_stations_and_between_them() {
+        let runs = kalman_runs(3.0, 3.0);
+        let c = azimuth_consistency(runs.iter());
+        assert_eq!(c.stations, 2400);
+        assert_eq!(c.drilling_stretches, 2000);
+        let station = c.station_correction_ratio.unwrap();
+        let drilling = c.drilling_growth_ratio.unwrap();
+        assert!((station - 1.0).abs() < 0.05, "{station}");
+        assert!((drilling - 1.0).abs() < 0.05, "{drilling}");
+        let removed = c.station_variance_removed.unwrap();
+        assert!(removed > 0.5 && removed < 0.8, "{removed}");
+    }
+
+    #[test]
+    fn a_station_measurement_noisier_than_the_filter_is_told_shows_at_the_stations() {
+        // The correction's variance is gain^2 (p + r) against the told
+        // gain^2 (p + r_told): at the steady prior p = 6, sqrt(12 / 9).
+        let c = azimuth_consistency(kalman_runs(6.0, 3.0).iter());
+        let station = c.station_correction_ratio.unwrap();
+        assert!(station > 1.1 && station < 1.3, "{station}");
+        let drilling = c.drilling_growth_ratio.unwrap();
+        assert!((drilling - 1.0).abs() < 0.05, "{drilling}");
+    }
+
+    #[test]
+    fn undetermined_stations_and_missing_starts_are_not_counted() {
+        let mut undetermined = station(2, (0.1, 0.2), (0.1, 0.1));
+        undetermined.survey.flags = station_flags::AZIMUTH_UNDETERMINED;
+        let mut no_start = station(3, (0.1, 0.2), (0.1, 0.1));
+        no_start.azimuth_error_before = None;
+        let runs = [run(vec![
+            station(1, (0.1, 0.2), (0.1, 0.1)),
+            undetermined,
+            no_start,
+            station(4, (0.3, 0.3), (0.0, 0.1)),
+        ])];
+        let c = azimuth_consistency(runs.iter());
+        assert_eq!(c.stations, 2);
+        // station 4 follows no counted station 3: no stretch
+        assert_eq!(c.drilling_stretches, 0);
+        assert_eq!(c.drilling_growth_ratio, None);
+        let empty = azimuth_consistency([].iter());
+        assert_eq!(empty.station_correction_ratio, None);
+        assert_eq!(empty.station_variance_removed, None);
+    }
+}
