@@ -21,8 +21,10 @@ use nalgebra::SMatrix;
 
 /// Combinations per snapshot.
 pub const LINKED: usize = 3;
-/// Snapshots kept at once.
-pub const SNAPSHOTS: usize = 3;
+/// Snapshots kept at once: the station links' three
+/// (`probe::station_link`) and the station block's gyro noise
+/// (`probe::navigator_station`, [`CrossCovariances::start_zero`]).
+pub const SNAPSHOTS: usize = 4;
 
 /// One snapshot's `G = cov(x, z)`, column by column.
 pub type Columns<T, const N: usize> = [[T; N]; LINKED];
@@ -57,6 +59,26 @@ impl<T: FilterScalar, const N: usize> CrossCovariances<T, N> {
                 column
             }));
         }
+    }
+
+    /// Starts slot `slot` as zero columns: a quantity not yet correlated
+    /// with the state, such as the sum of sensor noise still to come,
+    /// which its owner then adds to ([`column_mut`](Self::column_mut))
+    /// as the noise enters the state. An index out of range does nothing.
+    pub fn start_zero(&mut self, slot: usize) {
+        if let Some(s) = self.slots.get_mut(slot) {
+            *s = Some([[T::zero(); N]; LINKED]);
+        }
+    }
+
+    /// Column `column` of slot `slot`, if the slot is set.
+    pub fn column(&self, slot: usize, column: usize) -> Option<&[T; N]> {
+        self.slots.get(slot)?.as_ref()?.get(column)
+    }
+
+    /// The same, to write.
+    pub fn column_mut(&mut self, slot: usize, column: usize) -> Option<&mut [T; N]> {
+        self.slots.get_mut(slot)?.as_mut()?.get_mut(column)
     }
 
     /// `cov(L x, z_slot)` now (LINKED x LINKED, row = L's combination),

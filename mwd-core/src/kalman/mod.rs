@@ -113,7 +113,7 @@ impl UpdateReport {
         self.gated == 0 && self.non_finite == 0 && self.degenerate == 0
     }
 
-    fn count<T>(&mut self, outcome: &ScalarOutcome<T>) {
+    pub(crate) fn count<T>(&mut self, outcome: &ScalarOutcome<T>) {
         let slot = match outcome {
             ScalarOutcome::Accepted { .. } => &mut self.accepted,
             ScalarOutcome::Gated { .. } => &mut self.gated,
@@ -180,8 +180,37 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
     /// One scalar measurement (eq. 19-21 with a 1 x N row). Leaves the
     /// filter untouched unless the outcome is `Accepted`.
     pub fn update_scalar(&mut self, m: &ScalarMeasurement<T>) -> ScalarOutcome<T> {
-        let outcome =
-            scalar::joseph_update(&mut self.x, &mut self.p, m, self.gate, &mut self.cross);
+        let outcome = scalar::joseph_update(
+            &mut self.x,
+            &mut self.p,
+            m,
+            self.gate,
+            &mut self.cross,
+            None,
+        );
+        if outcome.is_accepted() {
+            mirror_upper(&mut self.p);
+        }
+        outcome
+    }
+
+    /// One scalar whose measurement noise already entered the state:
+    /// `noise_cross` is `E[x v]`, the prior error's covariance with it
+    /// (`scalar::joseph_update`). Leaves the filter untouched unless the
+    /// outcome is `Accepted`.
+    pub fn update_scalar_correlated(
+        &mut self,
+        m: &ScalarMeasurement<T>,
+        noise_cross: &[T; N],
+    ) -> ScalarOutcome<T> {
+        let outcome = scalar::joseph_update(
+            &mut self.x,
+            &mut self.p,
+            m,
+            self.gate,
+            &mut self.cross,
+            Some(noise_cross),
+        );
         if outcome.is_accepted() {
             mirror_upper(&mut self.p);
         }
@@ -194,9 +223,14 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
         let mut report = UpdateReport::default();
         for k in 0..m.len() {
             let outcome = match m.scalar(k) {
-                Some(s) => {
-                    scalar::joseph_update(&mut self.x, &mut self.p, &s, self.gate, &mut self.cross)
-                }
+                Some(s) => scalar::joseph_update(
+                    &mut self.x,
+                    &mut self.p,
+                    &s,
+                    self.gate,
+                    &mut self.cross,
+                    None,
+                ),
                 None => ScalarOutcome::NonFinite,
             };
             report.count(&outcome);

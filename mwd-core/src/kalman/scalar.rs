@@ -9,12 +9,20 @@ use nalgebra::{SMatrix, SVector};
 /// is stale afterwards: the caller mirrors it once per measurement, which
 /// saves a strided N^2/2 copy per scalar). Cost ~N^2/2 for the covariance,
 /// O(N * nnz) for the rest.
+///
+/// `noise_cross`, where given, is `E[x v]`: the prior error's covariance
+/// with the scalar's measurement noise, for noise that already entered the
+/// state (a gyro's samples both propagated the attitude and make the
+/// measurement). Then `c = P h + s` and the variance `h^T P h + 2 h^T s +
+/// r` (Simon, Optimal State Estimation, 2006, section 7.1), and the
+/// covariance update below is unchanged in form.
 pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     x: &mut SVector<T, N>,
     p: &mut SMatrix<T, N, N>,
     m: &ScalarMeasurement<T>,
     gate: Option<T>,
     cross: &mut CrossCovariances<T, N>,
+    noise_cross: Option<&[T; N]>,
 ) -> ScalarOutcome<T> {
     let row_finite = m.h.entries().all(|(i, c)| i < N && c.is_finite());
     if !(m.z.is_finite() && m.r.is_finite() && m.r >= T::zero() && row_finite) {
@@ -39,7 +47,19 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     let hph =
         m.h.entries()
             .fold(T::zero(), |acc, (i, coef)| acc + coef * c[i]);
-    let variance = hph + m.r;
+    let mut variance = hph + m.r;
+    if let Some(s) = noise_cross {
+        if !s.iter().all(|v| v.is_finite()) {
+            return ScalarOutcome::NonFinite;
+        }
+        let hs =
+            m.h.entries()
+                .fold(T::zero(), |acc, (i, coef)| acc + coef * s[i]);
+        variance += hs + hs;
+        for (ci, si) in c.iter_mut().zip(s) {
+            *ci += *si;
+        }
+    }
     if !(variance.is_finite() && variance > T::zero()) {
         return ScalarOutcome::Degenerate;
     }
@@ -86,7 +106,8 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     }
 
     // Covariance, eq. 21. Expanding (I - k h^T) P (I - k h^T)^T + r k k^T
-    // with c = P h and s = h^T c + r gives P - k c^T - c k^T + s k k^T,
+    // with c = P h and s = h^T c + r gives P - k c^T - c k^T + s k k^T
+    // (with a noise cross-covariance, c and s as above: the same form),
     // exactly and for any gain k: an error dk in the gain changes P only by
     // s dk dk^T (second order, the Joseph form's robustness), and every term
     // is symmetric, so the upper triangle is computed and mirrored: about a
@@ -176,6 +197,7 @@ fn joseph_last_rows<T: FilterScalar, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kalman::SparseRow;
 
     /// The probe's blocked loop and the host's column loop compute each
     /// entry with the same expression, so the host replays the probe's
@@ -205,5 +227,81 @@ mod tests {
             }
         }
         assert_ne!(blocked[20][10], value(10, 20), "the update changed nothing");
+    }
+
+    /// A scalar whose noise v is correlated with the prior error (E[x v]
+    /// = s) is an ordinary scalar of the state augmented with v: z = h^T
+    /// x + v with P_a = [[P, s], [s^T, r]] and a zero noise. The
+    /// correlated update must give the augmented filter's marginal.
+    #[test]
+    fn a_correlated_scalar_is_the_augmented_states_update() {
+        const N: usize = 4;
+        let p: SMatrix<f64, N, N> = SMatrix::from_row_slice(&[
+            4.0, 1.0, 0.5, 0.0, //
+            1.0, 3.0, 0.2, 0.1, //
+            0.5, 0.2, 2.0, 0.3, //
+            0.0, 0.1, 0.3, 1.0,
+        ]);
+        let s = [0.3, -0.2, 0.0, 0.1];
+        let r = 0.8;
+        let mut h = SparseRow::empty();
+        h.push(0, 1.0);
+        h.push(2, -0.5);
+        let m = ScalarMeasurement { z: 0.7, h, r };
+
+        let mut x = SVector::<f64, N>::zeros();
+        let mut pc = p;
+        let mut cross = CrossCovariances::default();
+        let outcome = joseph_update(&mut x, &mut pc, &m, None, &mut cross, Some(&s));
+        assert!(outcome.is_accepted());
+
+        const A: usize = N + 1;
+        let mut pa = SMatrix::<f64, A, A>::zeros();
+        for i in 0..N {
+            for j in 0..N {
+                pa[(i, j)] = p[(i, j)];
+            }
+            pa[(i, N)] = s[i];
+            pa[(N, i)] = s[i];
+        }
+        pa[(N, N)] = r;
+        let mut ha = SparseRow::empty();
+        ha.push(0, 1.0);
+        ha.push(2, -0.5);
+        ha.push(N, 1.0);
+        let ma = ScalarMeasurement {
+            z: 0.7,
+            h: ha,
+            r: 0.0,
+        };
+        let mut xa = SVector::<f64, A>::zeros();
+        let mut cross_a = CrossCovariances::default();
+        let outcome = joseph_update(&mut xa, &mut pa, &ma, None, &mut cross_a, None);
+        assert!(outcome.is_accepted());
+        for i in 0..N {
+            assert!((x[i] - xa[i]).abs() < 1e-12, "x[{i}]");
+            for j in i..N {
+                // the upper triangle is the updated one
+                assert!((pc[(i, j)] - pa[(i, j)]).abs() < 1e-12, "P[{i},{j}]");
+            }
+        }
+        // and it differs from the update that ignores the correlation
+        let mut xu = SVector::<f64, N>::zeros();
+        let mut pu = p;
+        joseph_update(&mut xu, &mut pu, &m, None, &mut cross, None);
+        assert!((xu[0] - x[0]).abs() > 1e-3);
+    }
+
+    #[test]
+    fn a_non_finite_noise_cross_covariance_is_refused() {
+        let mut x = SVector::<f64, 2>::zeros();
+        let mut p = SMatrix::<f64, 2, 2>::identity();
+        let mut h = SparseRow::empty();
+        h.push(0, 1.0);
+        let m = ScalarMeasurement { z: 1.0, h, r: 1.0 };
+        let mut cross = CrossCovariances::default();
+        let outcome = joseph_update(&mut x, &mut p, &m, None, &mut cross, Some(&[f64::NAN, 0.0]));
+        assert!(matches!(outcome, ScalarOutcome::NonFinite));
+        assert_eq!(p, SMatrix::<f64, 2, 2>::identity());
     }
 }

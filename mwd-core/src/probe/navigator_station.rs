@@ -13,6 +13,7 @@ use crate::aid_sources::{long_run_variance, EarthRate};
 use crate::attitude::NEAR_VERTICAL;
 use crate::conventions::dcm_from_quat;
 use crate::earth::earth_rate_n;
+use crate::error_model::ATT;
 use crate::kalman::{FilterScalar, SparseRow, LINKED};
 use crate::probe::station::{angle_uncertainty, angles_and_jacobian};
 use crate::probe::station_link::{
@@ -22,6 +23,16 @@ use crate::probe_sample::GYRO_AXES;
 use crate::protocol::frame::{nav_flags, station_flags};
 use crate::protocol::StationSurvey;
 use crate::timing::SAMPLE_INTERVAL_S;
+
+/// The snapshot slot (`kalman::CrossCovariances`) holding the state's
+/// covariance with the sums of the current block's x and z gyro noise
+/// (columns 0 and 1): the samples whose means make the block's rate
+/// gyrocompass also turned the attitude, by -C_b^n n dt each, so the
+/// block's measurement noise is correlated with the attitude error it is
+/// compared against (the accelerometers, through the zero-velocity
+/// updates, see that turn as tilt). Uncounted, a station took the gyros'
+/// information about the heading twice (docs/filter-derivation.md 4k).
+pub(super) const BLOCK_NOISE: usize = 3;
 
 /// What a station's block did with the rate gyrocompass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -52,6 +63,8 @@ impl<T: FilterScalar> Navigator<T> {
             .max(statistics.gravity);
         let start = self.sample_counter;
         if self.station.is_none() {
+            let (_, snapshots) = self.filter.snapshots_mut();
+            snapshots.start_zero(BLOCK_NOISE);
             self.stations = self.stations.wrapping_add(1);
             self.station = Some(Station {
                 epochs: 0,
@@ -71,12 +84,16 @@ impl<T: FilterScalar> Navigator<T> {
         };
         station.epochs += 1;
         station.quality_sum += quality;
-        if let Some(g) = self.still_gyro {
+        let gyro = self.still_gyro;
+        if let Some(g) = gyro {
             station.gyro_sum[0] += g[0];
             station.gyro_sum[1] += g[1];
             station.gyro_epochs += 1;
         }
         let block_done = station.epochs % SURVEY_SETTLE_EPOCHS == 0;
+        if gyro.is_some() {
+            self.add_block_noise();
+        }
         // Each block's means are one rate-gyrocompass update, before the
         // block's survey is taken, so a station's survey holds the heading
         // and the rate biases (and through them the heading drift of the
@@ -141,6 +158,7 @@ impl<T: FilterScalar> Navigator<T> {
             let (_, snapshots) = self.filter.snapshots_mut();
             snapshots.move_to(SETTLED, PREVIOUS);
             snapshots.clear(CHECKPOINT);
+            snapshots.clear(BLOCK_NOISE);
             if link.is_none() {
                 snapshots.clear(PREVIOUS);
             }
@@ -186,6 +204,36 @@ impl<T: FilterScalar> Navigator<T> {
     /// A block whose means fail [`EARTH_RATE_GATE`] is not used: the tool
     /// turned ([`Gyrocompass::Turning`]).
     fn gyrocompass_block(&mut self) -> Gyrocompass {
+        let outcome = self.gyrocompass_block_means();
+        // The next block's noise is not yet in the state.
+        let (_, snapshots) = self.filter.snapshots_mut();
+        snapshots.start_zero(BLOCK_NOISE);
+        outcome
+    }
+
+    /// This cycle's x and z gyro noise turned the attitude: adds its
+    /// covariance with the block's noise sums, E[(-r_a n_a dt) n_a] = -r_a
+    /// q_a per axis a (r_a = C_b^n e_a, q_a the white noise's density
+    /// squared, the attitude process noise's gyro part), to the
+    /// [`BLOCK_NOISE`] columns.
+    fn add_block_noise(&mut self) {
+        let c_bn = dcm_from_quat(&self.filter.state().attitude);
+        let noise = self.noise.gyro;
+        let (_, snapshots) = self.filter.snapshots_mut();
+        for (column, axis) in GYRO_AXES.iter().enumerate() {
+            let q = noise[*axis].white_density * noise[*axis].white_density;
+            let Some(sum) = snapshots.column_mut(BLOCK_NOISE, column) else {
+                return;
+            };
+            for i in 0..3 {
+                sum[ATT + i] -= T::of(c_bn[(i, *axis)] * q);
+            }
+        }
+    }
+
+    /// [`gyrocompass_block`](Self::gyrocompass_block)'s update from the
+    /// block's sums, which it clears.
+    fn gyrocompass_block_means(&mut self) -> Gyrocompass {
         let Some(station) = self.station.as_mut() else {
             return Gyrocompass::Skipped;
         };
@@ -216,7 +264,7 @@ impl<T: FilterScalar> Navigator<T> {
         {
             return Gyrocompass::Turning;
         }
-        self.filter.aid(&measurement);
+        self.filter.aid_correlated(&measurement, BLOCK_NOISE, n);
         Gyrocompass::Used
     }
 
