@@ -19,6 +19,9 @@
 //!   rows are dropped, docs/filter-derivation.md 4d), so that growth is
 //!   what its model adds.
 //!
+//! The window's station (the first) is not counted as a correction: the
+//! tie-in replaces its heading.
+//!
 //! The mean fraction of the azimuth variance a station removes,
 //! `1 - s_end^2 / s_start^2`, says how much the station weighs.
 
@@ -26,6 +29,12 @@ use super::drilling_run::{RunOutcome, StationCheck};
 use crate::survey_listing::drilling::azimuth_determined;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
+
+/// The run's first station, at the window: the tie-in replaces its
+/// heading (a survey's, not the station's measurement; before it the
+/// solution is the alignment's), so its change is not a station's
+/// correction. Its end starts the first drilling stretch.
+const WINDOW_STATION: u16 = 1;
 
 /// The azimuth's consistency through stations and drilling; `None` where
 /// nothing was counted (undetermined, never 0).
@@ -84,7 +93,7 @@ pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Az
                 continue;
             };
             let lost = start.1 * start.1 - end.1 * end.1;
-            if lost > 0.0 {
+            if lost > 0.0 && st.survey.station != WINDOW_STATION {
                 station.add((start.0 - end.0) / lost.sqrt());
                 removed += lost / (start.1 * start.1);
                 stations += 1;
@@ -177,7 +186,8 @@ mod tests {
     fn a_consistent_filter_scores_one_at_stations_and_between_them() {
         let runs = kalman_runs(3.0, 3.0);
         let c = azimuth_consistency(runs.iter());
-        assert_eq!(c.stations, 2400);
+        // station 1 of each run is the window's: not a correction
+        assert_eq!(c.stations, 2000);
         assert_eq!(c.drilling_stretches, 2000);
         let station = c.station_correction_ratio.unwrap();
         let drilling = c.drilling_growth_ratio.unwrap();
@@ -211,7 +221,8 @@ mod tests {
             station(4, (0.3, 0.3), (0.0, 0.1)),
         ])];
         let c = azimuth_consistency(runs.iter());
-        assert_eq!(c.stations, 2);
+        // station 1 is the window's; station 4 is counted
+        assert_eq!(c.stations, 1);
         // station 4 follows no counted station 3: no stretch
         assert_eq!(c.drilling_stretches, 0);
         assert_eq!(c.drilling_growth_ratio, None);
