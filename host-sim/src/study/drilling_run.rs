@@ -241,6 +241,24 @@ pub struct RunOutcome {
     pub cpu_s: Option<f64>,
 }
 
+#[cfg(test)]
+impl RunOutcome {
+    /// A run of `stations` alone, without a TD or timings: for the
+    /// summaries' tests.
+    pub(crate) fn of_stations(seed: u64, stations: Vec<StationCheck>) -> Self {
+        Self {
+            seed,
+            stations,
+            td: None,
+            td_note: None,
+            method_td_error_ne: None,
+            samples: 0,
+            elapsed_s: 0.0,
+            cpu_s: None,
+        }
+    }
+}
+
 impl RunOutcome {
     /// The survey method's own TD horizontal error (m).
     pub fn method_td_error_m(&self) -> Option<f64> {

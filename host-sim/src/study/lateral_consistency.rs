@@ -143,16 +143,7 @@ mod tests {
     }
 
     fn run(stations: Vec<StationCheck>) -> RunOutcome {
-        RunOutcome {
-            seed: 0,
-            stations,
-            td: None,
-            td_note: None,
-            method_td_error_ne: None,
-            samples: 0,
-            elapsed_s: 0.0,
-            cpu_s: None,
-        }
+        RunOutcome::of_stations(0, stations)
     }
 
     /// Runs of a scalar Kalman filter: random-walk growth `q` between

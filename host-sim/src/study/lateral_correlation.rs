@@ -133,16 +133,7 @@ mod tests {
     }
 
     fn run(seed: u64, stations: Vec<StationCheck>) -> RunOutcome {
-        RunOutcome {
-            seed,
-            stations,
-            td: None,
-            td_note: None,
-            method_td_error_ne: None,
-            samples: 0,
-            elapsed_s: 0.0,
-            cpu_s: None,
-        }
+        RunOutcome::of_stations(seed, stations)
     }
 
     #[test]
