@@ -12,7 +12,7 @@ use crate::capture::{raw_sample_from_si, SiSample};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey_error::{ErrorTerm, Site};
 use crate::survey_listing::depth_log::DepthLog;
-use crate::survey_listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey};
+use crate::survey_listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
 use crate::survey_listing::{
     compute, AzimuthReference, InputStation, LengthUnit, StationFile, TieOnInput,
 };
@@ -433,8 +433,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     // each station's azimuth sigma at its start, for the survey's chain
     let mut track = AzimuthSigmaTrack::default();
     let mut azi_before = Vec::new();
-    // each station's azimuth error at its start (the solution `track` takes)
-    let mut azimuths = AzimuthTrack::default();
+    // and the error of that solution's azimuth
     let mut err_before = Vec::new();
     let mut links = Vec::new();
     let mut samples = 0;
@@ -443,9 +442,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        let solution = feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?;
-        track.push(&solution);
-        azimuths.push(&solution);
+        track.push(&feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?);
         samples += 1;
         last = Some((
             s.true_rate,
@@ -466,8 +463,9 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
             continue;
         }
         if let Some(station) = navigator.take_station() {
-            azi_before.push(track.station_start(&station));
-            err_before.push(azimuths.error_at_start(&station, &drilling));
+            let (sigma, error) = start_of(track.station_start_solution(&station), &drilling);
+            azi_before.push(sigma);
+            err_before.push(error);
             links.push(link_of(&navigator, &station));
             stations.push(station);
         }
@@ -483,13 +481,18 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         });
         for k in 0..MAX_STATION_SAMPLES as usize {
             let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
-            let solution = feed(&mut navigator, raw_frames, run_samples + k, &gyro, &force)?;
-            track.push(&solution);
-            azimuths.push(&solution);
+            track.push(&feed(
+                &mut navigator,
+                raw_frames,
+                run_samples + k,
+                &gyro,
+                &force,
+            )?);
             samples += 1;
             if let Some(station) = navigator.take_station() {
-                azi_before.push(track.station_start(&station));
-                err_before.push(azimuths.error_at_start(&station, &drilling));
+                let (sigma, error) = start_of(track.station_start_solution(&station), &drilling);
+                azi_before.push(sigma);
+                err_before.push(error);
                 links.push(link_of(&navigator, &station));
                 stations.push(station);
                 break;
@@ -563,41 +566,16 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     })
 }
 
-/// The solutions' azimuths since the last station, for the azimuth error
-/// a station starts from (as [`AzimuthSigmaTrack`] keeps their sigmas).
-#[derive(Default)]
-struct AzimuthTrack {
-    /// (sample counter, azimuth in rad), counters increasing.
-    points: Vec<(u32, f32)>,
-}
-
-impl AzimuthTrack {
-    fn push(&mut self, s: &NavSolution) {
-        self.points.push((s.sample_counter, s.attitude[2]));
-    }
-
-    /// The azimuth error of the last solution before the station's first
-    /// sample (no more than a second before it, as the sigma's), against
-    /// the truth at that solution's time; the solutions before the
-    /// station's end are forgotten.
-    fn error_at_start(&mut self, station: &StationSurvey, drilling: &Drilling) -> Option<f64> {
-        let k = self
-            .points
-            .partition_point(|&(c, _)| c < station.start_sample);
-        let error = k
-            .checked_sub(1)
-            .and_then(|i| self.points.get(i))
-            .and_then(|&(c, azimuth)| {
-                let truth = drilling.truth((f64::from(c) + 1.0) * SAMPLE_INTERVAL_S);
-                let error = wrap_pi(f64::from(azimuth) - truth.point.azimuth);
-                (station.start_sample - c <= 20 && error.is_finite()).then_some(error)
-            });
-        let end = self
-            .points
-            .partition_point(|&(c, _)| c < station.end_sample);
-        self.points.drain(..end);
-        error
-    }
+/// A station's start (`AzimuthSigmaTrack::station_start_solution`): its
+/// azimuth sigma and the error of the same solution's azimuth against the
+/// truth at that solution's time (rad, wrapped; `None` if not finite).
+fn start_of(start: Option<StationStart>, drilling: &Drilling) -> (Option<f64>, Option<f64>) {
+    let Some(start) = start else {
+        return (None, None);
+    };
+    let truth = drilling.truth((f64::from(start.sample_counter) + 1.0) * SAMPLE_INTERVAL_S);
+    let error = wrap_pi(start.azimuth - truth.point.azimuth);
+    (Some(start.sigma), error.is_finite().then_some(error))
 }
 
 /// Minimum curvature through the true MD and angles at the survey's

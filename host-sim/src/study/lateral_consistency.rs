@@ -26,6 +26,7 @@
 //! `1 - s_end^2 / s_start^2`, says how much the station weighs.
 
 use super::drilling_run::{RunOutcome, StationCheck};
+use super::stats::rms;
 use crate::survey_listing::drilling::azimuth_determined;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -64,27 +65,11 @@ fn start_and_end(st: &StationCheck) -> Option<((f64, f64), (f64, f64))> {
     (valid && finite).then_some((start, end))
 }
 
-/// Sums of squares and counts.
-#[derive(Default)]
-struct Rms {
-    sum: f64,
-    n: usize,
-}
-
-impl Rms {
-    fn add(&mut self, x: f64) {
-        self.sum += x * x;
-        self.n += 1;
-    }
-    fn value(&self) -> Option<f64> {
-        (self.n > 0).then(|| (self.sum / self.n as f64).sqrt())
-    }
-}
-
 /// The consistency over the runs that finished.
 pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> AzimuthConsistency {
-    let (mut station, mut drilling) = (Rms::default(), Rms::default());
-    let (mut removed, mut stations) = (0.0, 0);
+    // per station: (correction / its sigma, fraction of variance removed)
+    let mut corrections: Vec<(f64, f64)> = Vec::new();
+    let mut stretches: Vec<f64> = Vec::new();
     for run in runs {
         let mut previous_end: Option<(u16, (f64, f64))> = None;
         for st in &run.stations {
@@ -94,27 +79,28 @@ pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Az
             };
             let lost = start.1 * start.1 - end.1 * end.1;
             if lost > 0.0 && st.survey.station != WINDOW_STATION {
-                station.add((start.0 - end.0) / lost.sqrt());
-                removed += lost / (start.1 * start.1);
-                stations += 1;
+                corrections.push(((start.0 - end.0) / lost.sqrt(), lost / (start.1 * start.1)));
             }
             // The stretch from the previous station's end, where that
             // station is the one before this.
             if let Some((number, (e0, s0))) = previous_end {
                 let grown = start.1 * start.1 - s0 * s0;
                 if number.wrapping_add(1) == st.survey.station && grown > 0.0 {
-                    drilling.add((start.0 - e0) / grown.sqrt());
+                    stretches.push((start.0 - e0) / grown.sqrt());
                 }
             }
             previous_end = Some((st.survey.station, end));
         }
     }
+    let ratios: Vec<f64> = corrections.iter().map(|c| c.0).collect();
+    let n = corrections.len();
     AzimuthConsistency {
-        stations: station.n,
-        station_correction_ratio: station.value(),
-        station_variance_removed: (stations > 0).then(|| removed / stations as f64),
-        drilling_stretches: drilling.n,
-        drilling_growth_ratio: drilling.value(),
+        stations: n,
+        station_correction_ratio: rms(&ratios),
+        station_variance_removed: (n > 0)
+            .then(|| corrections.iter().map(|c| c.1).sum::<f64>() / n as f64),
+        drilling_stretches: stretches.len(),
+        drilling_growth_ratio: rms(&stretches),
     }
 }
 

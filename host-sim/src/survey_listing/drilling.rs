@@ -87,8 +87,18 @@ pub fn survey_terms() -> Result<Vec<ErrorTerm>> {
 /// station's sigma.
 #[derive(Clone, Debug, Default)]
 pub struct AzimuthSigmaTrack {
-    /// (sample counter, azimuth sigma in rad), counters increasing.
-    points: Vec<(u32, f32)>,
+    /// (sample counter, azimuth, azimuth sigma; rad), counters increasing.
+    points: Vec<(u32, f32, f32)>,
+}
+
+/// The solution a station starts from ([`AzimuthSigmaTrack::start_before`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StationStart {
+    pub sample_counter: u32,
+    /// Azimuth (rad), as the solution gave it.
+    pub azimuth: f64,
+    /// Its 1-sigma (rad): a finite number > 0.
+    pub sigma: f64,
 }
 
 impl AzimuthSigmaTrack {
@@ -98,11 +108,12 @@ impl AzimuthSigmaTrack {
         if self
             .points
             .last()
-            .is_some_and(|&(last, _)| s.sample_counter <= last)
+            .is_some_and(|&(last, _, _)| s.sample_counter <= last)
         {
             self.points.clear();
         }
-        self.points.push((s.sample_counter, s.attitude_std[2]));
+        self.points
+            .push((s.sample_counter, s.attitude[2], s.attitude_std[2]));
     }
 
     /// A station just taken from the stream: its start's sigma
@@ -110,24 +121,39 @@ impl AzimuthSigmaTrack {
     /// before its end forgotten, so that a live stream or a long run keeps
     /// only what a station still to come can start from.
     pub fn station_start(&mut self, station: &StationSurvey) -> Option<f64> {
-        let start = self.before(station.start_sample);
+        self.station_start_solution(station).map(|s| s.sigma)
+    }
+
+    /// The same, with the start's azimuth and sample counter.
+    pub fn station_start_solution(&mut self, station: &StationSurvey) -> Option<StationStart> {
+        let start = self.start_before(station.start_sample);
         self.forget_before(station.end_sample);
         start
     }
 
     /// Forgets the solutions before `sample`.
     fn forget_before(&mut self, sample: u32) {
-        let k = self.points.partition_point(|&(c, _)| c < sample);
+        let k = self.points.partition_point(|&(c, _, _)| c < sample);
         self.points.drain(..k);
     }
 
     /// The sigma of the last solution before `sample`, if it is a finite
     /// number > 0 and no more than a second (20 samples) before it.
     pub fn before(&self, sample: u32) -> Option<f64> {
-        let k = self.points.partition_point(|&(c, _)| c < sample);
-        let &(counter, sigma) = self.points.get(k.checked_sub(1)?)?;
+        self.start_before(sample).map(|s| s.sigma)
+    }
+
+    /// The last solution before `sample`, under [`before`](Self::before)'s
+    /// conditions.
+    pub fn start_before(&self, sample: u32) -> Option<StationStart> {
+        let k = self.points.partition_point(|&(c, _, _)| c < sample);
+        let &(counter, azimuth, sigma) = self.points.get(k.checked_sub(1)?)?;
         let sigma = f64::from(sigma);
-        (sample - counter <= 20 && sigma.is_finite() && sigma > 0.0).then_some(sigma)
+        (sample - counter <= 20 && sigma.is_finite() && sigma > 0.0).then_some(StationStart {
+            sample_counter: counter,
+            azimuth: f64::from(azimuth),
+            sigma,
+        })
     }
 }
 
