@@ -30,6 +30,7 @@ use super::stats::rms;
 use crate::survey_listing::drilling::azimuth_determined;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The run's first station, at the window: the tie-in replaces its
 /// heading (a survey's, not the station's measurement; before it the
@@ -65,11 +66,20 @@ fn start_and_end(st: &StationCheck) -> Option<((f64, f64), (f64, f64))> {
     (valid && finite).then_some((start, end))
 }
 
-/// The consistency over the runs that finished.
-pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> AzimuthConsistency {
-    // per station: (correction / its sigma, fraction of variance removed)
-    let mut corrections: Vec<(f64, f64)> = Vec::new();
-    let mut stretches: Vec<f64> = Vec::new();
+/// One counted station's two normalised quantities.
+struct Counted {
+    station: u16,
+    /// (correction / its sigma, fraction of the variance removed), where
+    /// the station removed variance and is not the window's.
+    correction: Option<(f64, f64)>,
+    /// The drilling stretch that ended at this station, against its
+    /// growth, where the station before it was counted.
+    stretch: Option<f64>,
+}
+
+/// Every determined station's quantities over the runs that finished.
+fn counted<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Vec<Counted> {
+    let mut out = Vec::new();
     for run in runs {
         let mut previous_end: Option<(u16, (f64, f64))> = None;
         for st in &run.stations {
@@ -78,20 +88,29 @@ pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Az
                 continue;
             };
             let lost = start.1 * start.1 - end.1 * end.1;
-            if lost > 0.0 && st.survey.station != WINDOW_STATION {
-                corrections.push(((start.0 - end.0) / lost.sqrt(), lost / (start.1 * start.1)));
-            }
+            let correction = (lost > 0.0 && st.survey.station != WINDOW_STATION)
+                .then(|| ((start.0 - end.0) / lost.sqrt(), lost / (start.1 * start.1)));
             // The stretch from the previous station's end, where that
             // station is the one before this.
-            if let Some((number, (e0, s0))) = previous_end {
+            let stretch = previous_end.and_then(|(number, (e0, s0))| {
                 let grown = start.1 * start.1 - s0 * s0;
-                if number.wrapping_add(1) == st.survey.station && grown > 0.0 {
-                    stretches.push((start.0 - e0) / grown.sqrt());
-                }
-            }
+                (number.wrapping_add(1) == st.survey.station && grown > 0.0)
+                    .then(|| (start.0 - e0) / grown.sqrt())
+            });
+            out.push(Counted {
+                station: st.survey.station,
+                correction,
+                stretch,
+            });
             previous_end = Some((st.survey.station, end));
         }
     }
+    out
+}
+
+fn consistency_of<'a>(counted: impl Iterator<Item = &'a Counted> + Clone) -> AzimuthConsistency {
+    let corrections: Vec<(f64, f64)> = counted.clone().filter_map(|c| c.correction).collect();
+    let stretches: Vec<f64> = counted.filter_map(|c| c.stretch).collect();
     let ratios: Vec<f64> = corrections.iter().map(|c| c.0).collect();
     let n = corrections.len();
     AzimuthConsistency {
@@ -102,6 +121,25 @@ pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Az
         drilling_stretches: stretches.len(),
         drilling_growth_ratio: rms(&stretches),
     }
+}
+
+/// The consistency over the runs that finished.
+pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> AzimuthConsistency {
+    consistency_of(counted(runs).iter())
+}
+
+/// The same per station number (the drilling stretch counted at the
+/// station it ends at), in station order: where along the well the sigma
+/// stops holding.
+pub fn azimuth_consistency_by_station<'a>(
+    runs: impl Iterator<Item = &'a RunOutcome>,
+) -> BTreeMap<u16, AzimuthConsistency> {
+    let all = counted(runs);
+    let numbers: BTreeSet<u16> = all.iter().map(|c| c.station).collect();
+    numbers
+        .into_iter()
+        .map(|n| (n, consistency_of(all.iter().filter(|c| c.station == n))))
+        .collect()
 }
 
 #[cfg(test)]
@@ -206,5 +244,32 @@ mod tests {
         let empty = azimuth_consistency([].iter());
         assert_eq!(empty.station_correction_ratio, None);
         assert_eq!(empty.station_variance_removed, None);
+    }
+
+    #[test]
+    fn the_by_station_breakdown_splits_the_same_counts() {
+        let runs = kalman_runs(3.0, 3.0);
+        let all = azimuth_consistency(runs.iter());
+        let by = azimuth_consistency_by_station(runs.iter());
+        assert_eq!(
+            by.keys().copied().collect::<Vec<_>>(),
+            vec![1, 2, 3, 4, 5, 6]
+        );
+        assert_eq!(by[&1].stations, 0, "the window's station corrects nothing");
+        assert_eq!(
+            by[&1].drilling_stretches, 0,
+            "no stretch ends at the window"
+        );
+        let stations: usize = by.values().map(|c| c.stations).sum();
+        let stretches: usize = by.values().map(|c| c.drilling_stretches).sum();
+        assert_eq!(
+            (stations, stretches),
+            (all.stations, all.drilling_stretches)
+        );
+        // each station's own 400 ratios score one (a few percent of noise)
+        for c in by.values().skip(1) {
+            let r = c.drilling_growth_ratio.unwrap();
+            assert!((r - 1.0).abs() < 0.12, "{r}");
+        }
     }
 }

@@ -12,7 +12,9 @@
 
 use super::drilling_coverage::Fraction;
 use super::drilling_run::RunOutcome;
-use super::lateral_consistency::{azimuth_consistency, AzimuthConsistency};
+use super::lateral_consistency::{
+    azimuth_consistency, azimuth_consistency_by_station, AzimuthConsistency,
+};
 use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::stats::{median, percentile, rms};
 use crate::survey_listing::ellipse::scale_2d;
@@ -96,6 +98,11 @@ pub struct AlongMd {
     pub positioned: usize,
     pub rms_horizontal_error_m: Option<f64>,
     pub median_horizontal_sigma_m: Option<f64>,
+    /// This station's azimuth correction against the variance it removed,
+    /// and the drilling stretch that ended at it against its growth, RMS
+    /// over the runs (`super::lateral_consistency`; 1 when consistent).
+    pub station_correction_ratio: Option<f64>,
+    pub drilling_growth_ratio: Option<f64>,
 }
 
 /// One grade on one well.
@@ -185,6 +192,8 @@ impl Tally {
             positioned: self.position.len(),
             rms_horizontal_error_m: rms(&radial),
             median_horizontal_sigma_m: median(&predicted),
+            station_correction_ratio: None,
+            drilling_growth_ratio: None,
         }
     }
 }
@@ -315,7 +324,19 @@ pub fn summarise(
     s.azimuth_consistency =
         azimuth_consistency(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
     s.td_unchecked = unchecked.into_iter().collect();
-    s.along_md = by_station.iter().map(|(n, t)| t.along(*n)).collect();
+    let by_number =
+        azimuth_consistency_by_station(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
+    s.along_md = by_station
+        .iter()
+        .map(|(n, t)| {
+            let consistency = by_number.get(n);
+            AlongMd {
+                station_correction_ratio: consistency.and_then(|c| c.station_correction_ratio),
+                drilling_growth_ratio: consistency.and_then(|c| c.drilling_growth_ratio),
+                ..t.along(*n)
+            }
+        })
+        .collect();
     let ok = s.runs > s.failed_runs.len();
     s.run_cpu_s = cpu.filter(|_| ok);
     s.epochs_per_core_second = s

@@ -300,6 +300,8 @@ pub fn table(study: &LateralStudy) -> String {
                     a.positioned.to_string(),
                     num(a.rms_horizontal_error_m, 2),
                     num(a.median_horizontal_sigma_m, 2),
+                    num(a.station_correction_ratio, 2),
+                    num(a.drilling_growth_ratio, 2),
                 ]
             })
             .collect();
@@ -317,6 +319,8 @@ pub fn table(study: &LateralStudy) -> String {
                 "positioned",
                 "horiz RMS (m)",
                 "horiz median 1s (m)",
+                "station corr / sigma",
+                "drilling growth / sigma",
             ],
             &rows,
             0,
