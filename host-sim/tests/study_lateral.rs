@@ -138,7 +138,12 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
     // the stretches between them are counted too
     let c = &s.azimuth_consistency;
     assert!(c.stations >= 2 && c.drilling_stretches >= 1, "{c:?}");
-    for v in [c.station_correction_ratio, c.drilling_growth_ratio] {
+    for v in [
+        c.station_correction_ratio,
+        c.drilling_growth_ratio,
+        c.start_error_ratio,
+        c.end_error_ratio,
+    ] {
         assert!(v.is_some_and(|v| v.is_finite() && v > 0.0), "{c:?}");
     }
     // the table and the CSV carry it, one field per column
@@ -153,7 +158,9 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 2);
     assert_eq!(lines[0].split(',').count(), lines[1].split(',').count());
-    assert!(lines[0].ends_with("drilling_growth_ratio"), "{}", lines[0]);
+    assert!(lines[0].ends_with("end_error_ratio"), "{}", lines[0]);
+    // the along-MD rows carry the same per station
+    assert!(s.along_md.iter().any(|a| a.start_error_ratio.is_some()));
 }
 
 #[test]

@@ -52,6 +52,15 @@ pub struct AzimuthConsistency {
     /// RMS of the error's change over a drilling stretch against the
     /// square root of its variance's growth.
     pub drilling_growth_ratio: Option<f64>,
+    /// RMS of the azimuth error over its sigma at the counted stations'
+    /// starts (after the drilling) and at their ends: 1 when the sigma
+    /// holds there, whatever the correlations. The growth ratio above
+    /// reads the change alone, so it is 1 only when the change is
+    /// uncorrelated with the error it starts from: a station that leaves
+    /// its heading error tied to its gyro bias error (the SCC1300's rate
+    /// gyrocompass) makes it larger with a consistent filter.
+    pub start_error_ratio: Option<f64>,
+    pub end_error_ratio: Option<f64>,
 }
 
 /// (error, sigma) at a determined station's start and end, rad.
@@ -63,7 +72,8 @@ fn start_and_end(st: &StationCheck) -> Option<((f64, f64), (f64, f64))> {
     let finite = [start.0, start.1, end.0, end.1]
         .iter()
         .all(|v| v.is_finite());
-    (valid && finite).then_some((start, end))
+    let positive = start.1 > 0.0 && end.1 > 0.0;
+    (valid && finite && positive).then_some((start, end))
 }
 
 /// One counted station's two normalised quantities.
@@ -75,6 +85,9 @@ struct Counted {
     /// The drilling stretch that ended at this station, against its
     /// growth, where the station before it was counted.
     stretch: Option<f64>,
+    /// The error over its sigma at the station's start and end.
+    start: f64,
+    end: f64,
 }
 
 /// Every determined station's quantities over the runs that finished.
@@ -101,6 +114,8 @@ fn counted<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Vec<Counted> {
                 station: st.survey.station,
                 correction,
                 stretch,
+                start: start.0 / start.1,
+                end: end.0 / end.1,
             });
             previous_end = Some((st.survey.station, end));
         }
@@ -110,7 +125,9 @@ fn counted<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Vec<Counted> {
 
 fn consistency_of<'a>(counted: impl Iterator<Item = &'a Counted> + Clone) -> AzimuthConsistency {
     let corrections: Vec<(f64, f64)> = counted.clone().filter_map(|c| c.correction).collect();
-    let stretches: Vec<f64> = counted.filter_map(|c| c.stretch).collect();
+    let stretches: Vec<f64> = counted.clone().filter_map(|c| c.stretch).collect();
+    let starts: Vec<f64> = counted.clone().map(|c| c.start).collect();
+    let ends: Vec<f64> = counted.map(|c| c.end).collect();
     let ratios: Vec<f64> = corrections.iter().map(|c| c.0).collect();
     let n = corrections.len();
     AzimuthConsistency {
@@ -120,6 +137,8 @@ fn consistency_of<'a>(counted: impl Iterator<Item = &'a Counted> + Clone) -> Azi
             .then(|| corrections.iter().map(|c| c.1).sum::<f64>() / n as f64),
         drilling_stretches: stretches.len(),
         drilling_growth_ratio: rms(&stretches),
+        start_error_ratio: rms(&starts),
+        end_error_ratio: rms(&ends),
     }
 }
 
@@ -210,6 +229,9 @@ mod tests {
         assert!((drilling - 1.0).abs() < 0.05, "{drilling}");
         let removed = c.station_variance_removed.unwrap();
         assert!(removed > 0.5 && removed < 0.8, "{removed}");
+        for r in [c.start_error_ratio.unwrap(), c.end_error_ratio.unwrap()] {
+            assert!((r - 1.0).abs() < 0.05, "{r}");
+        }
     }
 
     #[test]
@@ -270,6 +292,55 @@ mod tests {
         for c in by.values().skip(1) {
             let r = c.drilling_growth_ratio.unwrap();
             assert!((r - 1.0).abs() < 0.12, "{r}");
+        }
+    }
+
+    /// A consistent two-state filter (heading error and a constant gyro
+    /// bias; a station measures their sum, as a rate gyrocompass does):
+    /// after a station the two errors are anti-correlated, so the drift
+    /// that follows, b T + w, partly undoes the heading error and the
+    /// variance grows by less than the drift's own square. The growth
+    /// ratio then reads above 1 while the sigma holds at every start and
+    /// end: the start and end ratios are the consistency check.
+    #[test]
+    fn a_drift_tied_to_the_heading_error_lifts_the_growth_ratio_of_a_consistent_filter() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
+        let (t, q, r): (f64, f64, f64) = (1.0, 0.5, 0.2);
+        let runs: Vec<RunOutcome> = (0..1000)
+            .map(|_| {
+                let (mut psi, mut b) = (normal(), normal());
+                // P = [[pp, pb], [pb, bb]]
+                let (mut pp, mut pb, mut bb): (f64, f64, f64) = (1.0, 0.0, 1.0);
+                let stations = (1..=6)
+                    .map(|k| {
+                        psi += b * t + q.sqrt() * normal();
+                        pp += 2.0 * t * pb + t * t * bb + q;
+                        pb += t * bb;
+                        let start = (psi, pp.sqrt());
+                        // z = psi + b + v; the estimate's correction is fed
+                        // back, so the errors become (I - k h^T) e - k v.
+                        let v = r.sqrt() * normal();
+                        let s = pp + 2.0 * pb + bb + r;
+                        let (k1, k2) = ((pp + pb) / s, (pb + bb) / s);
+                        let innovation = psi + b + v;
+                        psi -= k1 * innovation;
+                        b -= k2 * innovation;
+                        let (c1, c2) = (pp + pb, pb + bb);
+                        pp -= k1 * c1;
+                        pb -= k1 * c2;
+                        bb -= k2 * c2;
+                        station(k, start, (psi, pp.sqrt()))
+                    })
+                    .collect();
+                run(stations)
+            })
+            .collect();
+        let c = azimuth_consistency(runs.iter());
+        let growth = c.drilling_growth_ratio.unwrap();
+        assert!(growth > 1.15, "{growth}");
+        for ratio in [c.start_error_ratio.unwrap(), c.end_error_ratio.unwrap()] {
+            assert!((ratio - 1.0).abs() < 0.04, "{ratio}");
         }
     }
 }

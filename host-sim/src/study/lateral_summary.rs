@@ -103,6 +103,9 @@ pub struct AlongMd {
     /// over the runs (`super::lateral_consistency`; 1 when consistent).
     pub station_correction_ratio: Option<f64>,
     pub drilling_growth_ratio: Option<f64>,
+    /// The azimuth error over its sigma at this station's start (after
+    /// the drilling), RMS over the runs.
+    pub start_error_ratio: Option<f64>,
 }
 
 /// One grade on one well.
@@ -194,6 +197,7 @@ impl Tally {
             median_horizontal_sigma_m: median(&predicted),
             station_correction_ratio: None,
             drilling_growth_ratio: None,
+            start_error_ratio: None,
         }
     }
 }
@@ -333,6 +337,7 @@ pub fn summarise(
             AlongMd {
                 station_correction_ratio: consistency.and_then(|c| c.station_correction_ratio),
                 drilling_growth_ratio: consistency.and_then(|c| c.drilling_growth_ratio),
+                start_error_ratio: consistency.and_then(|c| c.start_error_ratio),
                 ..t.along(*n)
             }
         })

@@ -190,6 +190,8 @@ fn consistency_table(study: &LateralStudy) -> String {
                 num(c.station_variance_removed.map(|v| 100.0 * v), 1),
                 c.drilling_stretches.to_string(),
                 num(c.drilling_growth_ratio, 2),
+                num(c.start_error_ratio, 2),
+                num(c.end_error_ratio, 2),
             ]
         })
         .collect();
@@ -202,6 +204,8 @@ fn consistency_table(study: &LateralStudy) -> String {
             "variance removed (%)",
             "stretches",
             "drilling growth / its variance",
+            "error / sigma at station start",
+            "at station end",
         ],
         &rows,
         2,
@@ -302,6 +306,7 @@ pub fn table(study: &LateralStudy) -> String {
                     num(a.median_horizontal_sigma_m, 2),
                     num(a.station_correction_ratio, 2),
                     num(a.drilling_growth_ratio, 2),
+                    num(a.start_error_ratio, 2),
                 ]
             })
             .collect();
@@ -321,6 +326,7 @@ pub fn table(study: &LateralStudy) -> String {
                 "horiz median 1s (m)",
                 "station corr / sigma",
                 "drilling growth / sigma",
+                "start error / sigma",
             ],
             &rows,
             0,
@@ -488,6 +494,8 @@ pub fn csv(study: &LateralStudy) -> String {
             "station_correction_ratio",
             "station_variance_removed",
             "drilling_growth_ratio",
+            "start_error_ratio",
+            "end_error_ratio",
         ]
         .map(String::from),
     );
@@ -546,6 +554,8 @@ pub fn csv(study: &LateralStudy) -> String {
         fields.push(f(c.station_correction_ratio));
         fields.push(f(c.station_variance_removed));
         fields.push(f(c.drilling_growth_ratio));
+        fields.push(f(c.start_error_ratio));
+        fields.push(f(c.end_error_ratio));
         out.push_str(&(fields.join(",") + "\n"));
     }
     out
