@@ -9,6 +9,7 @@ use host_sim::study::grade;
 use host_sim::study::lateral::{study, DrillingOverrides, StudyConfig, Well};
 use host_sim::study::lateral_covariance::SweepGrid;
 use host_sim::study::lateral_figures::plots;
+use host_sim::study::lateral_stations::stations_csv;
 use host_sim::study::lateral_table::{csv, table};
 use std::path::PathBuf;
 
@@ -77,6 +78,11 @@ pub struct LateralArgs {
     /// Write one row per grade and well here (CSV).
     #[arg(long)]
     pub csv: Option<PathBuf>,
+    /// Write every run's stations here, one row each (CSV: signed
+    /// azimuth and inclination errors with their sigmas, at the station's
+    /// start and end).
+    #[arg(long, value_name = "CSV")]
+    pub stations_csv: Option<PathBuf>,
     /// Directory for the plots (SVG and PNG): error growth along MD per
     /// grade against the predicted sigmas, and the sweep's contour map.
     #[arg(long)]
@@ -166,6 +172,14 @@ pub fn run(args: LateralArgs) -> Result<()> {
     }
     if let Some(path) = &args.csv {
         std::fs::write(path, csv(&result))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.stations_csv {
+        let tables = result
+            .summaries
+            .iter()
+            .map(|s| (s.grade.as_str(), s.well.as_str(), s.station_rows.as_slice()));
+        std::fs::write(path, stations_csv(tables))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(dir) = &args.plots {

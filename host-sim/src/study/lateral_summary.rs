@@ -16,6 +16,7 @@ use super::lateral_consistency::{
     azimuth_consistency, azimuth_consistency_by_station, AzimuthConsistency,
 };
 use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
+use super::lateral_stations::{station_rows, StationRow};
 use super::stats::{median, percentile, rms};
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
@@ -152,6 +153,9 @@ pub struct GradeWellSummary {
     /// The same per second of wall time per thread (lower on a machine
     /// shared with other work).
     pub epochs_per_thread_wall_second: Option<f64>,
+    /// Every run's stations (`--stations-csv`; not in the JSON).
+    #[serde(skip)]
+    pub station_rows: Vec<StationRow>,
 }
 
 /// One station number's values while summarising.
@@ -350,6 +354,7 @@ pub fn summarise(
         .map(|c| s.samples as f64 / c);
     s.epochs_per_thread_wall_second = (s.run_wall_s > 0.0).then(|| s.samples as f64 / s.run_wall_s);
     s.requirement = requirement(&s);
+    s.station_rows = station_rows(results);
     s
 }
 

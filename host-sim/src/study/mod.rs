@@ -9,6 +9,7 @@ pub mod lateral_correlation;
 pub mod lateral_covariance;
 pub mod lateral_figures;
 pub mod lateral_plots;
+pub mod lateral_stations;
 pub mod lateral_summary;
 pub mod lateral_table;
 pub mod owsg;
