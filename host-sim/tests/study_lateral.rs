@@ -161,6 +161,11 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
     assert!(lines[0].ends_with("end_error_ratio"), "{}", lines[0]);
     // the along-MD rows carry the same per station
     assert!(s.along_md.iter().any(|a| a.start_error_ratio.is_some()));
+    // --stations-csv: one row per station of every run
+    let rows = host_sim::study::lateral_stations::stations_csv(
+        [(s.grade.as_str(), s.well.as_str(), s.station_rows.as_slice())].into_iter(),
+    );
+    assert_eq!(rows.lines().count(), 1 + s.stations, "{rows}");
 }
 
 #[test]
