@@ -85,8 +85,10 @@ struct Counted {
     /// The drilling stretch that ended at this station, against its
     /// growth, where the station before it was counted.
     stretch: Option<f64>,
-    /// The error over its sigma at the station's start and end.
-    start: f64,
+    /// The error over its sigma at the station's start (not at the
+    /// window's: that is the alignment's heading, which the tie-in
+    /// replaces) and at its end.
+    start: Option<f64>,
     end: f64,
 }
 
@@ -114,7 +116,7 @@ fn counted<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Vec<Counted> {
                 station: st.survey.station,
                 correction,
                 stretch,
-                start: start.0 / start.1,
+                start: (st.survey.station != WINDOW_STATION).then(|| start.0 / start.1),
                 end: end.0 / end.1,
             });
             previous_end = Some((st.survey.station, end));
@@ -126,7 +128,7 @@ fn counted<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> Vec<Counted> {
 fn consistency_of<'a>(counted: impl Iterator<Item = &'a Counted> + Clone) -> AzimuthConsistency {
     let corrections: Vec<(f64, f64)> = counted.clone().filter_map(|c| c.correction).collect();
     let stretches: Vec<f64> = counted.clone().filter_map(|c| c.stretch).collect();
-    let starts: Vec<f64> = counted.clone().map(|c| c.start).collect();
+    let starts: Vec<f64> = counted.clone().filter_map(|c| c.start).collect();
     let ends: Vec<f64> = counted.map(|c| c.end).collect();
     let ratios: Vec<f64> = corrections.iter().map(|c| c.0).collect();
     let n = corrections.len();
@@ -281,6 +283,10 @@ mod tests {
         assert_eq!(
             by[&1].drilling_stretches, 0,
             "no stretch ends at the window"
+        );
+        assert_eq!(
+            by[&1].start_error_ratio, None,
+            "the window starts from the alignment"
         );
         let stations: usize = by.values().map(|c| c.stations).sum();
         let stretches: usize = by.values().map(|c| c.drilling_stretches).sum();
