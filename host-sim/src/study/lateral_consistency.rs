@@ -4,8 +4,8 @@
 //! Each determined station gives its azimuth error and sigma at its start
 //! (the last solution before its first still sample,
 //! `StationCheck::azimuth_error_before`) and at its end (the station's).
-//! Two normalised quantities follow, each with an RMS of 1 when the
-//! filter's azimuth variance is right:
+//! Normalised quantities follow, each with an RMS of 1 when the filter's
+//! azimuth variance is right:
 //!
 //! * the station's correction, the azimuth estimate's change over it,
 //!   `d = e_start - e_end`, against `s_start^2 - s_end^2`: a Kalman
@@ -17,10 +17,15 @@
 //!   station's end, against `s_start(k)^2 - s_end(k-1)^2`: the filter
 //!   takes no azimuth information while drilling (the constraints' attitude
 //!   rows are dropped, docs/filter-derivation.md 4d), so that growth is
-//!   what its model adds.
+//!   what its model adds. This one is 1 only when the change is
+//!   uncorrelated with the error it starts from: a rate gyrocompass ties
+//!   the heading error to the bias error that then drifts it, and a
+//!   consistent filter scores above 1 (unit test below);
+//! * so also the error over its sigma at each station's start and end,
+//!   which needs no such assumption.
 //!
-//! The window's station (the first) is not counted as a correction: the
-//! tie-in replaces its heading.
+//! The window's station (the first) is not counted as a correction nor
+//! as a start: the tie-in replaces its heading.
 //!
 //! The mean fraction of the azimuth variance a station removes,
 //! `1 - s_end^2 / s_start^2`, says how much the station weighs.
