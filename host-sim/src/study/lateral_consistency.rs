@@ -35,7 +35,7 @@ use super::stats::rms;
 use crate::survey_listing::drilling::azimuth_determined;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 /// The run's first station, at the window: the tie-in replaces its
 /// heading (a survey's, not the station's measurement; before it the
@@ -149,23 +149,23 @@ fn consistency_of<'a>(counted: impl Iterator<Item = &'a Counted> + Clone) -> Azi
     }
 }
 
-/// The consistency over the runs that finished.
-pub fn azimuth_consistency<'a>(runs: impl Iterator<Item = &'a RunOutcome>) -> AzimuthConsistency {
-    consistency_of(counted(runs).iter())
-}
-
-/// The same per station number (the drilling stretch counted at the
-/// station it ends at), in station order: where along the well the sigma
-/// stops holding.
-pub fn azimuth_consistency_by_station<'a>(
+/// The consistency over the runs that finished, in all and per station
+/// number (the drilling stretch counted at the station it ends at, in
+/// station order: where along the well the sigma stops holding), from one
+/// pass over the stations.
+pub fn azimuth_consistency<'a>(
     runs: impl Iterator<Item = &'a RunOutcome>,
-) -> BTreeMap<u16, AzimuthConsistency> {
+) -> (AzimuthConsistency, BTreeMap<u16, AzimuthConsistency>) {
     let all = counted(runs);
-    let numbers: BTreeSet<u16> = all.iter().map(|c| c.station).collect();
-    numbers
+    let mut by_number: BTreeMap<u16, Vec<&Counted>> = BTreeMap::new();
+    for c in &all {
+        by_number.entry(c.station).or_default().push(c);
+    }
+    let by_station = by_number
         .into_iter()
-        .map(|n| (n, consistency_of(all.iter().filter(|c| c.station == n))))
-        .collect()
+        .map(|(n, stations)| (n, consistency_of(stations.into_iter())))
+        .collect();
+    (consistency_of(all.iter()), by_station)
 }
 
 #[cfg(test)]
@@ -226,7 +226,7 @@ mod tests {
     #[test]
     fn a_consistent_filter_scores_one_at_stations_and_between_them() {
         let runs = kalman_runs(3.0, 3.0);
-        let c = azimuth_consistency(runs.iter());
+        let c = azimuth_consistency(runs.iter()).0;
         // station 1 of each run is the window's: not a correction
         assert_eq!(c.stations, 2000);
         assert_eq!(c.drilling_stretches, 2000);
@@ -245,7 +245,7 @@ mod tests {
     fn a_station_measurement_noisier_than_the_filter_is_told_shows_at_the_stations() {
         // The correction's variance is gain^2 (p + r) against the told
         // gain^2 (p + r_told): at the steady prior p = 6, sqrt(12 / 9).
-        let c = azimuth_consistency(kalman_runs(6.0, 3.0).iter());
+        let c = azimuth_consistency(kalman_runs(6.0, 3.0).iter()).0;
         let station = c.station_correction_ratio.unwrap();
         assert!(station > 1.1 && station < 1.3, "{station}");
         let drilling = c.drilling_growth_ratio.unwrap();
@@ -264,13 +264,13 @@ mod tests {
             no_start,
             station(4, (0.3, 0.3), (0.0, 0.1)),
         ])];
-        let c = azimuth_consistency(runs.iter());
+        let c = azimuth_consistency(runs.iter()).0;
         // station 1 is the window's; station 4 is counted
         assert_eq!(c.stations, 1);
         // station 4 follows no counted station 3: no stretch
         assert_eq!(c.drilling_stretches, 0);
         assert_eq!(c.drilling_growth_ratio, None);
-        let empty = azimuth_consistency([].iter());
+        let empty = azimuth_consistency([].iter()).0;
         assert_eq!(empty.station_correction_ratio, None);
         assert_eq!(empty.station_variance_removed, None);
     }
@@ -278,8 +278,7 @@ mod tests {
     #[test]
     fn the_by_station_breakdown_splits_the_same_counts() {
         let runs = kalman_runs(3.0, 3.0);
-        let all = azimuth_consistency(runs.iter());
-        let by = azimuth_consistency_by_station(runs.iter());
+        let (all, by) = azimuth_consistency(runs.iter());
         assert_eq!(
             by.keys().copied().collect::<Vec<_>>(),
             vec![1, 2, 3, 4, 5, 6]
@@ -347,7 +346,7 @@ mod tests {
                 run(stations)
             })
             .collect();
-        let c = azimuth_consistency(runs.iter());
+        let c = azimuth_consistency(runs.iter()).0;
         let growth = c.drilling_growth_ratio.unwrap();
         assert!(growth > 1.15, "{growth}");
         for ratio in [c.start_error_ratio.unwrap(), c.end_error_ratio.unwrap()] {

@@ -12,9 +12,7 @@
 
 use super::drilling_coverage::Fraction;
 use super::drilling_run::RunOutcome;
-use super::lateral_consistency::{
-    azimuth_consistency, azimuth_consistency_by_station, AzimuthConsistency,
-};
+use super::lateral_consistency::{azimuth_consistency, AzimuthConsistency};
 use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::lateral_stations::{station_rows, StationRow};
 use super::stats::{median, percentile, rms};
@@ -329,11 +327,10 @@ pub fn summarise(
     };
     s.azimuth_correlation =
         azimuth_lag_correlations(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
-    s.azimuth_consistency =
+    let by_number;
+    (s.azimuth_consistency, by_number) =
         azimuth_consistency(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
     s.td_unchecked = unchecked.into_iter().collect();
-    let by_number =
-        azimuth_consistency_by_station(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
     s.along_md = by_station
         .iter()
         .map(|(n, t)| {
