@@ -932,8 +932,14 @@ impl<T: FilterScalar> Navigator<T> {
         // One part's gyro alone cannot gyrocompass: not even tried.
         let estimate =
             gyrocompass_possible.then(|| gyrocompass(core::slice::from_ref(segment), &config));
+        // A heading whose mirror candidate explains the data as well is
+        // undetermined however small its sigma: the probe has no prior to
+        // choose with (`AlignmentConfig::probe`), so the lower misfit is a
+        // coin toss. A horizontal tool's cross-axis gyros see only the sine
+        // of its heading, and a quiet grade's 1 deg sigma once went out on
+        // the mirror 60 deg away; the tie-in brings the heading.
         let (heading, heading_std) = match estimate {
-            Some(Ok(h)) if h.determined => (h.heading.value, h.heading.sigma),
+            Some(Ok(h)) if h.determined && !h.ambiguous => (h.heading.value, h.heading.sigma),
             Some(Ok(h)) => (h.heading.value, f64::INFINITY),
             Some(Err(_)) | None => (0.0, f64::INFINITY),
         };
@@ -1261,3 +1267,7 @@ mod tests;
 #[cfg(test)]
 #[path = "navigator_slide_tests.rs"]
 mod slide_tests;
+
+#[cfg(test)]
+#[path = "navigator_heading_tests.rs"]
+mod heading_tests;

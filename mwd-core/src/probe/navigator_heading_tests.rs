@@ -1,0 +1,76 @@
+//! The coarse heading the probe sends before a tie-in: a horizontal
+//! tool's mirror heading is never sent as a determined azimuth, and an
+//! inclined tool, whose gyros tell the two apart, still gets its azimuth.
+
+use super::*;
+extern crate std;
+use crate::conventions::{dcm_from_euler, Euler};
+use crate::earth::earth_rate_n;
+use crate::sensor_units::STANDARD_GRAVITY;
+use crate::timing::sample_time_us;
+
+use super::super::test_support::{quieter_gyros, ALL_ALIGNMENT};
+
+/// A GE-2020-like gyro budget: the SCC1300's gyro errors 300 times smaller.
+static QUIET: ImuNoise = quieter_gyros(300.0);
+
+/// Sample `n` of a still tool at `attitude` at the paper's site, error
+/// free: the earth's rate and gravity's reaction in body axes.
+fn still(n: u32, attitude: &Euler) -> (u64, u32, ProbeSample) {
+    let c_nb = dcm_from_euler(attitude).transpose();
+    let rate = c_nb * earth_rate_n(Position::paper_site().lat);
+    let force = c_nb * Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
+    (
+        sample_time_us(n),
+        n,
+        ProbeSample::new(rate.x, rate.z, force),
+    )
+}
+
+/// The frames a quiet navigator sends still at `attitude` through its
+/// alignment and 10 s of navigation: the last coarse one and the rest.
+fn frames(attitude: &Euler) -> std::vec::Vec<NavSolution> {
+    let mut navigator =
+        Navigator::<f64>::calibrated(Position::paper_site(), ProbeCalibration::default());
+    navigator.set_noise_budget(&QUIET);
+    let mut sent = std::vec::Vec::new();
+    for n in 0..ALL_ALIGNMENT + 200 {
+        let (time, counter, s) = still(n, attitude);
+        let frame = navigator.step_sample(time, counter, &s);
+        if frame.mode != nav_mode::COARSE_ALIGNMENT {
+            sent.push(frame);
+        }
+    }
+    assert!(navigator.is_navigating());
+    sent
+}
+
+/// A horizontal tool heading 60 deg: its cross-axis gyros see the sine
+/// of the heading, which 120 deg shares, and the data cannot choose.
+/// Before the mend the quiet grade's coarse gyrocompass sent the lower
+/// misfit's candidate under a sigma of about a degree.
+#[test]
+fn a_horizontal_tools_mirror_heading_is_sent_as_undetermined() {
+    let heading = 60f64.to_radians();
+    let sent = frames(&Euler::new(0.0, 0.0, heading));
+    for frame in &sent {
+        assert!(frame.attitude_std[2].is_infinite(), "{frame:?}");
+        // The tilt is the levelling's, and known.
+        assert!(frame.attitude_std[..2].iter().all(|s| s.is_finite()));
+    }
+}
+
+/// The same heading with the tool 30 deg below horizontal (inclination
+/// 60 deg): the upper gyro sees the tool-axis earth rate's projection,
+/// which tells 60 deg from 120 deg, so the azimuth is determined and its
+/// error lies inside its sigma's bound.
+#[test]
+fn an_inclined_tools_heading_is_determined_and_inside_its_bound() {
+    let heading = 60f64.to_radians();
+    let sent = frames(&Euler::new(0.0, -30f64.to_radians(), heading));
+    let last = sent.last().expect("frames were sent");
+    let sigma = f64::from(last.attitude_std[2]);
+    assert!(sigma.is_finite() && sigma < 5f64.to_radians(), "{last:?}");
+    let error = crate::conventions::wrap_pi(f64::from(last.attitude[2]) - heading);
+    assert!(error.abs() < 3.0 * sigma, "error {error}, sigma {sigma}");
+}
