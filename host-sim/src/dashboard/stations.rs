@@ -3,7 +3,6 @@
 //! (the pairing and positioning of `host-sim survey CAPTURE --depth`,
 //! `survey_listing::drilling`), for the plan view and the vertical section.
 
-use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::StationSurvey;
 use serde_json::{json, Value};
 
@@ -68,7 +67,7 @@ fn station_row(s: &StationSurvey) -> Value {
         "inclination": display::angle_with_sigma(inc.to_degrees(), s_inc),
         "azimuth": display::station_azimuth_text(s),
         "toolface": display::angle_with_sigma(tf_deg, s_tf),
-        "invalid": s.flags & station_flags::SOLUTION_INVALID != 0,
+        "invalid": !drilling::station_valid(s),
         "md": Value::Null,
         "position": "no depth log",
     })

@@ -7,6 +7,7 @@
 
 use super::drilling_run::{run, RunConfig, RunOutcome};
 use super::stats::{median, rms};
+use crate::survey_listing::drilling::station_valid;
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -119,10 +120,7 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
         for st in &o.stations {
             s.stations += 1;
             let sd = st.survey.angles_std.map(f64::from);
-            if st.survey.flags & station_flags::SOLUTION_INVALID != 0
-                || !sd[0].is_finite()
-                || !sd[2].is_finite()
-            {
+            if !station_valid(&st.survey) || !sd[0].is_finite() || !sd[2].is_finite() {
                 s.invalid_stations += 1;
                 continue;
             }

@@ -32,8 +32,7 @@
 
 use super::drilling_run::{RunOutcome, StationCheck};
 use super::stats::rms;
-use crate::survey_listing::drilling::azimuth_determined;
-use mwd_core::protocol::frame::station_flags;
+use crate::survey_listing::drilling::azimuth_usable;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -70,8 +69,7 @@ pub struct AzimuthConsistency {
 
 /// (error, sigma) at a determined station's start and end, rad.
 fn start_and_end(st: &StationCheck) -> Option<((f64, f64), (f64, f64))> {
-    let valid =
-        st.survey.flags & station_flags::SOLUTION_INVALID == 0 && azimuth_determined(&st.survey);
+    let valid = azimuth_usable(&st.survey);
     let end = (st.error[1], f64::from(st.survey.angles_std[1]));
     let start = (st.azimuth_error_before?, st.azimuth_sigma_before?);
     let finite = [start.0, start.1, end.0, end.1]
@@ -171,6 +169,7 @@ pub fn azimuth_consistency<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mwd_core::protocol::frame::station_flags;
     use mwd_core::protocol::StationSurvey;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;

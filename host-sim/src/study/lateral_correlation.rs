@@ -20,8 +20,7 @@
 
 use super::drilling_run::RunOutcome;
 use crate::survey_error::probe_station::{azimuth_chain_correlations, links_in_order, AngleSigma};
-use crate::survey_listing::drilling::azimuth_determined;
-use mwd_core::protocol::frame::station_flags;
+use crate::survey_listing::drilling::azimuth_usable;
 use serde::Serialize;
 
 /// The station distances the study reports.
@@ -44,10 +43,7 @@ fn determined(o: &RunOutcome) -> Vec<(f64, AngleSigma)> {
         .stations
         .iter()
         .filter(|st| {
-            st.survey.flags & station_flags::SOLUTION_INVALID == 0
-                && azimuth_determined(&st.survey)
-                && st.survey.angles_std[1] > 0.0
-                && st.error[1].is_finite()
+            azimuth_usable(&st.survey) && st.survey.angles_std[1] > 0.0 && st.error[1].is_finite()
         })
         .collect();
     let numbered: Vec<_> = kept.iter().map(|st| (st.survey.station, st.link)).collect();
@@ -114,6 +110,7 @@ pub fn azimuth_lag_correlations<'a>(
 mod tests {
     use super::*;
     use crate::study::drilling_run::StationCheck;
+    use mwd_core::protocol::frame::station_flags;
     use mwd_core::protocol::StationSurvey;
 
     fn station(number: u16, error: f64, sigma: f32, before: Option<f64>) -> StationCheck {

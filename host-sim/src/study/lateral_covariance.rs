@@ -11,6 +11,7 @@ use super::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
 use super::grade::Grade;
 use super::lateral_summary::GradeWellSummary;
 use super::stats::rms;
+use crate::survey_listing::drilling::station_valid;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
 
@@ -52,7 +53,7 @@ impl CovariancePrediction {
         let mut along_md = Vec::new();
         for st in &o.stations {
             let sd = st.survey.angles_std.map(f64::from);
-            if st.survey.flags & station_flags::SOLUTION_INVALID != 0 || !sd[0].is_finite() {
+            if !station_valid(&st.survey) || !sd[0].is_finite() {
                 continue;
             }
             inc.push(sd[0].to_degrees());

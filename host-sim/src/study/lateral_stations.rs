@@ -4,8 +4,7 @@
 //! holding, a run that went astray).
 
 use super::drilling_run::RunOutcome;
-use crate::survey_listing::drilling::azimuth_determined;
-use mwd_core::protocol::frame::station_flags;
+use crate::survey_listing::drilling::{azimuth_determined, station_valid};
 
 /// One station of one run; angles in degrees, errors signed (estimate
 /// less truth, wrapped). Undetermined or invalid values are empty fields
@@ -39,7 +38,7 @@ pub fn station_rows(results: &[(u64, Result<RunOutcome, String>)]) -> Vec<Statio
                 seed: *seed,
                 station: s.station,
                 truth_md_m: st.truth_md,
-                valid: s.flags & station_flags::SOLUTION_INVALID == 0,
+                valid: station_valid(s),
                 azimuth_determined: azimuth_determined(s),
                 azimuth_deg: deg(f64::from(s.angles[1])),
                 azimuth_error_deg: deg(st.error[1]),
@@ -97,6 +96,7 @@ pub fn stations_csv<'a>(
 mod tests {
     use super::*;
     use crate::study::drilling_run::StationCheck;
+    use mwd_core::protocol::frame::station_flags;
     use mwd_core::protocol::StationSurvey;
 
     fn check(number: u16, flags: u16) -> StationCheck {

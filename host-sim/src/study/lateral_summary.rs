@@ -16,6 +16,7 @@ use super::lateral_consistency::{azimuth_consistency, AzimuthConsistency};
 use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::lateral_stations::{station_rows, StationRow};
 use super::stats::{median, percentile, rms};
+use crate::survey_listing::drilling::station_valid;
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -246,7 +247,7 @@ pub fn summarise(
                 s.motion_seen_stations += 1;
             }
             let sd = st.survey.angles_std.map(f64::from);
-            if st.survey.flags & station_flags::SOLUTION_INVALID != 0 || !sd[0].is_finite() {
+            if !station_valid(&st.survey) || !sd[0].is_finite() {
                 s.invalid_stations += 1;
                 continue;
             }

@@ -21,12 +21,12 @@ use super::drilling_coverage::Fraction;
 use super::drilling_run::{raw, tie_in};
 use super::stats::{percentile, rms};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
+use crate::survey_listing::drilling::azimuth_usable;
 use anyhow::Result;
 use mwd_core::conventions::{dcm_from_quat, wrap_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;
 use mwd_core::probe::station::{angle_uncertainty, angles_and_jacobian};
 use mwd_core::probe::Navigator;
-use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::StationSurvey;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use rand::SeedableRng;
@@ -122,9 +122,7 @@ pub struct PairOutcome {
 
 fn station_check(survey: &StationSurvey, truth_azimuth: f64) -> AzimuthCheck {
     let sigma = f64::from(survey.angles_std[1]);
-    let determined =
-        survey.flags & (station_flags::AZIMUTH_UNDETERMINED | station_flags::SOLUTION_INVALID) == 0
-            && sigma.is_finite();
+    let determined = azimuth_usable(survey);
     AzimuthCheck {
         error: wrap_pi(f64::from(survey.angles[1]) - truth_azimuth),
         sigma: determined.then_some(sigma),

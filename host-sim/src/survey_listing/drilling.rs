@@ -173,9 +173,21 @@ pub(crate) fn azimuth_determined(s: &StationSurvey) -> bool {
     s.flags & station_flags::AZIMUTH_UNDETERMINED == 0 && s.angles_std[1].is_finite()
 }
 
+/// The probe did not mark the station invalid (its tilt sigma held, the
+/// covariance kept its meaning).
+pub(crate) fn station_valid(s: &StationSurvey) -> bool {
+    s.flags & station_flags::SOLUTION_INVALID == 0
+}
+
+/// A valid station with a determined azimuth: the stations whose azimuth
+/// the survey and the studies use.
+pub(crate) fn azimuth_usable(s: &StationSurvey) -> bool {
+    station_valid(s) && azimuth_determined(s)
+}
+
 /// Why a station cannot be used at all, if so.
 fn unusable(s: &StationSurvey) -> Option<&'static str> {
-    if s.flags & station_flags::SOLUTION_INVALID != 0 {
+    if !station_valid(s) {
         return Some("the probe marked it invalid");
     }
     let inc_ok = s.angles[0].is_finite() && s.angles_std[0].is_finite();
