@@ -1,6 +1,7 @@
 //! The coarse heading the probe sends before a tie-in: a horizontal
 //! tool's mirror heading is never sent as a determined azimuth, and an
-//! inclined tool, whose gyros tell the two apart, still gets its azimuth.
+//! inclined tool, whose gyros tell the two apart, still gets its azimuth;
+//! the tie-in then gives the horizontal tool its azimuth.
 
 use super::*;
 extern crate std;
@@ -27,9 +28,9 @@ fn still(n: u32, attitude: &Euler) -> (u64, u32, ProbeSample) {
     )
 }
 
-/// The frames a quiet navigator sends still at `attitude` through its
-/// alignment and 10 s of navigation: the last coarse one and the rest.
-fn frames(attitude: &Euler) -> std::vec::Vec<NavSolution> {
+/// A quiet navigator still at `attitude` through its alignment and 10 s
+/// of navigation, with the frames it sent after the coarse alignment.
+fn aligned(attitude: &Euler) -> (Navigator<f64>, std::vec::Vec<NavSolution>) {
     let mut navigator =
         Navigator::<f64>::calibrated(Position::paper_site(), ProbeCalibration::default());
     navigator.set_noise_budget(&QUIET);
@@ -42,7 +43,12 @@ fn frames(attitude: &Euler) -> std::vec::Vec<NavSolution> {
         }
     }
     assert!(navigator.is_navigating());
-    sent
+    (navigator, sent)
+}
+
+/// The frames of [`aligned`].
+fn frames(attitude: &Euler) -> std::vec::Vec<NavSolution> {
+    aligned(attitude).1
 }
 
 /// A horizontal tool heading 60 deg: its cross-axis gyros see the sine
@@ -73,4 +79,35 @@ fn an_inclined_tools_heading_is_determined_and_inside_its_bound() {
     assert!(sigma.is_finite() && sigma < 5f64.to_radians(), "{last:?}");
     let error = crate::conventions::wrap_pi(f64::from(last.attitude[2]) - heading);
     assert!(error.abs() < 3.0 * sigma, "error {error}, sigma {sigma}");
+}
+
+/// The tie-in (the parent well's survey) chooses: the horizontal tool's
+/// azimuth is determined from then on, at the tie-in's sigma.
+#[test]
+fn after_the_tie_in_the_horizontal_tools_heading_is_determined() {
+    let heading = 60f64.to_radians();
+    let attitude = Euler::new(0.0, 0.0, heading);
+    let (mut navigator, _) = aligned(&attitude);
+    let sigma = 0.5f64.to_radians();
+    let tie_in = TieIn::new(
+        crate::conventions::DrillingAngles::from_euler(&attitude),
+        crate::conventions::DrillingAngles {
+            inclination: 0.1f64.to_radians(),
+            azimuth: sigma,
+            toolface: 1f64.to_radians(),
+        },
+    )
+    .expect("a valid tie-in");
+    navigator.start_from_tie_in(&tie_in);
+    let start = ALL_ALIGNMENT + 200;
+    let mut last = None;
+    for n in start..start + 200 {
+        let (time, counter, s) = still(n, &attitude);
+        last = Some(navigator.step_sample(time, counter, &s));
+    }
+    let last = last.expect("samples were stepped");
+    let got = f64::from(last.attitude_std[2]);
+    assert!(got.is_finite() && got <= 1.01 * sigma, "{last:?}");
+    let error = crate::conventions::wrap_pi(f64::from(last.attitude[2]) - heading);
+    assert!(error.abs() < 3.0 * got, "error {error}, sigma {got}");
 }
