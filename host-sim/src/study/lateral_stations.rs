@@ -4,6 +4,7 @@
 //! holding, a run that went astray).
 
 use super::drilling_run::RunOutcome;
+use super::lateral_table::csv_field;
 use crate::survey_listing::drilling::{azimuth_determined, station_valid};
 
 /// One station of one run; angles in degrees, errors signed (estimate
@@ -71,8 +72,8 @@ pub fn stations_csv<'a>(
             let azimuth = |v: f64| (r.valid && r.azimuth_determined).then_some(v);
             let inclination = |v: f64| r.valid.then_some(v);
             let fields = [
-                grade.to_string(),
-                well.to_string(),
+                csv_field(grade),
+                csv_field(well),
                 r.seed.to_string(),
                 r.station.to_string(),
                 format!("{:.3}", r.truth_md_m),
@@ -147,5 +148,12 @@ mod tests {
         let second: Vec<&str> = lines[2].split(',').collect();
         assert_eq!((second[7], second[8], second[9]), ("", "", ""));
         assert!(!second[12].is_empty(), "the inclination is still known");
+        // a grade file's name with a comma stays one field (RFC 4180)
+        let quoted = stations_csv([("lab, bench", "100m", &rows[..1])].into_iter());
+        assert!(quoted
+            .lines()
+            .nth(1)
+            .unwrap()
+            .starts_with("\"lab, bench\",100m,7,"));
     }
 }

@@ -562,7 +562,7 @@ pub fn csv(study: &LateralStudy) -> String {
 }
 
 /// A text field quoted when it holds a comma, quote or line break (RFC 4180).
-fn csv_field(text: &str) -> String {
+pub(crate) fn csv_field(text: &str) -> String {
     if text.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", text.replace('"', "\"\""))
     } else {
