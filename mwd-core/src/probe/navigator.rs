@@ -58,7 +58,9 @@ use crate::aid_sources::{
     AxialSpeed, DrillingToolface, ForceBlock, NonHolonomic, AXIAL_SPEED_VARIANCE,
     DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
 };
-use crate::alignment::{gyrocompass, level_segment, AlignmentConfig, SegmentSums, StaticSegment};
+use crate::alignment::{
+    gyrocompass, level_segment, AlignmentConfig, HeadingEstimate, SegmentSums, StaticSegment,
+};
 use crate::attitude::ToolAxisRate;
 use crate::calibration::ProbeCalibration;
 use crate::conventions::{
@@ -933,13 +935,15 @@ impl<T: FilterScalar> Navigator<T> {
         let estimate =
             gyrocompass_possible.then(|| gyrocompass(core::slice::from_ref(segment), &config));
         // A heading whose mirror candidate explains the data as well is
-        // undetermined however small its sigma: the probe has no prior to
-        // choose with (`AlignmentConfig::probe`), so the lower misfit is a
-        // coin toss. A horizontal tool's cross-axis gyros see only the sine
-        // of its heading, and a quiet grade's 1 deg sigma once went out on
-        // the mirror 60 deg away; the tie-in brings the heading.
+        // undetermined however small its sigma unless a prior chose it
+        // (`ambiguous` stays set when one did); the probe has none
+        // (`AlignmentConfig::probe`), so the lower misfit is a coin toss.
+        // A horizontal tool's cross-axis gyros see only the sine of its
+        // heading, and a quiet grade's 1 deg sigma once went out on the
+        // mirror 60 deg away; the tie-in brings the heading.
+        let unchosen = |h: &HeadingEstimate| h.ambiguous && config.heading_prior.is_none();
         let (heading, heading_std) = match estimate {
-            Some(Ok(h)) if h.determined && !h.ambiguous => (h.heading.value, h.heading.sigma),
+            Some(Ok(h)) if h.determined && !unchosen(&h) => (h.heading.value, h.heading.sigma),
             Some(Ok(h)) => (h.heading.value, f64::INFINITY),
             Some(Err(_)) | None => (0.0, f64::INFINITY),
         };
