@@ -5,27 +5,17 @@
 
 use super::*;
 extern crate std;
-use crate::conventions::{dcm_from_euler, Euler};
-use crate::earth::earth_rate_n;
-use crate::sensor_units::STANDARD_GRAVITY;
-use crate::timing::sample_time_us;
+use crate::conventions::Euler;
 
-use super::super::test_support::{quieter_gyros, ALL_ALIGNMENT};
+use super::super::test_support::{earth_rate_sample, quieter_gyros, ALL_ALIGNMENT};
 
 /// A GE-2020-like gyro budget: the SCC1300's gyro errors 300 times smaller.
 static QUIET: ImuNoise = quieter_gyros(300.0);
 
 /// Sample `n` of a still tool at `attitude` at the paper's site, error
-/// free: the earth's rate and gravity's reaction in body axes.
+/// free.
 fn still(n: u32, attitude: &Euler) -> (u64, u32, ProbeSample) {
-    let c_nb = dcm_from_euler(attitude).transpose();
-    let rate = c_nb * earth_rate_n(Position::paper_site().lat);
-    let force = c_nb * Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
-    (
-        sample_time_us(n),
-        n,
-        ProbeSample::new(rate.x, rate.z, force),
-    )
+    earth_rate_sample(n, attitude, Vector3::zeros())
 }
 
 /// A quiet navigator still at `attitude` through its alignment and 10 s

@@ -7,32 +7,20 @@
 use super::*;
 use crate::protocol::frame::station_flags;
 extern crate std;
-use crate::conventions::{dcm_from_euler, Euler};
-use crate::earth::earth_rate_n;
-use crate::sensor_units::STANDARD_GRAVITY;
-use crate::timing::sample_time_us;
+use crate::conventions::Euler;
 
-use super::super::test_support::{level_sample, quieter_gyros, ALL_ALIGNMENT};
+use super::super::test_support::{earth_rate_sample, level_sample, quieter_gyros, ALL_ALIGNMENT};
 
 /// A GE-2020-like gyro budget (the SCC1300's gyro noise and biases 300
 /// times smaller): its block means see a turn of a few deg/h.
 static QUIET: ImuNoise = quieter_gyros(300.0);
 
 /// Sample `n` of a level tool heading 60 deg at the paper's site, error
-/// free and at full resolution, turning about the vertical at `turn_deg_h`
-/// on top of the earth's rate (over the minutes of a test the heading
-/// change, under 1 deg, is left out of the earth rate's projection).
+/// free, turning about the vertical at `turn_deg_h` on top of the
+/// earth's rate.
 fn sample(n: u32, turn_deg_h: f64) -> (u64, u32, ProbeSample) {
-    let c_bn = dcm_from_euler(&Euler::new(0.0, 0.0, 60f64.to_radians()));
-    let c_nb = c_bn.transpose();
     let turn = Vector3::new(0.0, 0.0, turn_deg_h.to_radians() / 3600.0);
-    let rate = c_nb * (earth_rate_n(Position::paper_site().lat) + turn);
-    let force = c_nb * Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
-    (
-        sample_time_us(n),
-        n,
-        ProbeSample::new(rate.x, rate.z, force),
-    )
+    earth_rate_sample(n, &Euler::new(0.0, 0.0, 60f64.to_radians()), turn)
 }
 
 /// Runs a quiet navigator still through its alignment and `still` more

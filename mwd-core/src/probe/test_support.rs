@@ -1,14 +1,18 @@
 //! Helpers for the probe's unit tests (compiled for tests only).
 
 use super::Navigator;
-use crate::earth::Position;
+use crate::conventions::{dcm_from_euler, Euler};
+use crate::earth::{earth_rate_n, Position};
+use crate::probe_sample::ProbeSample;
 use crate::protocol::frame::raw_flags;
 use crate::protocol::{RawPart, RawSample};
 use crate::sensor_noise::ImuNoise;
 use crate::sensor_units::{
-    m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2,
+    m_s2_to_accel_count, rad_s_to_gyro_count, PART_MOUNTINGS, STANDARD_GRAVITY,
+    STANDARD_GRAVITY_M_S2,
 };
-use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES};
+use crate::timing::{sample_time_us, ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES};
+use nalgebra::Vector3;
 
 /// Samples from power-on to the end of the fine alignment.
 pub(crate) const ALL_ALIGNMENT: u32 = ALIGNMENT_SAMPLES + FINE_ALIGNMENT_SAMPLES;
@@ -47,6 +51,26 @@ pub(crate) fn level_turning_sample(n: u32, deg_s: f32) -> RawSample {
         n,
         [0.0, 0.0, STANDARD_GRAVITY_M_S2],
         [0.0, 0.0, deg_s.to_radians()],
+    )
+}
+
+/// Sample `n` (time, counter, calibrated sample) of an error-free tool at
+/// `attitude` at the paper's site, at full resolution: the earth's rate
+/// plus `turn_n` (NED, rad/s) and gravity's reaction, in body axes (over
+/// the minutes of a test a turn's heading change is left out of the
+/// earth rate's projection).
+pub(crate) fn earth_rate_sample(
+    n: u32,
+    attitude: &Euler,
+    turn_n: Vector3<f64>,
+) -> (u64, u32, ProbeSample) {
+    let c_nb = dcm_from_euler(attitude).transpose();
+    let rate = c_nb * (earth_rate_n(Position::paper_site().lat) + turn_n);
+    let force = c_nb * Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
+    (
+        sample_time_us(n),
+        n,
+        ProbeSample::new(rate.x, rate.z, force),
     )
 }
 
