@@ -1208,7 +1208,10 @@ impl<T: FilterScalar> Navigator<T> {
     /// at the current solution (`aid_sources::HeadingReference`: the probe
     /// as the backup of a reference heading, docs/redundant-rins.md); call
     /// it between steps. Only while navigating with a valid covariance;
-    /// `None` then, or for a reference the source refuses.
+    /// `None` then, or for a reference the source refuses. A heading lost
+    /// past the first-order limit stays undetermined after it: unlike a
+    /// tie-in, a reference does not restart the filter, whose gyro-bias
+    /// estimates were learned at the lost heading (`note_heading_loss`).
     pub fn aid_heading(&mut self, azimuth: f64, sigma: f64) -> Option<UpdateReport> {
         if !self.is_navigating() || self.covariance_invalid {
             return None;
