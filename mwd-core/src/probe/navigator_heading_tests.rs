@@ -26,14 +26,8 @@ fn aligned(attitude: &Euler) -> (Navigator<f64>, std::vec::Vec<NavSolution>) {
     let mut navigator =
         Navigator::<f64>::calibrated(Position::paper_site(), ProbeCalibration::default());
     navigator.set_noise_budget(&QUIET);
-    let mut sent = std::vec::Vec::new();
-    for n in 0..ALL_ALIGNMENT + 200 {
-        let (time, counter, s) = still(n, attitude);
-        let frame = navigator.step_sample(time, counter, &s);
-        if frame.mode != nav_mode::COARSE_ALIGNMENT {
-            sent.push(frame);
-        }
-    }
+    let mut sent = step_still(&mut navigator, attitude, 0, ALL_ALIGNMENT + 200);
+    sent.retain(|frame| frame.mode != nav_mode::COARSE_ALIGNMENT);
     assert!(navigator.is_navigating());
     (navigator, sent)
 }
