@@ -1062,7 +1062,10 @@ pub fn predict_holding_axis<T: FilterScalar, const N: usize>(
     // e w^T: Phi G in `predict`, then the held rows less t (w^T G).
     let mut wg = [T::zero(); SNAPSHOTS * LINKED];
     for (wgc, column) in wg.iter_mut().zip(filter.cross.columns_mut()) {
+        // (w's slice, not nalgebra's strided iterator: the same sum in the
+        // same order, without a stride per element)
         *wgc = w
+            .as_slice()
             .iter()
             .zip(column.iter())
             .fold(T::zero(), |acc, (a, b)| acc + *a * *b);

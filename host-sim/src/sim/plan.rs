@@ -9,7 +9,7 @@ use anyhow::{bail, ensure, Context, Result};
 use mwd_core::conventions::{wrap_two_pi, DEG};
 use mwd_core::earth::Position;
 use mwd_core::survey::{
-    dogleg, interpolate, positions, tangent, Segment, SurveyPoint, TieOn, TrueNorth, TrueStation,
+    dogleg, interpolate, positions, Segment, SurveyPoint, TieOn, TrueNorth, TrueStation,
 };
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -352,6 +352,45 @@ pub struct BuiltPlan {
     pub points: Vec<SurveyPoint<TrueNorth>>,
     pub sections: Vec<BuiltSection>,
     pub drilling: DrillingParams,
+    /// Each section's arc, computed once from `stations` by `build`.
+    arcs: Vec<SectionArc>,
+}
+
+/// A section's minimum-curvature arc with its curvature (rad/m) and unit
+/// bending axis (NED; zero on a straight hold): computed once per plan, as
+/// a simulated run reads the plan twice per sample (each arc's dogleg and
+/// tangents cost a dozen transcendental calls).
+#[derive(Clone, Copy, Debug)]
+struct SectionArc {
+    /// `None` if the stations form no segment (`build` rules it out).
+    segment: Option<Segment<TrueNorth>>,
+    curvature: f64,
+    axis: Vector3<f64>,
+}
+
+impl SectionArc {
+    fn new(from: TrueStation, to: TrueStation) -> Self {
+        match Segment::new(from, to) {
+            Ok(segment) => {
+                let cross = segment.start_tangent().cross(&segment.end_tangent());
+                let axis = if cross.norm() > 0.0 {
+                    cross / cross.norm()
+                } else {
+                    Vector3::zeros()
+                };
+                SectionArc {
+                    segment: Some(segment),
+                    curvature: segment.dogleg() / segment.length(),
+                    axis,
+                }
+            }
+            Err(_) => SectionArc {
+                segment: None,
+                curvature: 0.0,
+                axis: Vector3::zeros(),
+            },
+        }
+    }
 }
 
 /// A point of the planned hole at some MD: direction, position, the arc's
@@ -511,6 +550,10 @@ impl Plan {
         let points = positions(&tie_on, &stations)
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| anyhow::anyhow!("the plan's stations: {e}"))?;
+        let arcs = stations
+            .windows(2)
+            .map(|pair| SectionArc::new(pair[0], pair[1]))
+            .collect();
         let built = BuiltPlan {
             site: Position::from_degrees(s.latitude_deg, s.longitude_deg, s.height_m),
             tie_on,
@@ -518,6 +561,7 @@ impl Plan {
             points,
             sections,
             drilling: self.drilling,
+            arcs,
         };
         built.check_depth_log_monotone()?;
         Ok(built)
@@ -591,25 +635,14 @@ impl BuiltPlan {
     pub fn at_in_section(&self, md: f64, k: usize) -> PathPoint {
         let k = k.min(self.sections.len() - 1);
         let md = md.clamp(self.sections[k].start_md, self.sections[k].end_md);
-        let (from, to) = (self.stations[k], self.stations[k + 1]);
+        let from = self.stations[k];
         let base = self.points[k].nev;
-        // Stations of a built plan always form a segment; fall back to the
-        // start station if not (cannot happen: checked in `build`).
-        let (station, chord, curvature, axis) = match Segment::new(from, to) {
-            Ok(seg) => {
-                let (station, chord) = seg.at(md).unwrap_or((from, Vector3::zeros()));
-                let t1 = tangent(from.inclination(), from.azimuth());
-                let t2 = tangent(to.inclination(), to.azimuth());
-                let cross = t1.cross(&t2);
-                let axis = if cross.norm() > 0.0 {
-                    cross / cross.norm()
-                } else {
-                    Vector3::zeros()
-                };
-                (station, chord, seg.dogleg() / seg.length(), axis)
-            }
-            Err(_) => (from, Vector3::zeros(), 0.0, Vector3::zeros()),
-        };
+        let arc = &self.arcs[k];
+        let (station, chord) = arc
+            .segment
+            .and_then(|seg| seg.at(md).ok())
+            .unwrap_or((from, Vector3::zeros()));
+        let (curvature, axis) = (arc.curvature, arc.axis);
         PathPoint {
             md,
             inclination: station.inclination(),

@@ -80,6 +80,10 @@ pub struct Segment<N: NorthReference> {
     from: Station<N>,
     to: Station<N>,
     dogleg: f64,
+    /// The unit tangents at `from` and `to`, computed once: a simulated
+    /// hole reads its plan's arcs twice per sample.
+    start_tangent: Vector3<f64>,
+    end_tangent: Vector3<f64>,
 }
 
 impl<N: NorthReference> Segment<N> {
@@ -105,6 +109,8 @@ impl<N: NorthReference> Segment<N> {
             from,
             to,
             dogleg: beta,
+            start_tangent: tangent(from.inclination(), from.azimuth()),
+            end_tangent: tangent(to.inclination(), to.azimuth()),
         })
     }
 
@@ -179,12 +185,14 @@ impl<N: NorthReference> Segment<N> {
         ))
     }
 
-    fn start_tangent(&self) -> Vector3<f64> {
-        tangent(self.from.inclination(), self.from.azimuth())
+    /// The unit tangent at `from` (north, east, down).
+    pub fn start_tangent(&self) -> Vector3<f64> {
+        self.start_tangent
     }
 
-    fn end_tangent(&self) -> Vector3<f64> {
-        tangent(self.to.inclination(), self.to.azimuth())
+    /// The unit tangent at `to`.
+    pub fn end_tangent(&self) -> Vector3<f64> {
+        self.end_tangent
     }
 
     /// Chord of an arc of `length` and dogleg `beta` from `from`'s direction
