@@ -54,14 +54,22 @@ pub fn angle_with_sigma(value_deg: f64, sigma_rad: f64) -> String {
 }
 
 /// A station's azimuth for people: "undetermined" when its flag or its
-/// sigma says so (`azimuth_text`'s rule plus the flag).
+/// sigma says so (`azimuth_text`'s rule plus the flag), with the reason
+/// when the heading was lost since the last tie-in (only a new one brings
+/// it back, unlike a heading the alignment has not found yet).
 pub fn station_azimuth_text(s: &StationSurvey) -> String {
-    if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
+    if s.flags & station_flags::HEADING_LOST != 0 {
+        HEADING_LOST_TEXT.to_string()
+    } else if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
         "undetermined".to_string()
     } else {
         azimuth_text(f64::from(s.angles[1]), f64::from(s.angles_std[1]), 3)
     }
 }
+
+/// An azimuth whose heading was lost since the last tie-in (station and
+/// navigation bit 8).
+pub const HEADING_LOST_TEXT: &str = "undetermined (heading lost: needs a tie-in)";
 
 /// One station survey for people: number, span, the three drilling angles
 /// with their 1-sigma (azimuth "undetermined" when its sigma or flag says
@@ -80,6 +88,7 @@ pub fn station_text(s: &StationSurvey) -> String {
         (station_flags::REQUESTED, "requested"),
         (station_flags::INDEXING_DWELL, "indexing dwell"),
         (station_flags::MOTION_SEEN, "gyros saw it turn"),
+        (station_flags::HEADING_LOST, "heading lost"),
     ];
     let flags: Vec<&str> = names
         .iter()
@@ -191,5 +200,18 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("inc-azi n/a"), "{text}");
+        assert!(!text.contains("heading lost"), "{text}");
+        // Lost since the last tie-in: the reason comes with the word.
+        s.flags |= station_flags::HEADING_LOST;
+        let text = station_text(&s);
+        assert!(
+            text.contains(&format!("azimuth {HEADING_LOST_TEXT}")) && !text.contains("120.0"),
+            "{text}"
+        );
+        assert!(
+            text.contains("; magnetic-free, azimuth undetermined"),
+            "{text}"
+        );
+        assert!(text.ends_with(", heading lost"), "{text}");
     }
 }

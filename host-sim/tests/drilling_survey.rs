@@ -137,6 +137,15 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     assert_eq!(lines.len(), 1, "{text}");
     assert!(lines[0].contains("position undetermined"), "{text}");
     assert!(text.contains("undetermined from station 3"), "{text}");
+    assert!(!text.contains("lost its heading"), "{text}");
+    // a heading lost since the tie-in (not merely never found) says so
+    stations[2].flags |= station_flags::HEADING_LOST;
+    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
+    let text = listing(&out, 0.95);
+    assert!(
+        text.contains("lost its heading at station 3 (MD 1020.00 m)"),
+        "{text}"
+    );
     // an invalid station is skipped, with its reason
     stations[1].flags |= station_flags::SOLUTION_INVALID;
     let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();

@@ -45,7 +45,8 @@ function apply(update) {
 
 function showAngle(id, text) {
   setText(id, text);
-  $(id).className = text === "undetermined" ? "undetermined" : text === "n/a" ? "invalid" : "";
+  // "undetermined" may carry its reason: "undetermined (heading lost ...)"
+  $(id).className = text.startsWith("undetermined") ? "undetermined" : text === "n/a" ? "invalid" : "";
 }
 
 function showState(rest) {
@@ -98,7 +99,7 @@ function showStations(st) {
     cells.forEach((c, i) => {
       const td = document.createElement("td");
       td.textContent = c;
-      if (i === 4) td.className = "station-azimuth" + (c === "undetermined" ? " undetermined" : "");
+      if (i === 4) td.className = "station-azimuth" + (String(c).startsWith("undetermined") ? " undetermined" : "");
       tr.appendChild(td);
     });
     if (s.invalid) tr.className = "invalid";

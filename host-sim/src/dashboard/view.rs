@@ -77,7 +77,7 @@ pub fn attitude_channels(nav: &NavSolution) -> [f32; ATTITUDE_CHANNELS] {
     .map(|v| v as f32)
 }
 
-const NAV_FLAG_NAMES: [(u16, &str); 8] = [
+const NAV_FLAG_NAMES: [(u16, &str); 9] = [
     (nav_flags::ZUPT_APPLIED, "zero-velocity update"),
     (nav_flags::TOOL_AXIS_RATE_INVALID, "near vertical"),
     (nav_flags::SENSOR_DEGRADED, "sensor degraded"),
@@ -86,6 +86,7 @@ const NAV_FLAG_NAMES: [(u16, &str); 8] = [
     (nav_flags::COASTING, "coasting"),
     (nav_flags::SINGLE_PART, "single part"),
     (nav_flags::STILL, "still (station)"),
+    (nav_flags::HEADING_LOST, "heading lost: needs a tie-in"),
 ];
 
 /// The latest solution for people: each angle with its 1-sigma.
@@ -97,6 +98,8 @@ pub fn latest_json(nav: &NavSolution) -> Value {
         "n/a"
     } else if display::azimuth_is_determined(s_heading) {
         "determined"
+    } else if nav.flags & nav_flags::HEADING_LOST != 0 {
+        "lost"
     } else {
         "undetermined"
     };
@@ -112,7 +115,11 @@ pub fn latest_json(nav: &NavSolution) -> Value {
         "roll": display::angle_with_sigma(roll.to_degrees(), s_roll),
         "pitch": display::angle_with_sigma(pitch.to_degrees(), s_pitch),
         "inclination": display::angle_with_sigma(inc, s_pitch),
-        "azimuth": display::azimuth_text(heading, s_heading, 3),
+        "azimuth": if nav.flags & nav_flags::HEADING_LOST != 0 && s_heading.is_infinite() {
+            display::HEADING_LOST_TEXT.to_string()
+        } else {
+            display::azimuth_text(heading, s_heading, 3)
+        },
         "azimuth_status": azimuth_status,
         "toolface": display::angle_with_sigma(tf, s_roll),
     })
@@ -163,6 +170,13 @@ mod tests {
         let latest = latest_json(&nav);
         assert_eq!(latest["azimuth"], "undetermined");
         assert_eq!(latest["azimuth_status"], "undetermined");
+        // Lost since the last tie-in: said so, still no number.
+        nav.flags = nav_flags::HEADING_LOST;
+        let latest = latest_json(&nav);
+        assert_eq!(latest["azimuth"], display::HEADING_LOST_TEXT);
+        assert_eq!(latest["azimuth_status"], "lost");
+        assert_eq!(latest["flags"][0], "heading lost: needs a tie-in");
+        nav.flags = 0;
         nav.attitude_std[2] = 0.02;
         let latest = latest_json(&nav);
         assert_eq!(latest["azimuth"], "57.296 +- 1.146 deg (1 sigma)");

@@ -4,6 +4,7 @@
 
 use super::drilling::{DrillingRow, DrillingSurvey, TrajectoryPoint};
 use super::ellipse::scale_2d;
+use mwd_core::protocol::frame::station_flags;
 use std::fmt::Write as _;
 
 /// Angle and its 1-sigma, deg: "91.082+-0.064".
@@ -48,6 +49,15 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
             out,
             "note: azimuth undetermined from station {} (MD {:.2} m) on: no position from there on",
             u.survey.station, u.row.md_m
+        );
+    }
+    let lost = |r: &&DrillingRow| r.survey.flags & station_flags::HEADING_LOST != 0;
+    if let Some(l) = s.rows.iter().find(lost) {
+        let _ = writeln!(
+            out,
+            "note: the probe lost its heading at station {} (MD {:.2} m): its azimuth sigma \
+             passed 10 deg; no azimuth until the probe is tied in again",
+            l.survey.station, l.row.md_m
         );
     }
     for k in &s.skipped {

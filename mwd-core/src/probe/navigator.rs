@@ -298,7 +298,12 @@ pub struct Navigator<T: FilterScalar = f32> {
     /// azimuth sigma would not cover the error. A heading lost in
     /// navigation (its sigma past [`AZIMUTH_SIGMA_LIMIT_RAD`]) is set
     /// infinite here too, until the next tie-in (`note_heading_loss`).
+    /// Set only through [`set_heading_source`](Self::set_heading_source).
     coarse_std: [f32; 3],
+    /// The heading was determined and then lost in navigation (its sigma
+    /// past [`AZIMUTH_SIGMA_LIMIT_RAD`]) since the last tie-in or
+    /// alignment: the frames' and stations' `HEADING_LOST` bit.
+    heading_lost: bool,
     /// The last sample the filter took, held through a gap.
     held: Option<ImuSample>,
     /// Samples missed in a row (the current gap).
@@ -524,6 +529,7 @@ impl<T: FilterScalar> Navigator<T> {
             filter: Filter::new(idle, position, filter_config(&position, &[0.0; 3], noise)),
             input: ProbeInput::new(),
             coarse_std: [f32::NAN; 3],
+            heading_lost: false,
             held: None,
             missed: 0,
             coasting: false,
@@ -653,12 +659,22 @@ impl<T: FilterScalar> Navigator<T> {
     /// over sigma 1.67 RMS, one 92 deg off under a 9.3 deg sigma
     /// (docs/lateral-study.md, "A heading once lost stays lost"). A NaN
     /// sigma counts as past.
+    /// A heading never found (an infinite sigma already) is not "lost".
     fn note_heading_loss(&mut self, heading_std: f64) {
         let navigating = matches!(self.phase, Phase::Navigating);
         let within = heading_std <= AZIMUTH_SIGMA_LIMIT_RAD; // false for NaN
-        if navigating && !within {
+        if navigating && !within && self.coarse_std[2].is_finite() {
             self.coarse_std[2] = f32::INFINITY;
+            self.heading_lost = true;
         }
+    }
+
+    /// The roll, pitch and heading sigmas of a new source of the attitude
+    /// (the coarse alignment, a tie-in): a heading lost before is
+    /// forgotten.
+    fn set_heading_source(&mut self, sigma: [f64; 3]) {
+        self.coarse_std = sigma.map(|s| s as f32);
+        self.heading_lost = false;
     }
 
     /// The station survey finished by the last [`step`](Self::step), if
@@ -986,7 +1002,7 @@ impl<T: FilterScalar> Navigator<T> {
             Some(Err(_)) | None => (0.0, f64::INFINITY),
         };
         let sigma = [roll_pitch_std[0], roll_pitch_std[1], heading_std];
-        self.coarse_std = sigma.map(|s| s as f32);
+        self.set_heading_source(sigma);
         // A levelling that failed leaves no tilt sigma: the filter then
         // starts from a 10 deg one.
         let filter_sigma = sigma.map(|s| if s.is_nan() { 10f64.to_radians() } else { s });
@@ -1047,6 +1063,9 @@ impl<T: FilterScalar> Navigator<T> {
         solution.height = state.position.height as f32;
         if self.coasting {
             solution.flags |= nav_flags::COASTING;
+        }
+        if self.heading_lost {
+            solution.flags |= nav_flags::HEADING_LOST;
         }
         let Some(std) = attitude_std.filter(|_| !self.covariance_invalid) else {
             solution.flags |= nav_flags::COVARIANCE_INVALID | nav_flags::SOLUTION_INVALID;
@@ -1134,7 +1153,7 @@ impl<T: FilterScalar> Navigator<T> {
         };
         self.filter.aid(&tilt);
         let euler_std = self.filter.euler_std();
-        self.coarse_std = [euler_std.x, euler_std.y, sigma.azimuth].map(|s| s as f32);
+        self.set_heading_source([euler_std.x, euler_std.y, sigma.azimuth]);
         self.input = ProbeInput::new();
         self.coasting = false;
         self.coarse_single_part = false;
@@ -1159,7 +1178,7 @@ impl<T: FilterScalar> Navigator<T> {
         self.filter
             .set_attitude_error_covariance(&tie_in.attitude_error_covariance());
         self.filter.start_navigation();
-        self.coarse_std = sigma.map(|s| s as f32);
+        self.set_heading_source(sigma);
         self.input = ProbeInput::new();
         self.held = None;
         self.missed = 0;

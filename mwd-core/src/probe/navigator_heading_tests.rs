@@ -3,11 +3,12 @@
 //! inclined tool, whose gyros tell the two apart, still gets its azimuth;
 //! the tie-in then gives the horizontal tool its azimuth. A heading whose
 //! sigma passed the first-order limit in navigation stays undetermined
-//! until the next tie-in.
+//! until the next tie-in, flagged lost (a heading never found is not).
 
 use super::*;
 extern crate std;
 use crate::conventions::Euler;
+use crate::protocol::frame::station_flags;
 
 use super::super::test_support::{earth_rate_sample, quieter_gyros, ALL_ALIGNMENT};
 
@@ -129,22 +130,65 @@ fn a_heading_once_past_the_limit_stays_undetermined_until_the_next_tie_in() {
         frames
     };
     let determined = |f: &NavSolution| f.attitude_std[2].is_finite();
-    assert!(next(&mut navigator, 20).iter().all(determined));
+    let lost = |f: &NavSolution| f.flags & nav_flags::HEADING_LOST != 0;
+    let frames = next(&mut navigator, 20);
+    assert!(frames.iter().all(determined) && !frames.iter().any(lost));
 
-    // Past the limit: undetermined (as before the latch).
+    let station_lost = |navigator: &Navigator<f64>| {
+        let flags = navigator.station_survey().0.flags;
+        let undetermined = flags & station_flags::AZIMUTH_UNDETERMINED != 0;
+        let lost = flags & station_flags::HEADING_LOST != 0;
+        assert_eq!(undetermined, lost, "{flags:#x}");
+        lost
+    };
+    assert!(!station_lost(&navigator));
+
+    // Past the limit: undetermined (as before the latch), and said lost;
+    // a station at once, before the frames' latch.
     let past = AZIMUTH_SIGMA_LIMIT_RAD * 1.2;
     navigator.filter.set_heading(0.0, past * past);
-    assert!(!next(&mut navigator, 20).iter().any(determined));
+    assert!(station_lost(&navigator));
+    let frames = next(&mut navigator, 20);
+    assert!(!frames.iter().any(determined) && frames.iter().all(lost));
 
-    // Back well under it: still undetermined.
+    // Back well under it: still undetermined, still lost.
     let under = 2f64.to_radians();
     navigator.filter.set_heading(0.0, under * under);
     let frames = next(&mut navigator, 20);
     assert!(!frames.iter().any(determined), "{:?}", frames.last());
+    assert!(frames.iter().all(lost), "{:?}", frames.last());
+    assert!(station_lost(&navigator));
     // The filter's own sigma is the small one: only the frame says no.
     assert!(navigator.filter.euler_std().z < AZIMUTH_SIGMA_LIMIT_RAD);
 
     // A new tie-in brings the heading back.
     navigator.start_from_tie_in(&tie_in_at(&attitude));
-    assert!(next(&mut navigator, 20).iter().all(determined));
+    let frames = next(&mut navigator, 20);
+    assert!(frames.iter().all(determined) && !frames.iter().any(lost));
+    assert!(!station_lost(&navigator));
+}
+
+#[test]
+fn a_heading_never_found_is_undetermined_but_not_lost() {
+    // Navigating without a tie-in after an alignment that found no
+    // heading (a horizontal tool's, which only a tie-in chooses), even
+    // with a filter sigma past the limit: nothing was lost.
+    let attitude = Euler::new(0.0, 0.0, 60f64.to_radians());
+    let (mut navigator, _) = aligned(&attitude);
+    assert!(navigator.is_navigating());
+    assert!(navigator.coarse_std[2].is_infinite());
+    let past = AZIMUTH_SIGMA_LIMIT_RAD * 1.2;
+    navigator.filter.set_heading(0.0, past * past);
+    let frames = step_still(&mut navigator, &attitude, ALL_ALIGNMENT + 200, 20);
+    assert!(frames.iter().all(|f| f.attitude_std[2].is_infinite()));
+    assert!(
+        frames
+            .iter()
+            .all(|f| f.flags & nav_flags::HEADING_LOST == 0),
+        "{:?}",
+        frames.last()
+    );
+    let flags = navigator.station_survey().0.flags;
+    assert_ne!(flags & station_flags::AZIMUTH_UNDETERMINED, 0);
+    assert_eq!(flags & station_flags::HEADING_LOST, 0);
 }

@@ -272,7 +272,7 @@ impl<T: FilterScalar> Navigator<T> {
     /// angles, their covariance J P_phi J^T (`super::station`), the flags.
     /// Everything but the station number, start and quality. With the rows
     /// of its link's z (`station_link`) where the covariance is valid.
-    fn station_survey(&self) -> (StationSurvey, Option<[SparseRow<T>; LINKED]>) {
+    pub(super) fn station_survey(&self) -> (StationSurvey, Option<[SparseRow<T>; LINKED]>) {
         let state = self.filter.state();
         let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
         let mut flags = station_flags::MAGNETIC_FREE;
@@ -300,6 +300,13 @@ impl<T: FilterScalar> Navigator<T> {
             && self.flags & nav_flags::SINGLE_PART == 0
             && flags & station_flags::NEAR_VERTICAL == 0
             && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
+        // Lost: found, and now (or since the last tie-in) past the limit;
+        // the frames take this station's loss from the next cycle on.
+        let lost = self.heading_lost
+            || (self.coarse_std[2].is_finite() && !(u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD));
+        if lost {
+            flags |= station_flags::HEADING_LOST;
+        }
         if !determined {
             flags |= station_flags::AZIMUTH_UNDETERMINED;
             survey.angles_std[1] = f32::INFINITY;

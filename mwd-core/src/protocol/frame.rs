@@ -147,6 +147,12 @@ pub mod nav_flags {
     /// is being taken, with a zero-velocity update each cycle (bit 0), up
     /// to the longest station (then bit 7 alone).
     pub const STILL: u16 = 1 << 7;
+    /// The heading was lost: navigating, the filter's azimuth sigma passed
+    /// the first-order limit (`probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD`,
+    /// 10 deg) since the last tie-in or alignment. The azimuth sigma is
+    /// sent as +inf until the next tie-in: unlike a heading the alignment
+    /// never found, no station brings it back.
+    pub const HEADING_LOST: u16 = 1 << 8;
 }
 
 /// Bits of [`StationSurvey::flags`]; the rest are reserved (sent as 0).
@@ -183,6 +189,10 @@ pub mod station_flags {
     /// longest station, no further zero-velocity update and no further
     /// station until the detector sees motion.
     pub const MOTION_SEEN: u16 = 1 << 7;
+    /// The heading was lost since the last tie-in (as navigation bit 8),
+    /// at this station or before it: the azimuth is undetermined (bit 1)
+    /// until a new tie-in.
+    pub const HEADING_LOST: u16 = 1 << 8;
 }
 
 /// A station survey (kind 4): the attitude at the end of a still period
