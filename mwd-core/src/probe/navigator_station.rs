@@ -295,26 +295,27 @@ impl<T: FilterScalar> Navigator<T> {
         let u = angle_uncertainty(&jacobian, &self.filter.attitude_error_covariance());
         survey.angles_std = u.sigma.map(|s| s as f32);
         survey.correlations = u.correlation.map(|r| r as f32);
-        // The navigation frames' rule for the azimuth (see `solution`).
-        let determined = self.coarse_std[2].is_finite()
-            && self.flags & nav_flags::SINGLE_PART == 0
-            && flags & station_flags::NEAR_VERTICAL == 0
-            && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
-        // Lost: found, and now (or since the last tie-in) past the limit;
-        // the frames take this station's loss from the next cycle on.
+        // Lost: since the last tie-in, or now by the frames' own test
+        // (`note_heading_loss`, which runs after this cycle's station).
+        let euler_std = self.filter.euler_std();
         let lost = self.heading_lost
-            || (self.coarse_std[2].is_finite() && !(u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD));
+            || (self.coarse_std[2].is_finite() && !(euler_std.z <= AZIMUTH_SIGMA_LIMIT_RAD));
         if lost {
             flags |= station_flags::HEADING_LOST;
         }
+        // The navigation frames' rule for the azimuth (see `solution`).
+        let determined = !lost
+            && self.coarse_std[2].is_finite()
+            && self.flags & nav_flags::SINGLE_PART == 0
+            && flags & station_flags::NEAR_VERTICAL == 0
+            && u.sigma[1] <= AZIMUTH_SIGMA_LIMIT_RAD;
         if !determined {
             flags |= station_flags::AZIMUTH_UNDETERMINED;
             survey.angles_std[1] = f32::INFINITY;
             survey.correlations[0] = f32::NAN;
             survey.correlations[2] = f32::NAN;
         }
-        let tilt = self.filter.euler_std();
-        if !(tilt.x <= TILT_SIGMA_LIMIT_RAD && tilt.y <= TILT_SIGMA_LIMIT_RAD) {
+        if !(euler_std.x <= TILT_SIGMA_LIMIT_RAD && euler_std.y <= TILT_SIGMA_LIMIT_RAD) {
             flags |= station_flags::SOLUTION_INVALID;
         }
         survey.flags = flags;
