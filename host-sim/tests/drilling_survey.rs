@@ -143,7 +143,9 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
     let text = listing(&out, 0.95);
     assert!(
-        text.contains("lost its heading at station 3 (MD 1020.00 m)"),
+        text.contains(
+            "lost its heading at station 3 (MD 1020.00 m): its azimuth sigma passed 10 deg"
+        ),
         "{text}"
     );
     // an invalid station is skipped, with its reason

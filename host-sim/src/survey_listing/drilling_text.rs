@@ -4,6 +4,7 @@
 
 use super::drilling::{DrillingRow, DrillingSurvey, TrajectoryPoint};
 use super::ellipse::scale_2d;
+use mwd_core::probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD;
 use mwd_core::protocol::frame::station_flags;
 use std::fmt::Write as _;
 
@@ -56,8 +57,10 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         let _ = writeln!(
             out,
             "note: the probe lost its heading at station {} (MD {:.2} m): its azimuth sigma \
-             passed 10 deg; no azimuth until the probe is tied in again",
-            l.survey.station, l.row.md_m
+             passed {:.0} deg; no azimuth until the probe is tied in again",
+            l.survey.station,
+            l.row.md_m,
+            AZIMUTH_SIGMA_LIMIT_RAD.to_degrees()
         );
     }
     for k in &s.skipped {

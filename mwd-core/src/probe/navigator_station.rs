@@ -298,8 +298,8 @@ impl<T: FilterScalar> Navigator<T> {
         // Lost: since the last tie-in, or now by the frames' own test
         // (`note_heading_loss`, which runs after this cycle's station).
         let euler_std = self.filter.euler_std();
-        let lost = self.heading_lost
-            || (self.coarse_std[2].is_finite() && !(euler_std.z <= AZIMUTH_SIGMA_LIMIT_RAD));
+        let within = euler_std.z <= AZIMUTH_SIGMA_LIMIT_RAD; // false for NaN
+        let lost = self.heading_lost || (self.coarse_std[2].is_finite() && !within);
         if lost {
             flags |= station_flags::HEADING_LOST;
         }
