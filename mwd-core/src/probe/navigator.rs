@@ -662,11 +662,17 @@ impl<T: FilterScalar> Navigator<T> {
     /// A heading never found (an infinite sigma already) is not "lost".
     fn note_heading_loss(&mut self, heading_std: f64) {
         let navigating = matches!(self.phase, Phase::Navigating);
-        let within = heading_std <= AZIMUTH_SIGMA_LIMIT_RAD; // false for NaN
-        if navigating && !within && self.coarse_std[2].is_finite() {
+        if navigating && self.loses_heading(heading_std) {
             self.coarse_std[2] = f32::INFINITY;
             self.heading_lost = true;
         }
+    }
+
+    /// Whether a heading sigma (rad, the filter's Euler heading) loses a
+    /// heading that was found: past the limit, or NaN.
+    pub(super) fn loses_heading(&self, heading_std: f64) -> bool {
+        let within = heading_std <= AZIMUTH_SIGMA_LIMIT_RAD; // false for NaN
+        self.coarse_std[2].is_finite() && !within
     }
 
     /// The roll, pitch and heading sigmas of a new source of the attitude

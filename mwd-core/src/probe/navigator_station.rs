@@ -298,8 +298,7 @@ impl<T: FilterScalar> Navigator<T> {
         // Lost: since the last tie-in, or now by the frames' own test
         // (`note_heading_loss`, which runs after this cycle's station).
         let euler_std = self.filter.euler_std();
-        let within = euler_std.z <= AZIMUTH_SIGMA_LIMIT_RAD; // false for NaN
-        let lost = self.heading_lost || (self.coarse_std[2].is_finite() && !within);
+        let lost = self.heading_lost || self.loses_heading(euler_std.z);
         if lost {
             flags |= station_flags::HEADING_LOST;
         }
