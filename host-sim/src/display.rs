@@ -5,9 +5,9 @@
 
 use mwd_core::alignment::MAX_DETERMINED_SIGMA;
 use mwd_core::conventions::wrap_two_pi;
-use mwd_core::protocol::frame::station_flags;
+use mwd_core::protocol::frame::{nav_flags, station_flags};
 use mwd_core::protocol::uplink::{Field, NakReason, Reply, ReplyStatus};
-use mwd_core::protocol::StationSurvey;
+use mwd_core::protocol::{NavSolution, StationSurvey};
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 
 /// An angle (rad) in degrees in [0, 360): azimuth and toolface.
@@ -70,6 +70,18 @@ pub fn station_azimuth_text(s: &StationSurvey) -> String {
 /// An azimuth whose heading was lost since the last tie-in (station and
 /// navigation bit 8).
 pub const HEADING_LOST_TEXT: &str = "undetermined (heading lost: needs a tie-in)";
+
+/// A navigation frame's azimuth for people: [`azimuth_text`], with the
+/// reason when its infinite sigma is a heading lost since the last tie-in
+/// (navigation bit 8).
+pub fn nav_azimuth_text(nav: &NavSolution, decimals: usize) -> String {
+    let sigma = f64::from(nav.attitude_std[2]);
+    if nav.flags & nav_flags::HEADING_LOST != 0 && sigma.is_infinite() {
+        HEADING_LOST_TEXT.to_string()
+    } else {
+        azimuth_text(f64::from(nav.attitude[2]), sigma, decimals)
+    }
+}
 
 /// One station survey for people: number, span, the three drilling angles
 /// with their 1-sigma (azimuth "undetermined" when its sigma or flag says

@@ -86,7 +86,7 @@ impl fmt::Display for LiveStatus {
         } else {
             f64::NAN
         };
-        let azimuth = display::azimuth_text(heading, f64::from(s.attitude_std[2]), 2);
+        let azimuth = display::nav_azimuth_text(s, 2);
         let l = &self.link;
         write!(
             f,
@@ -580,8 +580,15 @@ mod tests {
             replay: ReplaySummary::default(),
         };
         let line = status.to_string();
-        assert!(line.contains("az undetermined"), "{line}");
+        assert!(line.contains("az undetermined |"), "{line}");
         assert!(!line.contains("-57.30"), "{line}");
+        let mut lost = status;
+        lost.solution.flags = mwd_core::protocol::frame::nav_flags::HEADING_LOST;
+        let line = lost.to_string();
+        assert!(
+            line.contains("az undetermined (heading lost: needs a tie-in) |"),
+            "{line}"
+        );
         let mut coarse = status;
         coarse.solution.attitude = [f32::NAN; 3];
         coarse.solution.attitude_std = [f32::NAN; 3];

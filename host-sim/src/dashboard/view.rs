@@ -115,11 +115,7 @@ pub fn latest_json(nav: &NavSolution) -> Value {
         "roll": display::angle_with_sigma(roll.to_degrees(), s_roll),
         "pitch": display::angle_with_sigma(pitch.to_degrees(), s_pitch),
         "inclination": display::angle_with_sigma(inc, s_pitch),
-        "azimuth": if nav.flags & nav_flags::HEADING_LOST != 0 && s_heading.is_infinite() {
-            display::HEADING_LOST_TEXT.to_string()
-        } else {
-            display::azimuth_text(heading, s_heading, 3)
-        },
+        "azimuth": display::nav_azimuth_text(nav, 3),
         "azimuth_status": azimuth_status,
         "toolface": display::angle_with_sigma(tf, s_roll),
     })
