@@ -27,7 +27,7 @@ use mwd_core::protocol::frame::nav_mode;
 use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
-use crate::capture::Capture;
+use crate::capture::CaptureSummary;
 use crate::display;
 use crate::replay::commands::CommandRow;
 use crate::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
@@ -167,9 +167,14 @@ pub struct LiveSinks<'a> {
 }
 
 /// The result of a live replay: as a file replay gives, and why it ended.
+/// A session of any length keeps only this: the rows went to the CSV
+/// sink as they settled.
 pub struct LiveOutcome {
-    pub capture: Capture,
-    pub rows: Vec<ReplayRow>,
+    pub capture: CaptureSummary,
+    /// How many rows the replay made (one per raw frame replayed).
+    pub rows: usize,
+    /// The newest of them.
+    pub last_row: Option<ReplayRow>,
     pub summary: ReplaySummary,
     pub step_losses: Vec<StepLoss>,
     /// The replies to uplink commands and what the replay did with each.
@@ -193,7 +198,7 @@ pub fn run(
     let mut decoder = Decoder::new();
     let mut replayer = Replayer::with_settings(position, options.calibration, options.still)
         .with_tie_in(options.tie_in);
-    let mut capture = Capture::default();
+    let mut capture = CaptureSummary::default();
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];
     if let Some(csv) = sinks.csv.as_mut() {
@@ -229,12 +234,13 @@ pub fn run(
                 break StreamEnd::OutputFailed(e);
             }
         }
-        capture.feed(&mut decoder, &buf[..n], |received| {
-            if let Some(solution) = replayer.push_received(received) {
+        crate::capture::feed(&mut decoder, &buf[..n], |item| {
+            capture.note(item.received());
+            if let Some(solution) = replayer.push_received(item.received()) {
                 latest = Some(solution);
             }
         });
-        if let Err(e) = write_settled(&mut replayer, sinks.csv.as_mut(), false) {
+        if let Err(e) = replayer.write_settled(sink(&mut sinks.csv), false) {
             break StreamEnd::OutputFailed(e);
         }
         let due = last_shown.is_none_or(|t| t.elapsed() >= options.display_interval);
@@ -249,32 +255,24 @@ pub fn run(
     };
     // Raw frames the replay held for their navigation frame are replayed.
     replayer.end_of_stream();
-    let end = match write_settled(&mut replayer, sinks.csv.as_mut(), true) {
+    let end = match replayer.write_settled(sink(&mut sinks.csv), true) {
         Err(e) if !matches!(end, StreamEnd::OutputFailed(_)) => StreamEnd::OutputFailed(e),
         _ => end,
     };
     outcome(decoder, capture, replayer, end)
 }
 
-/// Writes the rows whose comparison is settled (all of them at the end).
-fn write_settled(
-    replayer: &mut Replayer,
-    csv: Option<&mut &mut dyn Write>,
-    all: bool,
-) -> io::Result<()> {
-    let rows = replayer.settled_rows(all);
+/// The CSV sink, reborrowed for one call.
+fn sink<'s>(csv: &'s mut Option<&mut dyn Write>) -> Option<&'s mut dyn Write> {
     match csv {
-        Some(out) if !rows.is_empty() => {
-            replay::write_csv_rows(rows, &mut **out)?;
-            out.flush()
-        }
-        _ => Ok(()),
+        Some(w) => Some(&mut **w),
+        None => None,
     }
 }
 
 fn outcome(
     mut decoder: Decoder,
-    mut capture: Capture,
+    mut capture: CaptureSummary,
     mut replayer: Replayer,
     end: StreamEnd,
 ) -> LiveOutcome {
@@ -283,10 +281,13 @@ fn outcome(
     replayer.end_of_stream();
     let step_losses = replayer.step_losses().to_vec();
     let commands = replayer.commands().to_vec();
-    let (rows, summary) = replayer.finish();
+    let rows = replayer.rows_replayed();
+    let last_row = replayer.last_row().copied();
+    let (_, summary) = replayer.finish();
     LiveOutcome {
         capture,
         rows,
+        last_row,
         summary,
         step_losses,
         commands,
@@ -378,7 +379,9 @@ mod tests {
         assert_eq!(outcome.capture.stats.frames[0], 120);
         let (rows, summary) = replay::replay(&whole.frames, Position::paper_site());
         assert_eq!(outcome.summary, summary);
-        assert_eq!(outcome.rows.len(), rows.len());
+        assert_eq!(outcome.rows, rows.len());
+        let last = rows.last().map(|r| r.solution.sample_counter);
+        assert_eq!(outcome.last_row.map(|r| r.solution.sample_counter), last);
         // Display lines carry the link figures; the last one saw every frame.
         let last = shown.last().expect("a status line");
         assert!(last.contains("frames 120 lost 0 crc 0"), "{last}");
@@ -400,7 +403,7 @@ mod tests {
             |_| {},
         );
         assert!(matches!(outcome.end, StreamEnd::TimeLimit));
-        assert_eq!(outcome.rows.len(), 0);
+        assert_eq!(outcome.rows, 0);
         assert!(outcome.capture.stats.bytes > 0);
     }
 
@@ -461,7 +464,7 @@ mod tests {
             outcome.end
         );
         assert_eq!(saved, bytes);
-        assert_eq!(outcome.rows.len(), 150);
+        assert_eq!(outcome.rows, 150);
         let text = String::from_utf8(csv).unwrap();
         assert_eq!(text.lines().count(), 1 + 150);
         assert!(text.starts_with(replay::CSV_HEADER));
@@ -524,7 +527,7 @@ mod tests {
             sinks,
             |_| {},
         );
-        assert_eq!(outcome.rows.len(), 200);
+        assert_eq!(outcome.rows, 200);
         // Without probe solutions to wait for, a row settles once 64 later
         // samples came: by the last read, all but those were written.
         let before_end = *watching.lines_seen.last().unwrap();
@@ -564,7 +567,7 @@ mod tests {
             "{}",
             outcome.end
         );
-        assert_eq!(outcome.rows.len(), 30);
+        assert_eq!(outcome.rows, 30);
     }
 
     #[test]

@@ -273,24 +273,17 @@ pub fn replay_capture(
 }
 
 /// The station links of a capture's station frames (`stations`, in the
-/// capture's order), from its replay with the probe's site, calibration,
-/// still settings and tie-in: one per station when every station frame was
-/// replayed bit for bit, in the same order (the replay's filter then held
-/// the probe's, and its links are the ones the probe's would have kept);
-/// otherwise why not, for the survey to say (it then chains the azimuth
-/// alone).
+/// capture's order), from `replayer`, which has taken the whole capture
+/// with the probe's site, calibration, still settings and tie-in
+/// (`Replayer::with_settings`, `with_tie_in`): one per station when every
+/// station frame was replayed bit for bit, in the same order (the replay's
+/// filter then held the probe's, and its links are the ones the probe's
+/// would have kept); otherwise why not, for the survey to say (it then
+/// chains the azimuth alone).
 pub fn replayed_station_links(
-    capture: &Capture,
+    replayer: &mut Replayer,
     stations: &[StationSurvey],
-    position: Position,
-    calibration: ProbeCalibration,
-    still: StillSettings,
-    tie_in: Option<TieIn>,
 ) -> Result<Vec<Option<StationLink>>, String> {
-    let mut replayer = Replayer::with_settings(position, calibration, still).with_tie_in(tie_in);
-    for received in capture.in_order() {
-        replayer.push_received(received);
-    }
     let (rows, summary) = replayer.stations();
     let same = rows.len() == stations.len()
         && rows.iter().zip(stations).all(|(row, probe)| {
@@ -334,16 +327,22 @@ pub struct Replayer {
     tie_in: Option<TieIn>,
     tie_in_pending: Option<TieIn>,
     navigator: Navigator,
+    /// The replayed rows not forgotten yet ([`Replayer::forget_settled`]):
+    /// `rows[0]` is row number `rows_forgotten` of the replay.
     rows: Vec<ReplayRow>,
-    /// Rows (index into `rows`) of replayed samples the probe's solution
-    /// has not arrived for yet, by sample counter (of the current run).
-    awaiting_probe: HashMap<u32, usize>,
+    rows_forgotten: usize,
+    /// The newest replayed row (kept when it is forgotten).
+    last_row: Option<ReplayRow>,
+    /// Replayed samples the probe's solution has not arrived for yet, by
+    /// sample counter (of the current run).
+    awaiting_probe: HashMap<u32, Awaiting>,
     /// The probe's solutions whose raw frame has not arrived yet.
     early_probe: HashMap<u32, NavSolution>,
     summary: ReplaySummary,
     step: StepTracker,
     step_losses: Vec<StepLoss>,
-    /// Rows already handed out by [`Replayer::settled_rows`].
+    /// Rows already handed out by [`Replayer::settled_rows`] (a row
+    /// number of the replay).
     settled: usize,
     station_rows: Vec<StationRow>,
     /// Replayed stations waiting for the probe's, by station number, in
@@ -367,6 +366,17 @@ pub struct Replayer {
     /// The configuration version of the capture's first boot event that
     /// reported one: the configuration the replay is taken to have.
     first_config_version: Option<u32>,
+}
+
+/// A replayed sample waiting for the probe's solution.
+#[derive(Debug, Clone, Copy)]
+enum Awaiting {
+    /// Its row, by row number.
+    Row(usize),
+    /// Its row was forgotten before the probe's solution came (a capture
+    /// whose navigation frames come late or not at all): the comparison
+    /// still counts.
+    Forgotten(ReplayRow),
 }
 
 /// What the commands need to know of the current run.
@@ -472,6 +482,8 @@ impl Replayer {
             tie_in_pending: None,
             navigator: linked(Navigator::with_settings(position, calibration, &still)),
             rows: Vec::new(),
+            rows_forgotten: 0,
+            last_row: None,
             awaiting_probe: HashMap::new(),
             early_probe: HashMap::new(),
             summary: ReplaySummary::default(),
@@ -577,7 +589,8 @@ impl Replayer {
                 self.run.last_probe_nav = Some(on_board.sample_counter);
                 self.run.lost_since_nav = false;
                 match self.awaiting_probe.remove(&on_board.sample_counter) {
-                    Some(index) => self.compare(index, &on_board),
+                    Some(Awaiting::Row(index)) => self.compare(index, &on_board),
+                    Some(Awaiting::Forgotten(mut row)) => self.compare_row(&mut row, &on_board),
                     None => {
                         self.early_probe.insert(on_board.sample_counter, on_board);
                     }
@@ -636,7 +649,7 @@ impl Replayer {
         if solution.flags & nav_flags::SENSOR_DEGRADED != 0 {
             self.summary.degraded += 1;
         }
-        let index = self.rows.len();
+        let index = self.rows_replayed();
         self.rows.push(ReplayRow {
             solution,
             matches_probe: None,
@@ -645,9 +658,10 @@ impl Replayer {
         match self.early_probe.remove(&counter) {
             Some(on_board) => self.compare(index, &on_board),
             None => {
-                self.awaiting_probe.insert(counter, index);
+                self.awaiting_probe.insert(counter, Awaiting::Row(index));
             }
         }
+        self.last_row = self.rows.last().copied();
         if let Some(station) = self.navigator.take_station() {
             self.replayed_station(station, counter);
         }
@@ -688,7 +702,7 @@ impl Replayer {
         self.station_summary.replayed += 1;
         let index = self.station_rows.len();
         // In step as the newest replayed sample was.
-        let arrived_in_step = self.rows.last().is_none_or(|r| r.in_step);
+        let arrived_in_step = self.last_row.is_none_or(|r| r.in_step);
         let link = self
             .navigator
             .station_link()
@@ -811,12 +825,24 @@ impl Replayer {
         }
     }
 
+    /// Compares row number `index` with the probe's solution.
     fn compare(&mut self, index: usize, on_board: &NavSolution) {
-        let compared = self.compared(on_board.sample_counter);
-        let lost_in_run = self.run.lost_in_run;
-        let Some(row) = self.rows.get_mut(index) else {
+        let Some(at) = index.checked_sub(self.rows_forgotten) else {
             return;
         };
+        let Some(mut row) = self.rows.get(at).copied() else {
+            return;
+        };
+        self.compare_row(&mut row, on_board);
+        self.rows[at] = row;
+        if self.rows_replayed() == index + 1 {
+            self.last_row = Some(row);
+        }
+    }
+
+    fn compare_row(&mut self, row: &mut ReplayRow, on_board: &NavSolution) {
+        let compared = self.compared(on_board.sample_counter);
+        let lost_in_run = self.run.lost_in_run;
         row.in_step &= compared;
         if !row.in_step {
             self.summary.unchecked += 1;
@@ -869,7 +895,7 @@ impl Replayer {
     /// [`SETTLE_AFTER_SAMPLES`] samples), in order: what a live replay can
     /// write now. `all` settles every row (the stream ended).
     pub fn settled_rows(&mut self, all: bool) -> &[ReplayRow] {
-        let from = self.settled;
+        let from = self.settled - self.rows_forgotten;
         // Held raw frames count as later samples.
         let newest = self.rows.len() + self.held.len();
         let settled = self.rows[from..]
@@ -881,13 +907,58 @@ impl Replayer {
                     || newest - (from + i) > SETTLE_AFTER_SAMPLES
             })
             .count();
-        self.settled = from + settled;
-        &self.rows[from..self.settled]
+        self.settled += settled;
+        &self.rows[from..from + settled]
     }
 
-    /// The replayed rows (one per raw frame, in arrival order) and the
-    /// summary (probe solutions whose raw frame never came count as
-    /// unchecked).
+    /// Forgets the rows [`settled_rows`](Self::settled_rows) handed out, so
+    /// that a replay of any length (a live session, a day and a half of
+    /// drilling) keeps only the rows still settling. A forgotten row whose
+    /// probe solution has not come keeps its place in the comparison.
+    pub fn forget_settled(&mut self) {
+        let n = self.settled - self.rows_forgotten;
+        for (k, row) in self.rows.drain(..n).enumerate() {
+            let number = self.rows_forgotten + k;
+            let counter = row.solution.sample_counter;
+            if let Some(a) = self.awaiting_probe.get_mut(&counter) {
+                if matches!(*a, Awaiting::Row(i) if i == number) {
+                    *a = Awaiting::Forgotten(row);
+                }
+            }
+        }
+        self.rows_forgotten += n;
+    }
+
+    /// Writes the settled rows (all of them when `all`: the stream ended)
+    /// to `csv` as CSV rows, flushed, and forgets them: a replay streaming
+    /// its rows out keeps only the ones still settling.
+    pub fn write_settled(&mut self, csv: Option<&mut dyn Write>, all: bool) -> io::Result<()> {
+        let rows = self.settled_rows(all);
+        if let Some(out) = csv {
+            if !rows.is_empty() {
+                write_csv_rows(rows, &mut *out)?;
+                out.flush()?;
+            }
+        }
+        self.forget_settled();
+        Ok(())
+    }
+
+    /// How many rows the replay has made (one per raw frame replayed),
+    /// forgotten ones included.
+    pub fn rows_replayed(&self) -> usize {
+        self.rows_forgotten + self.rows.len()
+    }
+
+    /// The newest replayed row, forgotten or not.
+    pub fn last_row(&self) -> Option<&ReplayRow> {
+        self.last_row.as_ref()
+    }
+
+    /// The replayed rows not forgotten (one per raw frame, in arrival
+    /// order: all of them unless [`forget_settled`](Self::forget_settled)
+    /// was called) and the summary (probe solutions whose raw frame never
+    /// came count as unchecked).
     pub fn finish(mut self) -> (Vec<ReplayRow>, ReplaySummary) {
         self.end_of_stream();
         self.summary.unchecked += self.early_probe.len() as u64;

@@ -165,12 +165,18 @@ pub fn is_capture(path: &Path) -> bool {
 /// simulated CSV). Samples with a faulty part are left out (and counted on
 /// standard error), as are CRC failures and other corrupt frames.
 pub fn capture_records(path: &Path) -> Result<Vec<Record>> {
+    use crate::capture::{FrameStream, Item};
     use mwd_core::protocol::Payload;
-    let capture = crate::capture::read_capture(path)
-        .with_context(|| format!("cannot read capture {}", path.display()))?;
+    let context = || format!("cannot read capture {}", path.display());
+    let file = std::fs::File::open(path).with_context(context)?;
+    let mut stream = FrameStream::new(std::io::BufReader::new(file));
     let mut records = Vec::new();
-    let mut skipped = 0usize;
-    for frame in &capture.frames {
+    let (mut frames, mut skipped) = (0usize, 0usize);
+    while let Some(item) = stream.next_item().with_context(context)? {
+        let Item::Frame(frame) = item else {
+            continue;
+        };
+        frames += 1;
         let Payload::Raw(raw) = frame.payload else {
             continue;
         };
@@ -186,10 +192,9 @@ pub fn capture_records(path: &Path) -> Result<Vec<Record>> {
     }
     if records.is_empty() {
         bail!(
-            "{}: no valid raw-sample frame ({} frames decoded, {} CRC failures)",
+            "{}: no valid raw-sample frame ({frames} frames decoded, {} CRC failures)",
             path.display(),
-            capture.frames.len(),
-            capture.stats.crc_errors
+            stream.stats().crc_errors
         );
     }
     if skipped > 0 {

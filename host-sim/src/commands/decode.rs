@@ -1,11 +1,13 @@
 //! `host-sim decode FILE [--csv OUT]`: summary of a UART capture (frames by
-//! kind, sequence gaps, CRC failures, garbage) and optional CSV export.
+//! kind, sequence gaps, CRC failures, garbage) and optional CSV export. The
+//! capture is read as a stream: a capture of any length takes the memory
+//! of its summary.
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 use anyhow::Context;
-use host_sim::capture;
+use host_sim::capture::{self, CaptureSummary, Item, ProbeCaptureFile};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -17,18 +19,34 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let cap = capture::read_probe_capture(&args.file)?;
+    let mut cap = ProbeCaptureFile::open(&args.file)?;
+    let mut csv = match &args.csv {
+        Some(out) => {
+            let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
+            let mut w = BufWriter::new(file);
+            writeln!(w, "{}", capture::CSV_HEADER)
+                .with_context(|| format!("writing {}", out.display()))?;
+            Some((out, w))
+        }
+        None => None,
+    };
+    let mut summary = CaptureSummary::default();
+    let mut rows = 0u64;
+    while let Some(item) = cap.next_item()? {
+        summary.note(item.received());
+        if let (Some((out, w)), Item::Frame(frame)) = (csv.as_mut(), &item) {
+            capture::write_csv_row(frame, w)
+                .with_context(|| format!("writing {}", out.display()))?;
+            rows += 1;
+        }
+    }
+    summary.stats = *cap.stats();
     outln!("capture          {}", args.file.display());
-    outln!("{cap}");
-    if let Some(out) = &args.csv {
-        let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
-        capture::write_csv(&cap.frames, BufWriter::new(file))
+    outln!("{summary}");
+    if let Some((out, mut w)) = csv {
+        w.flush()
             .with_context(|| format!("writing {}", out.display()))?;
-        outln!(
-            "csv              {} ({} rows)",
-            out.display(),
-            cap.frames.len()
-        );
+        outln!("csv              {} ({rows} rows)", out.display());
     }
     Ok(())
 }

@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::capture::{self, Capture};
+use host_sim::capture::{CaptureSummary, ProbeCaptureFile};
 use host_sim::display;
 use host_sim::job::Job;
 use host_sim::live::{self, LiveOptions, LiveSinks};
@@ -123,16 +123,19 @@ pub struct Args {
 
 /// A replayed capture: where it came from, the capture, the replayed
 /// solutions and their summary.
+/// What a replay reports: the rows themselves went to `--csv` as they
+/// settled, so a capture of any length keeps only this.
 struct Replayed {
     source: String,
-    capture: Capture,
-    rows: Vec<ReplayRow>,
+    capture: CaptureSummary,
+    /// How many rows the replay made, and the newest.
+    rows: usize,
+    last_row: Option<ReplayRow>,
     summary: ReplaySummary,
     step_losses: Vec<StepLoss>,
     /// The replies to uplink commands and what the replay did with each.
     commands: Vec<CommandRow>,
     /// Live: the CSV was written while streaming.
-    csv_written: bool,
     /// Replayed station surveys and their comparison; `None` for a live
     /// session (its stations are listed from the probe's frames only).
     stations: Option<(Vec<StationRow>, StationSummary)>,
@@ -167,7 +170,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 }
                 None => Vec::new(),
             };
-            replay_file(file, site, calibration, still, tie_in, &sent)?
+            let probe = ReplayedProbe {
+                site,
+                calibration,
+                still,
+                tie_in,
+            };
+            replay_file(file, probe, &sent, args.csv.as_deref())?
         }
         (None, None) => anyhow::bail!("give a capture file or --port"),
     };
@@ -185,36 +194,67 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     report(&replayed, args.csv.as_ref(), post_processed)
 }
 
-/// Replays a capture file.
-fn replay_file(
-    file: &Path,
+/// The probe the replay stands for: its site, calibration, still settings
+/// and tie-in.
+struct ReplayedProbe {
     site: Position,
     calibration: ProbeCalibration,
     still: StillSettings,
     tie_in: Option<TieIn>,
+}
+
+/// Replays a capture file as it is read, writing `--csv` as the rows
+/// settle.
+fn replay_file(
+    file: &Path,
+    probe: ReplayedProbe,
     sent: &[(u16, UplinkCommand)],
+    csv: Option<&Path>,
 ) -> anyhow::Result<Replayed> {
-    let capture = capture::read_probe_capture(file)?;
-    let mut replayer = Replayer::with_settings(site, calibration, still).with_tie_in(tie_in);
+    let mut capture = ProbeCaptureFile::open(file)?;
+    let mut out = csv.map(create).transpose()?;
+    let csv_error = |e: std::io::Error| {
+        let path = csv.map(|p| p.display().to_string()).unwrap_or_default();
+        anyhow::Error::new(e).context(format!("writing {path}"))
+    };
+    if let Some(w) = out.as_mut() {
+        writeln!(w, "{}", replay::CSV_HEADER).map_err(csv_error)?;
+    }
+    let mut replayer = Replayer::with_settings(probe.site, probe.calibration, probe.still)
+        .with_tie_in(probe.tie_in);
     for (seq, command) in sent {
         replayer.knows_sent_command(*seq, command);
     }
-    for received in capture.in_order() {
-        replayer.push_received(received);
+    let mut summary = CaptureSummary::default();
+    let mut since_written = 0;
+    while let Some(item) = capture.next_item()? {
+        summary.note(item.received());
+        replayer.push_received(item.received());
+        since_written += 1;
+        if since_written == 4096 {
+            let sink = out.as_mut().map(|w| w as &mut dyn Write);
+            replayer.write_settled(sink, false).map_err(csv_error)?;
+            since_written = 0;
+        }
     }
+    summary.stats = *capture.stats();
     let (station_rows, station_summary) = replayer.stations();
     let stations = Some((station_rows.to_vec(), station_summary));
+    let sink = out.as_mut().map(|w| w as &mut dyn Write);
+    replayer.write_settled(sink, true).map_err(csv_error)?;
     let step_losses = replayer.step_losses().to_vec();
     let commands = replayer.commands().to_vec();
-    let (rows, summary) = replayer.finish();
+    let rows = replayer.rows_replayed();
+    let last_row = replayer.last_row().copied();
+    let (_, replay_summary) = replayer.finish();
     Ok(Replayed {
         source: file.display().to_string(),
-        capture,
+        capture: summary,
         rows,
-        summary,
+        last_row,
+        summary: replay_summary,
         step_losses,
         commands,
-        csv_written: false,
         stations,
     })
 }
@@ -290,10 +330,10 @@ fn replay_live(
         source: port.to_string(),
         capture: outcome.capture,
         rows: outcome.rows,
+        last_row: outcome.last_row,
         summary: outcome.summary,
         step_losses: outcome.step_losses,
         commands: outcome.commands,
-        csv_written: args.csv.is_some(),
         stations: None,
     })
 }
@@ -308,10 +348,10 @@ fn report(
         source,
         capture: cap,
         rows,
+        last_row,
         summary,
         step_losses,
         commands,
-        csv_written,
         stations,
     } = replayed;
     outln!("capture          {source}");
@@ -367,7 +407,7 @@ fn report(
             outln!("station parity   not replayed live (the probe's stations are listed above)")
         }
     }
-    if let Some(last) = rows.last() {
+    if let Some(last) = last_row {
         let s = &last.solution;
         let [r, p, h] = s.attitude.map(f64::from);
         outln!(
@@ -378,11 +418,7 @@ fn report(
         );
     }
     if let Some(out) = csv {
-        if !csv_written {
-            let file = create(out)?;
-            replay::write_csv(rows, file).with_context(|| format!("writing {}", out.display()))?;
-        }
-        outln!("csv              {} ({} rows)", out.display(), rows.len());
+        outln!("csv              {} ({rows} rows)", out.display());
     }
     if post_processed {
         if summary.mismatched > 0 || stations_differ > 0 {

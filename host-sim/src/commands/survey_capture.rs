@@ -6,16 +6,16 @@
 use super::limits::number_in;
 use super::survey::{Args, Resolved};
 use anyhow::{bail, Context, Result};
-use host_sim::capture::read_probe_capture;
-use host_sim::capture::Capture;
-use host_sim::replay::replayed_station_links;
+use host_sim::capture::{Item, ProbeCaptureFile};
+use host_sim::replay::{replayed_station_links, Replayer};
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::depth_log::DepthLog;
 use host_sim::survey_listing::drilling::AzimuthSigmaTrack;
 use host_sim::survey_listing::{drilling, drilling_text, LengthUnit};
 use mwd_core::probe::StationLink;
-use mwd_core::protocol::{Payload, StationSurvey};
-use std::path::PathBuf;
+use mwd_core::protocol::{DecoderStats, Frame, Payload, StationSurvey};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 
 fn step_m(text: &str) -> Result<f64, String> {
     let v = number_in(text, "the trajectory step", (0.0, 1000.0), "m")?;
@@ -71,18 +71,10 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
     let Some(depth_path) = &args.capture.depth else {
         bail!("a capture survey needs --depth");
     };
-    let capture = read_probe_capture(&args.stations)?;
+    let read = read_stations(&args.stations, resolved)?;
     let file = std::fs::File::open(depth_path)
         .with_context(|| format!("reading {}", depth_path.display()))?;
     let depth = DepthLog::read(file).with_context(|| format!("{}", depth_path.display()))?;
-    let stations: Vec<_> = capture
-        .frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Station(s) => Some(s),
-            _ => None,
-        })
-        .collect();
     // The depth log is in metres.
     let tie = resolved.tie_on(args, LengthUnit::Metre);
     let site = Site {
@@ -95,22 +87,10 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         gyro_noise_reduction: 1.0,
     };
     let terms = drilling::survey_terms()?;
-    let track: AzimuthSigmaTrack = capture
-        .frames
-        .iter()
-        .filter_map(|f| match &f.payload {
-            Payload::Nav(n) => Some(n),
-            _ => None,
-        })
-        .collect();
-    let azi_before: Vec<_> = stations
-        .iter()
-        .map(|s| track.before(s.start_sample))
-        .collect();
-    let links = capture_links(&capture, &stations, resolved);
+    let links = read.links;
     let survey = drilling::survey(
-        &stations,
-        &azi_before,
+        &read.stations,
+        &read.azimuth_sigma_before,
         links.as_deref().unwrap_or(&[]),
         &depth,
         tie,
@@ -118,7 +98,7 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         &site,
     )
     .with_context(|| format!("{}", args.stations.display()))?;
-    let s = &capture.stats;
+    let s = &read.stats;
     let bad = s.crc_errors + s.malformed + s.unknown_kind;
     if bad > 0 || s.lost > 0 {
         outln!(
@@ -144,23 +124,37 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
         write(path, drilling_text::stations_csv(&survey, args.confidence))?;
     }
     if let Some(path) = &args.capture.trajectory {
-        let solutions: Vec<_> = capture
-            .frames
-            .iter()
-            .filter_map(|f| match f.payload {
-                Payload::Nav(n) => Some(n),
-                _ => None,
-            })
-            .collect();
+        // A second pass over the file: the trajectory starts from the
+        // survey's tie-on, known only now.
+        let mut capture = ProbeCaptureFile::open(&args.stations)?;
+        let mut failed = None;
+        let solutions = std::iter::from_fn(|| loop {
+            match capture.next_item() {
+                Ok(Some(Item::Frame(Frame {
+                    payload: Payload::Nav(n),
+                    ..
+                }))) => return Some(n),
+                Ok(Some(_)) => {}
+                Ok(None) => return None,
+                Err(e) => {
+                    failed = Some(e);
+                    return None;
+                }
+            }
+        });
         let points = drilling::trajectory(
-            &solutions,
+            solutions,
             &depth,
             &survey,
             tie,
             &terms,
             &site,
             args.capture.trajectory_step_m,
-        )?;
+        );
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        let points = points?;
         write(
             path,
             drilling_text::trajectory_csv(&points, args.confidence),
@@ -170,20 +164,60 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
     Ok(())
 }
 
-/// The stations' links from the capture's replay (`replay::replayed_station_links`),
-/// or why there are none.
-fn capture_links(
-    capture: &Capture,
-    stations: &[StationSurvey],
-    resolved: &Resolved,
-) -> Result<Vec<Option<StationLink>>, String> {
+/// What the survey takes from a capture, read in one pass as a stream (a
+/// day and a half of drilling is 5 M frames: none of them is kept).
+struct CaptureStations {
+    /// The probe's station surveys, in order.
+    stations: Vec<StationSurvey>,
+    /// Each one's azimuth sigma just before its still period began.
+    azimuth_sigma_before: Vec<Option<f64>>,
+    /// The stations' links from the capture's replay
+    /// (`replay::replayed_station_links`), or why there are none.
+    links: Result<Vec<Option<StationLink>>, String>,
+    stats: DecoderStats,
+}
+
+fn read_stations(path: &Path, resolved: &Resolved) -> Result<CaptureStations> {
+    let mut capture = ProbeCaptureFile::open(path)?;
     let probe = &resolved.probe;
-    replayed_station_links(
-        capture,
+    let mut replayer = Replayer::with_settings(probe.site, probe.calibration, probe.still)
+        .with_tie_in(probe.tie_in);
+    let mut track = AzimuthSigmaTrack::default();
+    let mut stations = Vec::new();
+    let mut azimuth_sigma_before = Vec::new();
+    // A station frame sent again (on request) starts where the first did.
+    let mut starts: HashMap<(u16, u32), Option<f64>> = HashMap::new();
+    let mut since_forgotten = 0;
+    while let Some(item) = capture.next_item()? {
+        if let Item::Frame(frame) = &item {
+            match &frame.payload {
+                Payload::Nav(n) => track.push(n),
+                Payload::Station(st) => {
+                    let key = (st.station, st.start_sample);
+                    let sigma = match starts.get(&key) {
+                        Some(sigma) => *sigma,
+                        None => track.station_start(st),
+                    };
+                    starts.insert(key, sigma);
+                    stations.push(*st);
+                    azimuth_sigma_before.push(sigma);
+                }
+                _ => {}
+            }
+        }
+        replayer.push_received(item.received());
+        since_forgotten += 1;
+        if since_forgotten == 4096 {
+            replayer.settled_rows(false);
+            replayer.forget_settled();
+            since_forgotten = 0;
+        }
+    }
+    let links = replayed_station_links(&mut replayer, &stations);
+    Ok(CaptureStations {
         stations,
-        probe.site,
-        probe.calibration,
-        probe.still,
-        probe.tie_in,
-    )
+        azimuth_sigma_before,
+        links,
+        stats: *capture.stats(),
+    })
 }

@@ -406,3 +406,63 @@ fn a_configured_tie_in_is_taken_where_the_probe_takes_it() {
     assert!(summary.mismatched > 0, "{summary:?}");
     assert_eq!(stations.mismatched, 1, "{stations:?}");
 }
+
+/// A long replay forgets the rows it has written (`write_settled`), and
+/// still compares every solution: also those whose row was forgotten
+/// before the probe's solution came (here 100 navigation frames sent late,
+/// one of them different).
+#[test]
+fn a_replay_that_forgets_its_written_rows_compares_as_one_that_keeps_them() {
+    let run = probe_run(300);
+    let late =
+        |f: &Frame| matches!(f.payload, Payload::Nav(n) if (100..200).contains(&n.sample_counter));
+    let mut payloads: Vec<Payload> = run.iter().filter(|f| !late(f)).map(|f| f.payload).collect();
+    payloads.extend(run.iter().filter(|f| late(f)).map(|f| {
+        let mut p = f.payload;
+        if let Payload::Nav(n) = &mut p {
+            if n.sample_counter == 150 {
+                n.attitude[2] += 1e-6;
+            }
+        }
+        p
+    }));
+    let capture = numbered(0, payloads);
+    let site = Position::paper_site();
+
+    let mut keeping = Replayer::new(site);
+    for frame in &capture {
+        keeping.push(frame);
+    }
+    let (kept_rows, kept) = keeping.finish();
+
+    let mut forgetting = Replayer::new(site);
+    let mut csv = Vec::new();
+    for (i, frame) in capture.iter().enumerate() {
+        forgetting.push(frame);
+        if i % 10 == 0 {
+            forgetting.write_settled(Some(&mut csv), false).unwrap();
+        }
+    }
+    forgetting.end_of_stream();
+    forgetting.write_settled(Some(&mut csv), true).unwrap();
+    assert_eq!(forgetting.rows_replayed(), 300);
+    let last = forgetting.last_row().map(|r| r.solution.sample_counter);
+    let (left, forgot) = forgetting.finish();
+
+    assert_eq!(forgot, kept);
+    assert_eq!((kept.matched, kept.mismatched, kept.unchecked), (299, 1, 0));
+    assert!(left.is_empty(), "{} rows kept", left.len());
+    assert_eq!(last, Some(299));
+    // The same rows, written as they settled: the late ones before their
+    // comparison was known.
+    let mut whole = Vec::new();
+    write_csv_rows(&kept_rows, &mut whole).unwrap();
+    let solutions = |text: &[u8]| -> Vec<String> {
+        String::from_utf8(text.to_vec())
+            .unwrap()
+            .lines()
+            .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+            .collect()
+    };
+    assert_eq!(solutions(&csv), solutions(&whole));
+}

@@ -424,7 +424,7 @@ pub struct TrajectoryPoint {
 /// 0.4 mm per 20 Hz sample), positioned by minimum curvature from the
 /// tie-on, with the covariance model of the stations (module docs).
 pub fn trajectory(
-    solutions: &[NavSolution],
+    solutions: impl IntoIterator<Item = NavSolution>,
     depth: &DepthLog,
     survey: &DrillingSurvey,
     tie: TieOnInput,
@@ -439,7 +439,7 @@ pub fn trajectory(
         bail!("no tie-on station");
     };
     let start_time = tie_row.time_s;
-    let mut points: Vec<(f64, f64, &NavSolution)> = Vec::new();
+    let mut points: Vec<(f64, f64, NavSolution)> = Vec::new();
     let mut next_md = tie_row.row.md_m + step_m;
     for s in solutions {
         let t = s.time_us as f64 * 1e-6;

@@ -12,7 +12,6 @@ use anyhow::Context;
 use mwd_core::earth::Position;
 use mwd_core::probe::{Navigator, TieIn};
 use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
-use mwd_core::protocol::uplink::reply::decode_reply_body;
 use mwd_core::protocol::uplink::Reply;
 use mwd_core::protocol::{Decoder, DecoderStats, Frame, FrameEncoder, MAX_WIRE_LEN};
 use mwd_core::protocol::{Event, EventKind};
@@ -22,6 +21,9 @@ use mwd_core::sensor_units::{
 use mwd_core::timing::sample_time_us;
 
 use crate::sim::SimSample;
+
+mod stream;
+pub use stream::{feed, CaptureSummary, FrameStream, Item, ProbeCaptureFile};
 
 /// One simulated sample in SI units, body frame (x right, y forward, z up).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -250,22 +252,20 @@ impl Capture {
         })
     }
 
-    /// Feeds `bytes` to `decoder`, keeping its frames and replies (a live
-    /// session's capture grows this way); `on_new` sees each as it comes.
+    /// Feeds `bytes` to `decoder`, keeping its frames and replies;
+    /// `on_new` sees each as it comes.
     pub fn feed(&mut self, decoder: &mut Decoder, bytes: &[u8], mut on_new: impl FnMut(Received)) {
-        for &b in bytes {
-            if let Some(frame) = decoder.push(b) {
-                self.frames.push(frame);
-                on_new(Received::Frame(&frame));
-            } else if let Some(Ok((seq, reply))) = decoder.unknown_body().map(decode_reply_body) {
-                self.replies.push(CapturedReply {
+        stream::feed(decoder, bytes, |item| {
+            match item {
+                Item::Frame(frame) => self.frames.push(frame),
+                Item::Reply { seq, reply } => self.replies.push(CapturedReply {
                     after_frames: self.frames.len(),
                     seq,
                     reply,
-                });
-                on_new(Received::Reply { seq, reply: &reply });
+                }),
             }
-        }
+            on_new(item.received());
+        });
     }
 }
 
@@ -298,88 +298,34 @@ pub fn decode_bytes(bytes: &[u8]) -> Capture {
     capture
 }
 
-/// Reads and decodes a capture from any reader, streaming.
-pub fn decode_reader(mut reader: impl Read) -> io::Result<Capture> {
-    let mut decoder = Decoder::new();
+/// Reads and decodes a whole capture from any reader into memory (a
+/// command that reads a capture of any size goes through
+/// [`ProbeCaptureFile`] instead, keeping only what it reports).
+pub fn decode_reader(reader: impl Read) -> io::Result<Capture> {
+    let mut stream = FrameStream::new(reader);
     let mut capture = Capture::default();
-    let mut buf = [0u8; 64 * 1024];
-    loop {
-        let n = reader.read(&mut buf)?;
-        if n == 0 {
-            break;
+    while let Some(item) = stream.next_item()? {
+        match item {
+            Item::Frame(frame) => capture.frames.push(frame),
+            Item::Reply { seq, reply } => capture.replies.push(CapturedReply {
+                after_frames: capture.frames.len(),
+                seq,
+                reply,
+            }),
         }
-        capture.feed(&mut decoder, &buf[..n], |_| {});
     }
-    decoder.finish();
-    capture.stats = *decoder.stats();
+    capture.stats = *stream.stats();
     Ok(capture)
 }
 
-/// Reads and decodes a `.bin` capture file.
+/// Reads and decodes a `.bin` capture file into memory.
 pub fn read_capture(path: &Path) -> io::Result<Capture> {
-    decode_reader(File::open(path)?)
-}
-
-/// Reads a capture for `decode` and `replay`: an error naming the file when
-/// it cannot be read or holds no good frame of the probe's protocol (an
-/// empty file, a CSV, random bytes): that is not a probe capture.
-pub fn read_probe_capture(path: &Path) -> anyhow::Result<Capture> {
-    let capture = read_capture(path).with_context(|| format!("reading {}", path.display()))?;
-    let s = &capture.stats;
-    anyhow::ensure!(
-        s.good_frames() > 0,
-        "{} is not a probe capture: {} bytes without one good frame of the probe's \
-         protocol ({} corrupt chunks, {} of another protocol version; the layout is in \
-         docs/protocol.md)",
-        path.display(),
-        s.bytes,
-        s.corrupt(),
-        s.unsupported_version
-    );
-    Ok(capture)
+    decode_reader(io::BufReader::new(File::open(path)?))
 }
 
 impl fmt::Display for Capture {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = &self.stats;
-        let [raw, nav, event, station] = s.frames;
-        writeln!(f, "bytes            {}", s.bytes)?;
-        writeln!(
-            f,
-            "frames           {} good: raw sample {raw}, navigation {nav}, event {event}, \
-             station survey {station}, unknown kind {}",
-            s.good_frames(),
-            s.unknown_kind
-        )?;
-        writeln!(
-            f,
-            "sequence gaps    {} frames lost, {} restarts",
-            s.lost, s.sequence_restarts
-        )?;
-        writeln!(
-            f,
-            "corrupt          {} CRC failures, {} malformed ({} other version)",
-            s.crc_errors, s.malformed, s.unsupported_version
-        )?;
-        write!(f, "garbage          {} bytes", s.garbage_bytes)?;
-        let times = self.frames.iter().filter_map(|fr| match fr.payload {
-            Payload::Raw(r) => Some(r.time_us),
-            _ => None,
-        });
-        if let (Some(first), Some(last)) = (times.clone().min(), times.max()) {
-            write!(
-                f,
-                "\nraw samples span {:.3} s .. {:.3} s",
-                first as f64 * 1e-6,
-                last as f64 * 1e-6
-            )?;
-        }
-        for frame in &self.frames {
-            if let Payload::Station(st) = &frame.payload {
-                write!(f, "\nprobe {}", crate::display::station_text(st))?;
-            }
-        }
-        Ok(())
+        CaptureSummary::of(self).fmt(f)
     }
 }
 
@@ -417,6 +363,14 @@ fn join<T: fmt::Display>(values: impl IntoIterator<Item = T>) -> String {
 pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
     writeln!(out, "{CSV_HEADER}")?;
     for frame in frames {
+        write_csv_row(frame, &mut out)?;
+    }
+    out.flush()
+}
+
+/// Writes one frame as a row of the CSV export (after [`CSV_HEADER`]).
+pub fn write_csv_row(frame: &Frame, mut out: impl Write) -> io::Result<()> {
+    {
         let (kind, body) = match &frame.payload {
             Payload::Raw(r) => ("raw", raw_csv(r)),
             Payload::Nav(n) => {
@@ -470,9 +424,8 @@ pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
                 ("station", cells)
             }
         };
-        writeln!(out, "{},{kind}{body}", frame.seq)?;
+        writeln!(out, "{},{kind}{body}", frame.seq)
     }
-    out.flush()
 }
 
 /// The azimuth and its status, as `display` rules: in [0, 2 pi) rad when
