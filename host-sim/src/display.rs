@@ -83,6 +83,63 @@ pub fn nav_azimuth_text(nav: &NavSolution, decimals: usize) -> String {
     }
 }
 
+/// What an azimuth is, as the CSV exports and the dashboard say beside it
+/// ([`word`](Self::word)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AzimuthStatus {
+    /// A placeholder (NaN: no solution yet): "n/a".
+    Placeholder,
+    Determined,
+    /// Lost since the last tie-in (navigation and station bit 8): only a
+    /// new tie-in brings it back.
+    Lost,
+    /// Not found yet (or its station's flag says so).
+    Undetermined,
+}
+
+impl AzimuthStatus {
+    /// A navigation frame's.
+    pub fn of_nav(nav: &NavSolution) -> Self {
+        let (azimuth, sigma) = (f64::from(nav.attitude[2]), f64::from(nav.attitude_std[2]));
+        if !azimuth.is_finite() || sigma.is_nan() {
+            Self::Placeholder
+        } else if azimuth_is_determined(sigma) {
+            Self::Determined
+        } else if nav.flags & nav_flags::HEADING_LOST != 0 {
+            Self::Lost
+        } else {
+            Self::Undetermined
+        }
+    }
+
+    /// A station survey's: its flags can call an azimuth undetermined (or
+    /// lost) whatever its sigma.
+    pub fn of_station(s: &StationSurvey) -> Self {
+        let (azimuth, sigma) = (f64::from(s.angles[1]), f64::from(s.angles_std[1]));
+        if !azimuth.is_finite() || sigma.is_nan() {
+            Self::Placeholder
+        } else if s.flags & station_flags::HEADING_LOST != 0 {
+            Self::Lost
+        } else if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0
+            || !azimuth_is_determined(sigma)
+        {
+            Self::Undetermined
+        } else {
+            Self::Determined
+        }
+    }
+
+    /// "n/a", "determined", "lost" or "undetermined".
+    pub fn word(self) -> &'static str {
+        match self {
+            Self::Placeholder => "n/a",
+            Self::Determined => "determined",
+            Self::Lost => "lost",
+            Self::Undetermined => "undetermined",
+        }
+    }
+}
+
 /// One station survey for people: number, span, the three drilling angles
 /// with their 1-sigma (azimuth "undetermined" when its sigma or flag says
 /// so), correlations, still quality and flags.

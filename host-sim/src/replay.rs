@@ -980,7 +980,7 @@ fn encoded_payload(payload: &Payload) -> Vec<u8> {
 
 /// CSV columns of [`write_csv`]: SI inside, degrees at this edge. Azimuth
 /// and toolface in [0, 360); the azimuth is empty unless determined
-/// (`azimuth_status`: determined, undetermined, n/a); NaN is a placeholder
+/// (`azimuth_status`: determined, undetermined, lost, n/a: `display::AzimuthStatus`); NaN is a placeholder
 /// (no estimate yet). `matches_probe`: yes, no, unchecked (the replay was
 /// out of step), empty (no probe solution).
 pub const CSV_HEADER: &str = "sample,time_s,mode,flags,roll_deg,pitch_deg,\
@@ -1004,8 +1004,7 @@ pub fn write_csv_rows(rows: &[ReplayRow], mut out: impl Write) -> io::Result<()>
         let [roll, pitch, heading] = s.attitude.map(f64::from);
         let [roll_std, pitch_std, heading_std] = s.attitude_std.map(deg);
         let drilling = DrillingAngles::from_euler(&Euler::new(roll, pitch, heading));
-        let sigma = f64::from(s.attitude_std[2]);
-        let (azimuth, status) = azimuth_cells(heading, sigma);
+        let (azimuth, status) = azimuth_cells(s);
         let [vn, ve, vd] = s.velocity_ned;
         let matches = match (row.in_step, row.matches_probe) {
             (false, _) => "unchecked",
@@ -1042,17 +1041,15 @@ fn angle_0_360(angle_rad: f64) -> f64 {
     }
 }
 
-/// The azimuth cell (empty unless determined) and its status.
-pub fn azimuth_cells(azimuth_rad: f64, sigma_rad: f64) -> (String, &'static str) {
-    if !azimuth_rad.is_finite() || sigma_rad.is_nan() {
-        (String::new(), "n/a")
-    } else if !display::azimuth_is_determined(sigma_rad) {
-        (String::new(), "undetermined")
-    } else {
-        (
-            format!("{:.6}", display::deg_0_360(azimuth_rad)),
+/// The azimuth cell (empty unless determined, deg) and its status
+/// ([`display::AzimuthStatus`]).
+pub fn azimuth_cells(s: &NavSolution) -> (String, &'static str) {
+    match display::AzimuthStatus::of_nav(s) {
+        display::AzimuthStatus::Determined => (
+            format!("{:.6}", display::deg_0_360(f64::from(s.attitude[2]))),
             "determined",
-        )
+        ),
+        status => (String::new(), status.word()),
     }
 }
 

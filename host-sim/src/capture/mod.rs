@@ -20,6 +20,7 @@ use mwd_core::sensor_units::{
 };
 use mwd_core::timing::sample_time_us;
 
+use crate::display::AzimuthStatus;
 use crate::sim::SimSample;
 
 mod stream;
@@ -428,32 +429,23 @@ pub fn write_csv_row(frame: &Frame, mut out: impl Write) -> io::Result<()> {
     }
 }
 
-/// The azimuth and its status, as `display` rules: in [0, 2 pi) rad when
-/// determined, empty when not (undetermined, or a NaN placeholder: "n/a").
+/// The azimuth and its status ([`AzimuthStatus`]): in [0, 2 pi) rad when
+/// determined, empty when not.
 fn azimuth_cells(n: &mwd_core::protocol::NavSolution) -> String {
-    let (azimuth, sigma) = (f64::from(n.attitude[2]), f64::from(n.attitude_std[2]));
-    if !azimuth.is_finite() || sigma.is_nan() {
-        ",,n/a".to_string()
-    } else if !crate::display::azimuth_is_determined(sigma) {
-        ",,undetermined".to_string()
-    } else {
-        let wrapped = crate::display::deg_0_360(azimuth).to_radians();
-        format!(",{},determined", wrapped as f32)
+    match AzimuthStatus::of_nav(n) {
+        AzimuthStatus::Determined => {
+            let wrapped = crate::display::deg_0_360(f64::from(n.attitude[2])).to_radians();
+            format!(",{},determined", wrapped as f32)
+        }
+        status => format!(",,{}", status.word()),
     }
 }
 
-/// A station's azimuth cells, by the same rule plus its flag.
+/// The same for a station survey.
 fn station_azimuth_cells(st: &mwd_core::protocol::StationSurvey) -> String {
-    use mwd_core::protocol::frame::station_flags;
-    let (azimuth, sigma) = (f64::from(st.angles[1]), f64::from(st.angles_std[1]));
-    if !azimuth.is_finite() || sigma.is_nan() {
-        ",,n/a".to_string()
-    } else if st.flags & station_flags::AZIMUTH_UNDETERMINED != 0
-        || !crate::display::azimuth_is_determined(sigma)
-    {
-        ",,undetermined".to_string()
-    } else {
-        format!(",{},determined", st.angles[1])
+    match AzimuthStatus::of_station(st) {
+        AzimuthStatus::Determined => format!(",{},determined", st.angles[1]),
+        status => format!(",,{}", status.word()),
     }
 }
 
@@ -603,10 +595,28 @@ mod tests {
                 ..NavSolution::default()
             }),
         };
+        let mut lost = nav(-1.0, f32::INFINITY);
+        if let Payload::Nav(n) = &mut lost.payload {
+            n.flags = mwd_core::protocol::frame::nav_flags::HEADING_LOST;
+        }
+        let station = |flags: u16| Frame {
+            seq: 0,
+            payload: Payload::Station(mwd_core::protocol::StationSurvey {
+                flags,
+                angles: [1.5, 2.0, 0.3],
+                angles_std: [0.001, 0.01, 0.002],
+                ..mwd_core::protocol::StationSurvey::default()
+            }),
+        };
+        use mwd_core::protocol::frame::station_flags;
         let frames = [
             nav(-1.0, f32::INFINITY),
             nav(-1.0, 0.01),
             nav(f32::NAN, f32::NAN),
+            lost,
+            station(0),
+            station(station_flags::AZIMUTH_UNDETERMINED),
+            station(station_flags::AZIMUTH_UNDETERMINED | station_flags::HEADING_LOST),
         ];
         let mut out = Vec::new();
         write_csv(&frames, &mut out).unwrap();
@@ -622,7 +632,12 @@ mod tests {
         );
         assert_eq!(rows[2][status], "determined");
         assert_eq!((rows[3][az], rows[3][status]), ("", "n/a"));
+        assert_eq!((rows[4][az], rows[4][status]), ("", "lost"));
         assert_eq!(rows[1][col("roll_rad")], "0.1");
+        let (st_az, st_status) = (col("st_azimuth_rad"), col("st_azimuth_status"));
+        assert_eq!((rows[5][st_az], rows[5][st_status]), ("2", "determined"));
+        assert_eq!((rows[6][st_az], rows[6][st_status]), ("", "undetermined"));
+        assert_eq!((rows[7][st_az], rows[7][st_status]), ("", "lost"));
     }
 
     #[test]

@@ -91,18 +91,9 @@ const NAV_FLAG_NAMES: [(u16, &str); 9] = [
 
 /// The latest solution for people: each angle with its 1-sigma.
 pub fn latest_json(nav: &NavSolution) -> Value {
-    let [roll, pitch, heading] = nav.attitude.map(f64::from);
-    let [s_roll, s_pitch, s_heading] = nav.attitude_std.map(f64::from);
+    let [roll, pitch, _] = nav.attitude.map(f64::from);
+    let [s_roll, s_pitch, _] = nav.attitude_std.map(f64::from);
     let [inc, _, _, _, tf, _] = attitude_channels(nav).map(f64::from);
-    let azimuth_status = if !heading.is_finite() || s_heading.is_nan() {
-        "n/a"
-    } else if display::azimuth_is_determined(s_heading) {
-        "determined"
-    } else if nav.flags & nav_flags::HEADING_LOST != 0 {
-        "lost"
-    } else {
-        "undetermined"
-    };
     let flags: Vec<&str> = NAV_FLAG_NAMES
         .iter()
         .filter(|(bit, _)| nav.flags & bit != 0)
@@ -116,7 +107,7 @@ pub fn latest_json(nav: &NavSolution) -> Value {
         "pitch": display::angle_with_sigma(pitch.to_degrees(), s_pitch),
         "inclination": display::angle_with_sigma(inc, s_pitch),
         "azimuth": display::nav_azimuth_text(nav, 3),
-        "azimuth_status": azimuth_status,
+        "azimuth_status": display::AzimuthStatus::of_nav(nav).word(),
         "toolface": display::angle_with_sigma(tf, s_roll),
     })
 }

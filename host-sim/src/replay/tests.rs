@@ -211,8 +211,10 @@ fn the_csv_never_shows_an_undetermined_azimuth_and_reads_0_to_360() {
     determined.solution.attitude_std[2] = 0.01;
     let mut placeholder = row;
     placeholder.solution.attitude = [f32::NAN; 3];
+    let mut lost = row;
+    lost.solution.flags = nav_flags::HEADING_LOST;
     let mut csv = Vec::new();
-    write_csv(&[row, determined, placeholder], &mut csv).unwrap();
+    write_csv(&[row, determined, placeholder, lost], &mut csv).unwrap();
     let text = String::from_utf8(csv).unwrap();
     let cells: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
     let col = |name: &str| cells[0].iter().position(|c| *c == name).unwrap();
@@ -237,6 +239,7 @@ fn the_csv_never_shows_an_undetermined_azimuth_and_reads_0_to_360() {
         (cells[3][az], cells[3][status], cells[3][tf]),
         ("", "n/a", "NaN")
     );
+    assert_eq!((cells[4][az], cells[4][status]), ("", "lost"));
 }
 
 #[test]
