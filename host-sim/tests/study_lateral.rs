@@ -88,15 +88,21 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
         scalar: Scalar::F64,
     };
     let calls = std::sync::atomic::AtomicUsize::new(0);
-    let result = study(&config, &|| {
-        calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    })
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let result = study(
+        &config,
+        &|| {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        },
+        &never,
+    )
     .expect("the study");
     assert_eq!(
         calls.into_inner(),
         3,
         "two runs and one covariance analysis"
     );
+    assert_eq!(result.interrupted, None);
     assert_eq!(result.covariance.len(), 1);
     assert_eq!(result.agreement.len(), 1);
     assert_eq!(result.summaries.len(), 1);
@@ -191,4 +197,46 @@ fn a_navigation_grade_gyro_knows_its_azimuth_far_better_on_the_same_seed() {
     // and its error is inside the sigma it reports (3 sigma: one case)
     let last = b.stations.last().expect("stations");
     assert!(last.error[1].abs().to_degrees() <= 3.0 * sb, "{last:?}");
+}
+
+/// Ctrl-C during a study: the job under way finishes, no other starts, and
+/// the study is over the jobs done and says so (nothing is made up for the
+/// runs not done).
+#[test]
+fn a_study_stopped_after_its_first_job_reports_that_job_and_says_it_was_interrupted() {
+    let config = StudyConfig {
+        grades: vec![Grade::scc1300().expect("built in")],
+        wells: vec![short_well()],
+        runs: 3,
+        first_seed: 5,
+        threads: 1,
+        tie_in_azimuth_sigma: 0.5f64.to_radians(),
+        monte_carlo: true,
+        sweep: None,
+        scalar: Scalar::F64,
+    };
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let result = study(
+        &config,
+        &|| stop.store(true, std::sync::atomic::Ordering::Relaxed),
+        &stop,
+    )
+    .expect("the study");
+    assert_eq!(
+        result.interrupted,
+        Some(host_sim::study::lateral::Interruption {
+            jobs_done: 1,
+            jobs: 4
+        })
+    );
+    // The covariance analysis runs first; no Monte Carlo run was done.
+    assert_eq!(result.covariance.len(), 1);
+    let s = &result.summaries[0];
+    assert_eq!((s.runs, s.stations), (0, 0));
+    assert_eq!(s.td.rms_horizontal_error_m, None);
+    assert_eq!(s.rms_station_azimuth_deg, None);
+    let text = host_sim::study::lateral_table::table(&result);
+    assert!(text.starts_with("INTERRUPTED after 1 of 4 jobs"), "{text}");
+    let json = serde_json::to_value(&result).expect("serializable");
+    assert_eq!(json["interrupted"]["jobs_done"], 1);
 }

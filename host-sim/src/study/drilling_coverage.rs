@@ -25,12 +25,29 @@ pub struct Fraction {
 impl Fraction {
     pub(crate) fn of(inside: usize, total: usize) -> Self {
         let p = (total > 0).then(|| inside as f64 / total as f64);
+        // The binomial (Wald) standard error sqrt(p (1 - p) / n) says 0 at
+        // none or all of n, which no finite count shows: not valid there.
+        let valid = inside > 0 && inside < total;
         Self {
             inside,
             total,
             fraction: p,
-            standard_error: p.map(|p| (p * (1.0 - p) / total as f64).sqrt()),
+            standard_error: p
+                .filter(|_| valid)
+                .map(|p| (p * (1.0 - p) / total as f64).sqrt()),
         }
+    }
+
+    /// "95.0 +- 1.5 % (190/200)"; at none or all of the cases "100.0 %
+    /// (9/9)", without a standard error (not valid there); `None` without
+    /// cases.
+    pub fn text(&self) -> Option<String> {
+        let p = 100.0 * self.fraction?;
+        let (k, n) = (self.inside, self.total);
+        Some(match self.standard_error {
+            Some(se) => format!("{p:.1} +- {:.1} % ({k}/{n})", 100.0 * se),
+            None => format!("{p:.1} % ({k}/{n})"),
+        })
     }
 }
 
@@ -223,16 +240,7 @@ impl StationTally {
 }
 
 fn percent(f: &Fraction) -> String {
-    match (f.fraction, f.standard_error) {
-        (Some(p), Some(se)) => format!(
-            "{:.1} % +- {:.1} % ({} of {})",
-            100.0 * p,
-            100.0 * se,
-            f.inside,
-            f.total
-        ),
-        _ => "undetermined (no cases)".into(),
-    }
+    f.text().unwrap_or_else(|| "undetermined (no cases)".into())
 }
 
 fn opt(v: Option<f64>, unit: &str) -> String {
@@ -307,4 +315,24 @@ pub fn table(s: &Summary) -> String {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Fraction;
+
+    #[test]
+    fn a_fraction_has_a_standard_error_only_where_it_is_valid() {
+        let f = Fraction::of(190, 200);
+        assert_eq!(f.text().as_deref(), Some("95.0 +- 1.5 % (190/200)"));
+        // All or none of n: the binomial formula's 0 is no spread any
+        // finite count shows, so there is none.
+        for (k, text) in [(9, "100.0 % (9/9)"), (0, "0.0 % (0/9)")] {
+            let f = Fraction::of(k, 9);
+            assert_eq!(f.standard_error, None);
+            assert_eq!(f.text().as_deref(), Some(text));
+        }
+        let none = Fraction::of(0, 0);
+        assert_eq!((none.fraction, none.text()), (None, None));
+    }
 }

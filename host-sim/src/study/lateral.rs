@@ -15,11 +15,12 @@ use super::lateral_covariance::{
 };
 use super::lateral_summary::{summarise, GradeWellSummary};
 use super::owsg::OwsgPrediction;
-use super::run_jobs;
+use super::run_jobs_until;
 use crate::sim::{BuiltPlan, Plan};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 
 /// The repository's two laterals (docs/drilling-simulation.md), built in
 /// so the binary works from any directory.
@@ -139,6 +140,9 @@ pub struct LateralStudy {
     /// The navigator's filter scalar.
     pub filter_scalar: Scalar,
     pub wall_s: f64,
+    /// Set when the study was stopped (Ctrl-C) before its last job: every
+    /// figure is then over the jobs done (each summary's `runs`).
+    pub interrupted: Option<Interruption>,
     pub grades: Vec<GradeInfo>,
     pub wells: Vec<WellInfo>,
     /// One per grade and well, grade-major in the order given (empty
@@ -153,6 +157,14 @@ pub struct LateralStudy {
     /// The sweeps, one per well.
     pub sweeps: Vec<SweepResult>,
     pub errors: Vec<String>,
+}
+
+/// How much of a study was done when it was stopped.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
+pub struct Interruption {
+    /// Jobs finished (Monte Carlo runs, covariance analyses, sweep points).
+    pub jobs_done: usize,
+    pub jobs: usize,
 }
 
 /// The OWSG gyro models' predictions on one well.
@@ -178,8 +190,14 @@ enum JobOutcome {
 }
 
 /// Runs the study; `progress` is called after each of the
-/// grades x wells x runs jobs.
-pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<LateralStudy> {
+/// grades x wells x runs jobs. Setting `stop` (Ctrl-C) ends it early: the
+/// runs under way finish, and the study is over the jobs done
+/// ([`LateralStudy::interrupted`]).
+pub fn study(
+    config: &StudyConfig,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<LateralStudy> {
     let started = std::time::Instant::now();
     let mut configs = Vec::new();
     for grade in &config.grades {
@@ -197,30 +215,32 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
     let jobs = job_list(config, &configs)?;
     let sweep_grades = sweep_grades(config)?;
     let length = |c: usize| configs[c].plan.end_md() - configs[c].plan.tie_on.md();
-    let outcomes = run_jobs(jobs.len(), config.threads, progress, |k| match jobs[k] {
-        Job::MonteCarlo(c, r) => {
-            let seed = config.first_seed + r;
-            JobOutcome::Run(run(&configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}")))
-        }
-        Job::Covariance(c) => {
-            let (g, w) = (c / config.wells.len(), c % config.wells.len());
-            JobOutcome::Prediction(predict(
-                &configs[c],
-                &config.grades[g],
-                &config.wells[w].label,
-                length(c),
-                config.first_seed,
-            ))
-        }
-        Job::Sweep(w, i, j) => {
-            let grade = &sweep_grades[i][j];
-            JobOutcome::Prediction(predict(
-                &configs[w],
-                grade,
-                &config.wells[w].label,
-                length(w),
-                config.first_seed,
-            ))
+    let outcomes = run_jobs_until(jobs.len(), config.threads, progress, stop, |k| {
+        match jobs[k] {
+            Job::MonteCarlo(c, r) => {
+                let seed = config.first_seed + r;
+                JobOutcome::Run(run(&configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}")))
+            }
+            Job::Covariance(c) => {
+                let (g, w) = (c / config.wells.len(), c % config.wells.len());
+                JobOutcome::Prediction(predict(
+                    &configs[c],
+                    &config.grades[g],
+                    &config.wells[w].label,
+                    length(c),
+                    config.first_seed,
+                ))
+            }
+            Job::Sweep(w, i, j) => {
+                let grade = &sweep_grades[i][j];
+                JobOutcome::Prediction(predict(
+                    &configs[w],
+                    grade,
+                    &config.wells[w].label,
+                    length(w),
+                    config.first_seed,
+                ))
+            }
         }
     });
     let n = configs.len();
@@ -242,7 +262,13 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
             });
         }
     }
+    let jobs_done = outcomes.iter().flatten().count();
+    let interrupted = (jobs_done < jobs.len()).then_some(Interruption {
+        jobs_done,
+        jobs: jobs.len(),
+    });
     for (job, outcome) in jobs.iter().zip(outcomes) {
+        let Some(outcome) = outcome else { continue };
         match (*job, outcome) {
             (Job::MonteCarlo(c, r), JobOutcome::Run(o)) => {
                 per_config[c].push((config.first_seed + r, o))
@@ -307,6 +333,7 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
         tie_in_azimuth_sigma_deg: config.tie_in_azimuth_sigma.to_degrees(),
         filter_scalar: config.scalar,
         wall_s: started.elapsed().as_secs_f64(),
+        interrupted,
         grades: config
             .grades
             .iter()
@@ -340,13 +367,14 @@ pub fn study(config: &StudyConfig, progress: &(dyn Fn() + Sync)) -> Result<Later
 /// well, the sweep's points; the longest wells first (no long run left
 /// alone at the end while the other cores idle).
 fn job_list(config: &StudyConfig, configs: &[RunConfig]) -> Result<Vec<Job>> {
-    let mut jobs: Vec<Job> = Vec::new();
+    // The covariance analyses first (one run each), so that a study
+    // stopped early has them.
+    let mut jobs: Vec<Job> = (0..configs.len()).map(Job::Covariance).collect();
     if config.monte_carlo {
         for c in 0..configs.len() {
             jobs.extend((0..config.runs as u64).map(|r| Job::MonteCarlo(c, r)));
         }
     }
-    jobs.extend((0..configs.len()).map(Job::Covariance));
     if let Some(grid) = &config.sweep {
         for w in 0..config.wells.len() {
             for i in 0..grid.bias_deg_per_h.len() {

@@ -43,18 +43,9 @@ fn num(v: Option<f64>, decimals: usize) -> String {
     v.map_or_else(|| "-".into(), |v| format!("{v:.decimals$}"))
 }
 
-/// "95.0 +- 1.5 % (190/200)", or "-" without cases.
+/// [`Fraction::text`], or "-" without cases.
 fn fraction(f: &Fraction) -> String {
-    match (f.fraction, f.standard_error) {
-        (Some(p), Some(se)) => format!(
-            "{:.1} +- {:.1} % ({}/{})",
-            100.0 * p,
-            100.0 * se,
-            f.inside,
-            f.total
-        ),
-        _ => "-".into(),
-    }
+    f.text().unwrap_or_else(|| "-".into())
 }
 
 fn met(v: Option<bool>) -> String {
@@ -217,6 +208,12 @@ fn consistency_table(study: &LateralStudy) -> String {
 /// position requirement, then the error growth along MD per grade and well.
 pub fn table(study: &LateralStudy) -> String {
     let mut out = String::new();
+    if let Some(i) = &study.interrupted {
+        out.push_str(&format!(
+            "INTERRUPTED after {} of {} jobs: every figure below is over the runs done (\"runs ok\")\n\n",
+            i.jobs_done, i.jobs
+        ));
+    }
     out.push_str(&format!(
         "stations (azimuth over the determined ones; undetermined/invalid counted; attitude: the larger RMS < {ATTITUDE_LIMIT_DEG} deg, no azimuth withheld)\n"
     ));
@@ -584,6 +581,7 @@ mod tests {
             tie_in_azimuth_sigma_deg: 0.5,
             filter_scalar: Scalar::F64,
             wall_s: 1.0,
+            interrupted: None,
             grades: Vec::new(),
             wells: Vec::new(),
             summaries: vec![summarise(

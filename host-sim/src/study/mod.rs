@@ -16,7 +16,7 @@ pub mod owsg;
 pub mod rins_probe;
 pub mod stats;
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Runs seeds `first_seed..first_seed + runs` on `threads` threads (each
@@ -43,11 +43,30 @@ pub fn run_jobs<T: Send>(
     progress: &(dyn Fn() + Sync),
     job: impl Fn(usize) -> T + Sync,
 ) -> Vec<T> {
+    let never = AtomicBool::new(false);
+    run_jobs_until(jobs, threads, progress, &never, job)
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// The same, until `stop` is set (Ctrl-C): the jobs under way finish, no
+/// other starts; `None` for each job not run.
+pub fn run_jobs_until<T: Send>(
+    jobs: usize,
+    threads: usize,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    job: impl Fn(usize) -> T + Sync,
+) -> Vec<Option<T>> {
     let next = AtomicUsize::new(0);
     let done: Mutex<Vec<(usize, T)>> = Mutex::new(Vec::with_capacity(jobs));
     std::thread::scope(|scope| {
         for _ in 0..threads.max(1) {
             scope.spawn(|| loop {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
                 let k = next.fetch_add(1, Ordering::Relaxed);
                 if k >= jobs {
                     break;
@@ -60,9 +79,11 @@ pub fn run_jobs<T: Send>(
             });
         }
     });
-    let mut done = done.into_inner().unwrap_or_default();
-    done.sort_by_key(|d| d.0);
-    done.into_iter().map(|d| d.1).collect()
+    let mut out: Vec<Option<T>> = (0..jobs).map(|_| None).collect();
+    for (k, outcome) in done.into_inner().unwrap_or_default() {
+        out[k] = Some(outcome);
+    }
+    out
 }
 
 #[cfg(test)]
@@ -82,6 +103,36 @@ mod tests {
         );
         assert_eq!(out, (0..50).map(|k| k * 2).collect::<Vec<_>>());
         assert_eq!(calls.load(Ordering::Relaxed), 50);
+    }
+
+    #[test]
+    fn a_stop_lets_the_jobs_under_way_finish_and_starts_no_other() {
+        let stop = AtomicBool::new(false);
+        let finished = AtomicUsize::new(0);
+        // Stop after the third job is done (the progress call).
+        let out = run_jobs_until(
+            40,
+            2,
+            &|| {
+                if finished.fetch_add(1, Ordering::Relaxed) + 1 == 3 {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            },
+            &stop,
+            |k| k * 2,
+        );
+        assert_eq!(out.len(), 40);
+        let done: Vec<usize> = out.iter().flatten().copied().collect();
+        // The third job and the one the other thread had under way.
+        assert!((3..=4).contains(&done.len()), "{done:?}");
+        assert_eq!(done.len(), finished.load(Ordering::Relaxed));
+        for (k, o) in out.iter().enumerate() {
+            assert!(o.is_none_or(|v| v == k * 2), "job {k}: {o:?}");
+        }
+        let stopped = AtomicBool::new(true);
+        assert!(run_jobs_until(5, 2, &|| {}, &stopped, |k| k)
+            .iter()
+            .all(Option::is_none));
     }
 
     #[test]

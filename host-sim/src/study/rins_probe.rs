@@ -354,16 +354,7 @@ fn deg(v: Option<f64>) -> String {
 }
 
 fn percent(f: &Fraction) -> String {
-    match (f.fraction, f.standard_error) {
-        (Some(p), Some(se)) => format!(
-            "{:.1}+-{:.1} % ({}/{})",
-            100.0 * p,
-            100.0 * se,
-            f.inside,
-            f.total
-        ),
-        _ => "undetermined (no cases)".into(),
-    }
+    f.text().unwrap_or_else(|| "undetermined (no cases)".into())
 }
 
 /// The terminal table: one row per grade and navigator.
