@@ -224,7 +224,7 @@ fn a_study_stopped_after_its_first_job_reports_that_job_and_says_it_was_interrup
     .expect("the study");
     assert_eq!(
         result.interrupted,
-        Some(host_sim::study::lateral::Interruption {
+        Some(host_sim::study::Interruption {
             jobs_done: 1,
             jobs: 4
         })
@@ -239,4 +239,35 @@ fn a_study_stopped_after_its_first_job_reports_that_job_and_says_it_was_interrup
     assert!(text.starts_with("INTERRUPTED after 1 of 4 jobs"), "{text}");
     let json = serde_json::to_value(&result).expect("serializable");
     assert_eq!(json["interrupted"]["jobs_done"], 1);
+}
+
+/// The same for `study drilling-coverage`: one run done of three.
+#[test]
+fn a_coverage_study_stopped_after_its_first_run_is_over_that_run_and_says_so() {
+    let config = RunConfig::new(
+        short_well().plan,
+        0.5f64.to_radians(),
+        Grade::scc1300().expect("built in"),
+    )
+    .expect("run config");
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let summary = host_sim::study::drilling_coverage::study(
+        &config,
+        3,
+        1,
+        1,
+        &|| stop.store(true, std::sync::atomic::Ordering::Relaxed),
+        &stop,
+    );
+    assert_eq!(summary.runs, 1);
+    assert_eq!(
+        summary.interrupted,
+        Some(host_sim::study::Interruption {
+            jobs_done: 1,
+            jobs: 3
+        })
+    );
+    assert!(summary.stations > 0, "{summary:?}");
+    let text = host_sim::study::drilling_coverage::table(&summary);
+    assert!(text.starts_with("INTERRUPTED after 1 of 3 runs"), "{text}");
 }

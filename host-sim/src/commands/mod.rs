@@ -120,6 +120,34 @@ fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> anyhow::
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
+/// A flag the first Ctrl-C (or SIGTERM) sets: a study then finishes the
+/// runs under way and writes what it has. A second one quits at once.
+fn stop_on_ctrl_c(
+    bar: &indicatif::ProgressBar,
+) -> anyhow::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    use anyhow::Context;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let bar = bar.clone();
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        let note = "interrupted: finishing the runs under way, then writing the results so \
+                    far (Ctrl-C again to quit at once, writing nothing)";
+        // A bar that is not drawn (no terminal) prints nothing either.
+        if bar.is_hidden() {
+            eprintln!("{note}");
+        } else {
+            bar.println(note);
+        }
+    })
+    .context("installing the SIGINT/SIGTERM handler")?;
+    Ok(stop)
+}
+
 /// Runs a command; its exit status (only `replay` has others than 0: see
 /// its `--help`).
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {

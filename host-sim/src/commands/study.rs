@@ -94,12 +94,14 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})")
             .context("progress bar")?,
     );
+    let stop = super::stop_on_ctrl_c(&bar)?;
     let summary = study(
         &config,
         args.runs as usize,
         args.first_seed,
         threads,
         &|| bar.inc(1),
+        &stop,
     );
     bar.finish_and_clear();
     outln!(
@@ -119,6 +121,13 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     out!("{}", table(&summary));
     if let Some(path) = &args.json {
         super::write_json(path, &summary)?;
+    }
+    if let Some(i) = summary.interrupted {
+        anyhow::bail!(
+            "interrupted after {} of {} runs: the outputs above hold the runs done",
+            i.jobs_done,
+            i.jobs
+        );
     }
     Ok(())
 }

@@ -12,8 +12,6 @@ use host_sim::study::lateral_figures::plots;
 use host_sim::study::lateral_stations::stations_csv;
 use host_sim::study::lateral_table::{csv, table};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]
 pub enum WellChoice {
@@ -153,7 +151,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
         )
         .context("progress bar")?,
     );
-    let stop = stop_on_ctrl_c(&bar)?;
+    let stop = super::stop_on_ctrl_c(&bar)?;
     let result = study(&config, &|| bar.inc(1), &stop)?;
     bar.finish_and_clear();
     let names: Vec<&str> = config.grades.iter().map(|g| g.name()).collect();
@@ -202,27 +200,4 @@ pub fn run(args: LateralArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// A flag the first Ctrl-C (or SIGTERM) sets: the study then finishes the
-/// runs under way and writes what it has. A second one quits at once.
-fn stop_on_ctrl_c(bar: &indicatif::ProgressBar) -> Result<Arc<AtomicBool>> {
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    let bar = bar.clone();
-    ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::Relaxed) {
-            std::process::exit(130);
-        }
-        let note = "interrupted: finishing the runs under way, then writing the results so \
-                    far (Ctrl-C again to quit at once, writing nothing)";
-        // A bar that is not drawn (no terminal) prints nothing either.
-        if bar.is_hidden() {
-            eprintln!("{note}");
-        } else {
-            bar.println(note);
-        }
-    })
-    .context("installing the SIGINT/SIGTERM handler")?;
-    Ok(stop)
 }

@@ -7,10 +7,12 @@
 
 use super::drilling_run::{run, RunConfig, RunOutcome};
 use super::stats::{median, rms};
+use super::Interruption;
 use crate::survey_listing::drilling::station_valid;
 use crate::survey_listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
+use std::sync::atomic::AtomicBool;
 
 /// A fraction and its binomial standard error.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
@@ -54,7 +56,10 @@ impl Fraction {
 /// The study's results.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Summary {
+    /// The runs done (all of them unless `interrupted`).
     pub runs: usize,
+    /// Set when the study was stopped (Ctrl-C) before its last run.
+    pub interrupted: Option<Interruption>,
     pub failed_runs: Vec<String>,
     pub stations: usize,
     pub invalid_stations: usize,
@@ -97,19 +102,26 @@ pub struct StationCoverage {
 }
 
 /// Runs seeds `first_seed..first_seed + runs` on `threads` threads;
-/// `progress` is called after each run.
+/// `progress` is called after each run. Setting `stop` (Ctrl-C) ends it
+/// early: the runs under way finish, and the summary is over the runs
+/// done ([`Summary::interrupted`]).
 pub fn study(
     config: &RunConfig,
     runs: usize,
     first_seed: u64,
     threads: usize,
     progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
 ) -> Summary {
     let started = std::time::Instant::now();
-    let results = super::run_seeds(runs, first_seed, threads, progress, |seed| {
+    let results = super::run_seeds_until(runs, first_seed, threads, progress, stop, |seed| {
         run(config, seed)
     });
     let mut summary = summarise(&results);
+    summary.interrupted = (results.len() < runs).then_some(Interruption {
+        jobs_done: results.len(),
+        jobs: runs,
+    });
     summary.wall_s = started.elapsed().as_secs_f64();
     summary
 }
@@ -292,7 +304,14 @@ pub fn table(s: &Summary) -> String {
     for e in s.failed_runs.iter().take(5) {
         rows.push(("failed", e.clone()));
     }
-    let mut out: String = rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")).collect();
+    let mut out = String::new();
+    if let Some(i) = &s.interrupted {
+        out.push_str(&format!(
+            "INTERRUPTED after {} of {} runs: every figure below is over the runs done\n\n",
+            i.jobs_done, i.jobs
+        ));
+    }
+    out.extend(rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")));
     out.push_str("\nby station: within 2 sigma (inclination, azimuth where determined, toolface); azimuth error RMS against its median sigma; toolface error mean and RMS against its median sigma\n");
     for c in &s.by_station {
         let short = |f: &Fraction| {

@@ -15,7 +15,7 @@ use super::lateral_covariance::{
 };
 use super::lateral_summary::{summarise, GradeWellSummary};
 use super::owsg::OwsgPrediction;
-use super::run_jobs_until;
+use super::{run_jobs_until, Interruption};
 use crate::sim::{BuiltPlan, Plan};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
@@ -157,14 +157,6 @@ pub struct LateralStudy {
     /// The sweeps, one per well.
     pub sweeps: Vec<SweepResult>,
     pub errors: Vec<String>,
-}
-
-/// How much of a study was done when it was stopped.
-#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
-pub struct Interruption {
-    /// Jobs finished (Monte Carlo runs, covariance analyses, sweep points).
-    pub jobs_done: usize,
-    pub jobs: usize,
 }
 
 /// The OWSG gyro models' predictions on one well.

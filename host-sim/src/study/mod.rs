@@ -19,6 +19,17 @@ pub mod stats;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
+use serde::Serialize;
+
+/// How much of a study was done when it was stopped (Ctrl-C): every
+/// figure of it is then over the jobs done.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
+pub struct Interruption {
+    /// Jobs finished (Monte Carlo runs, covariance analyses, sweep points).
+    pub jobs_done: usize,
+    pub jobs: usize,
+}
+
 /// Runs seeds `first_seed..first_seed + runs` on `threads` threads (each
 /// takes the next seed when done), calling `progress` after each; the
 /// outcomes in seed order, errors as "seed N: ...".
@@ -29,10 +40,27 @@ pub fn run_seeds<T: Send>(
     progress: &(dyn Fn() + Sync),
     run: impl Fn(u64) -> anyhow::Result<T> + Sync,
 ) -> Vec<(u64, Result<T, String>)> {
-    run_jobs(runs, threads, progress, |k| {
+    let never = AtomicBool::new(false);
+    run_seeds_until(runs, first_seed, threads, progress, &never, run)
+}
+
+/// The same, until `stop` is set ([`run_jobs_until`]): the outcomes of
+/// the seeds done, in seed order.
+pub fn run_seeds_until<T: Send>(
+    runs: usize,
+    first_seed: u64,
+    threads: usize,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    run: impl Fn(u64) -> anyhow::Result<T> + Sync,
+) -> Vec<(u64, Result<T, String>)> {
+    run_jobs_until(runs, threads, progress, stop, |k| {
         let seed = first_seed + k as u64;
         (seed, run(seed).map_err(|e| format!("seed {seed}: {e:#}")))
     })
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// Runs `jobs` jobs on `threads` threads (each takes the next job when
