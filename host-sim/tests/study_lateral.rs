@@ -25,6 +25,21 @@ fn short_well() -> Well {
     }
 }
 
+/// A study of the SCC1300 on [`short_well`], from seed 5.
+fn scc1300_on_the_short_well(runs: usize, threads: usize) -> StudyConfig {
+    StudyConfig {
+        grades: vec![Grade::scc1300().expect("built in")],
+        wells: vec![short_well()],
+        runs,
+        first_seed: 5,
+        threads,
+        tie_in_azimuth_sigma: 0.5f64.to_radians(),
+        monte_carlo: true,
+        sweep: None,
+        scalar: Scalar::F64,
+    }
+}
+
 /// One run of the 100 m lateral as planned (30 m/h, 5 min stills).
 fn one_run(grade: &Grade, seed: u64) -> RunOutcome {
     let well = Well::builtin("100m", &Default::default()).expect("built in");
@@ -76,17 +91,7 @@ fn a_bad_grade_file_is_refused_naming_the_file_and_the_field() {
 
 #[test]
 fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
-    let config = StudyConfig {
-        grades: vec![Grade::scc1300().expect("built in")],
-        wells: vec![short_well()],
-        runs: 2,
-        first_seed: 5,
-        threads: 2,
-        tie_in_azimuth_sigma: 0.5f64.to_radians(),
-        monte_carlo: true,
-        sweep: None,
-        scalar: Scalar::F64,
-    };
+    let config = scc1300_on_the_short_well(2, 2);
     let calls = std::sync::atomic::AtomicUsize::new(0);
     let never = std::sync::atomic::AtomicBool::new(false);
     let result = study(
@@ -204,17 +209,7 @@ fn a_navigation_grade_gyro_knows_its_azimuth_far_better_on_the_same_seed() {
 /// runs not done).
 #[test]
 fn a_study_stopped_after_its_first_job_reports_that_job_and_says_it_was_interrupted() {
-    let config = StudyConfig {
-        grades: vec![Grade::scc1300().expect("built in")],
-        wells: vec![short_well()],
-        runs: 3,
-        first_seed: 5,
-        threads: 1,
-        tie_in_azimuth_sigma: 0.5f64.to_radians(),
-        monte_carlo: true,
-        sweep: None,
-        scalar: Scalar::F64,
-    };
+    let config = scc1300_on_the_short_well(3, 1);
     let stop = std::sync::atomic::AtomicBool::new(false);
     let result = study(
         &config,
