@@ -373,10 +373,10 @@ pub struct Replayer {
 enum Awaiting {
     /// Its row, by row number.
     Row(usize),
-    /// Its row was forgotten before the probe's solution came (a capture
-    /// whose navigation frames come late or not at all): the comparison
-    /// still counts.
-    Forgotten(ReplayRow),
+    /// Its row (row number `number`) was forgotten before the probe's
+    /// solution came (a capture whose navigation frames come late or not
+    /// at all): the comparison still counts.
+    Forgotten { number: usize, row: ReplayRow },
 }
 
 /// What the commands need to know of the current run.
@@ -590,7 +590,10 @@ impl Replayer {
                 self.run.lost_since_nav = false;
                 match self.awaiting_probe.remove(&on_board.sample_counter) {
                     Some(Awaiting::Row(index)) => self.compare(index, &on_board),
-                    Some(Awaiting::Forgotten(mut row)) => self.compare_row(&mut row, &on_board),
+                    Some(Awaiting::Forgotten { number, mut row }) => {
+                        self.compare_row(&mut row, &on_board);
+                        self.note_newest(number, row);
+                    }
                     None => {
                         self.early_probe.insert(on_board.sample_counter, on_board);
                     }
@@ -835,6 +838,11 @@ impl Replayer {
         };
         self.compare_row(&mut row, on_board);
         self.rows[at] = row;
+        self.note_newest(index, row);
+    }
+
+    /// Row number `index` changed: the newest row is kept apart too.
+    fn note_newest(&mut self, index: usize, row: ReplayRow) {
         if self.rows_replayed() == index + 1 {
             self.last_row = Some(row);
         }
@@ -922,7 +930,7 @@ impl Replayer {
             let counter = row.solution.sample_counter;
             if let Some(a) = self.awaiting_probe.get_mut(&counter) {
                 if matches!(*a, Awaiting::Row(i) if i == number) {
-                    *a = Awaiting::Forgotten(row);
+                    *a = Awaiting::Forgotten { number, row };
                 }
             }
         }
