@@ -121,16 +121,18 @@ fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> anyhow::
 }
 
 /// A flag the first Ctrl-C (or SIGTERM) sets: a study then finishes the
-/// runs under way and writes what it has. A second one quits at once.
+/// runs under way and writes what it has. A second one quits at once. The
+/// note goes above `bar` when it is drawn (one bar for the whole study),
+/// else to standard error.
 fn stop_on_ctrl_c(
-    bar: &indicatif::ProgressBar,
+    bar: Option<&indicatif::ProgressBar>,
 ) -> anyhow::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
     use anyhow::Context;
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
-    let bar = bar.clone();
+    let bar = bar.filter(|b| !b.is_hidden()).cloned();
     ctrlc::set_handler(move || {
         if flag.swap(true, Ordering::Relaxed) {
             std::process::exit(130);
@@ -138,10 +140,9 @@ fn stop_on_ctrl_c(
         let note = "interrupted: finishing the runs under way, then writing the results so \
                     far (Ctrl-C again to quit at once, writing nothing)";
         // A bar that is not drawn (no terminal) prints nothing either.
-        if bar.is_hidden() {
-            eprintln!("{note}");
-        } else {
-            bar.println(note);
+        match &bar {
+            Some(bar) => bar.println(note),
+            None => eprintln!("{note}"),
         }
     })
     .context("installing the SIGINT/SIGTERM handler")?;

@@ -94,7 +94,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})")
             .context("progress bar")?,
     );
-    let stop = super::stop_on_ctrl_c(&bar)?;
+    let stop = super::stop_on_ctrl_c(Some(&bar))?;
     let summary = study(
         &config,
         args.runs as usize,
@@ -196,6 +196,8 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
         |t| t as usize,
     );
     let mut summaries = Vec::new();
+    // One bar per grade: the note goes to standard error.
+    let stop = super::stop_on_ctrl_c(None)?;
     for name in names {
         let grade = GRADES[match name {
             GradeName::Scc1300 => 0,
@@ -224,6 +226,7 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
             args.first_seed,
             threads,
             &|| bar.inc(1),
+            &stop,
         ));
         bar.finish_and_clear();
     }
@@ -245,6 +248,9 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     out!("{}", table(&summaries));
     if let Some(path) = &args.json {
         super::write_json(path, &summaries)?;
+    }
+    if stop.load(std::sync::atomic::Ordering::Relaxed) {
+        anyhow::bail!("interrupted: the outputs above hold the runs done");
     }
     Ok(())
 }

@@ -151,7 +151,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
         )
         .context("progress bar")?,
     );
-    let stop = super::stop_on_ctrl_c(&bar)?;
+    let stop = super::stop_on_ctrl_c(Some(&bar))?;
     let result = study(&config, &|| bar.inc(1), &stop)?;
     bar.finish_and_clear();
     let names: Vec<&str> = config.grades.iter().map(|g| g.name()).collect();

@@ -20,6 +20,7 @@
 use super::drilling_coverage::Fraction;
 use super::drilling_run::{raw, tie_in};
 use super::stats::{percentile, rms};
+use super::Interruption;
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey_listing::drilling::azimuth_usable;
 use anyhow::Result;
@@ -33,6 +34,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
+use std::sync::atomic::AtomicBool;
 
 /// A gyro grade: the SCC1300's gyro errors divided by `factor`.
 #[derive(Clone, Copy, Debug, Serialize, PartialEq)]
@@ -299,6 +301,9 @@ pub struct GradeSummary {
     /// and |error| <= 3 sigma.
     pub last_reference_sigma_at_most_reference: Fraction,
     pub last_reference_within_3_sigma: Fraction,
+    /// Set when the study was stopped (Ctrl-C) before this grade's last
+    /// run: its figures are over the runs done.
+    pub interrupted: Option<Interruption>,
     pub wall_s: f64,
 }
 
@@ -326,25 +331,33 @@ fn summarise(
         with_reference: td_summary(&with),
         last_reference_sigma_at_most_reference: Fraction::of(bounded, last.len()),
         last_reference_within_3_sigma: within(&last, 3.0),
+        interrupted: None,
         wall_s: 0.0,
     }
 }
 
 /// Runs seeds `first_seed..first_seed + runs` of `config` on `threads`
-/// threads; `progress` is called after each run.
+/// threads; `progress` is called after each run. Setting `stop` (Ctrl-C)
+/// ends it early: the runs under way finish, and the summary is over the
+/// runs done ([`GradeSummary::interrupted`]).
 pub fn study(
     config: &ProbeConfig,
     runs: usize,
     first_seed: u64,
     threads: usize,
     progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
 ) -> GradeSummary {
     let started = std::time::Instant::now();
-    let results = super::run_seeds(runs, first_seed, threads, progress, |seed| {
+    let results = super::run_seeds_until(runs, first_seed, threads, progress, stop, |seed| {
         run(config, seed)
     });
     let outcomes: Vec<_> = results.into_iter().map(|r| r.1).collect();
     let mut summary = summarise(config.grade, config.reference_sigma, &outcomes);
+    summary.interrupted = (outcomes.len() < runs).then_some(Interruption {
+        jobs_done: outcomes.len(),
+        jobs: runs,
+    });
     summary.wall_s = started.elapsed().as_secs_f64();
     summary
 }
@@ -388,6 +401,12 @@ pub fn table(summaries: &[GradeSummary]) -> String {
             s.failed_runs.len(),
             s.wall_s
         );
+        if let Some(i) = &s.interrupted {
+            out += &format!(
+                "{:<11} INTERRUPTED after {} of {} runs: its figures are over the runs done\n",
+                s.grade.name, i.jobs_done, i.jobs
+            );
+        }
     }
     out
 }
