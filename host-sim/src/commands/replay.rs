@@ -242,6 +242,10 @@ fn replay_file(
     let stations = Some((station_rows.to_vec(), station_summary));
     let sink = out.as_mut().map(|w| w as &mut dyn Write);
     replayer.write_settled(sink, true).map_err(csv_error)?;
+    // The header alone (no raw frame) was never flushed with rows.
+    if let Some(w) = out.as_mut() {
+        w.flush().map_err(csv_error)?;
+    }
     let step_losses = replayer.step_losses().to_vec();
     let commands = replayer.commands().to_vec();
     let rows = replayer.rows_replayed();
