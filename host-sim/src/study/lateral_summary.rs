@@ -120,6 +120,10 @@ pub struct GradeWellSummary {
     /// Flagged invalid (not counted anywhere else).
     pub invalid_stations: usize,
     pub azimuth_undetermined_stations: usize,
+    /// Of those, the ones the probe flagged heading lost (station bit 8:
+    /// lost since the tie-in, only a new one brings it back); the others
+    /// were never found (before the tie-in).
+    pub azimuth_lost_stations: usize,
     /// Ended because the gyros saw the tool turn while the still detector
     /// saw none (`station_flags::MOTION_SEEN`: a slide too smooth for the
     /// detector); counted with the others too.
@@ -260,6 +264,9 @@ pub fn summarise(
                 .push((st.error[0].abs().to_degrees(), sd[0].to_degrees()));
             if st.survey.flags & station_flags::AZIMUTH_UNDETERMINED != 0 || !sd[1].is_finite() {
                 s.azimuth_undetermined_stations += 1;
+                if st.survey.flags & station_flags::HEADING_LOST != 0 {
+                    s.azimuth_lost_stations += 1;
+                }
                 tally.undetermined += 1;
             } else {
                 let e = st.error[1].abs();
@@ -472,6 +479,25 @@ mod tests {
         // leaves the position requirement unmet whatever the figures
         assert_eq!(s.requirement.attitude_met, Some(false));
         assert_eq!(s.requirement.position_met, Some(false));
+    }
+
+    #[test]
+    fn undetermined_azimuths_are_counted_and_the_lost_ones_told_apart() {
+        let mut run = outcome(1, [3.0, 4.0], 1.0);
+        let mut never_found = station(3, 0.0, 0.5);
+        never_found.survey.flags = station_flags::AZIMUTH_UNDETERMINED;
+        let mut lost = station(4, 0.0, 0.5);
+        lost.survey.flags = station_flags::AZIMUTH_UNDETERMINED | station_flags::HEADING_LOST;
+        let mut lost_by_sigma = station(5, 0.0, f32::INFINITY);
+        lost_by_sigma.survey.flags = station_flags::HEADING_LOST;
+        run.stations.extend([never_found, lost, lost_by_sigma]);
+        let s = summarise("g", "w", 100.0, &[(1, Ok(run))]);
+        assert_eq!(s.stations, 5);
+        assert_eq!(
+            (s.azimuth_undetermined_stations, s.azimuth_lost_stations),
+            (3, 2)
+        );
+        assert_eq!(s.azimuth_within_2_sigma.total, 2, "the determined ones");
     }
 
     #[test]

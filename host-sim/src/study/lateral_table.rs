@@ -62,7 +62,10 @@ fn station_row(s: &GradeWellSummary) -> Vec<String> {
         s.well.clone(),
         format!("{}/{}", s.runs - s.failed_runs.len(), s.runs),
         s.stations.to_string(),
-        format!("{}/{}", s.azimuth_undetermined_stations, s.invalid_stations),
+        format!(
+            "{} ({})/{}",
+            s.azimuth_undetermined_stations, s.azimuth_lost_stations, s.invalid_stations
+        ),
         num(s.rms_station_azimuth_deg, 3),
         fraction(&s.azimuth_within_2_sigma),
         num(s.rms_station_inclination_deg, 3),
@@ -215,7 +218,7 @@ pub fn table(study: &LateralStudy) -> String {
         ));
     }
     out.push_str(&format!(
-        "stations (azimuth over the determined ones; undetermined/invalid counted; attitude: the larger RMS < {ATTITUDE_LIMIT_DEG} deg, no azimuth withheld)\n"
+        "stations (azimuth over the determined ones; undetermined (of them lost since the tie-in)/invalid counted; attitude: the larger RMS < {ATTITUDE_LIMIT_DEG} deg, no azimuth withheld)\n"
     ));
     let rows: Vec<Vec<String>> = study.summaries.iter().map(station_row).collect();
     out.push_str(&aligned(
@@ -224,7 +227,7 @@ pub fn table(study: &LateralStudy) -> String {
             "well",
             "runs ok",
             "stations",
-            "undet/inv",
+            "undet (lost)/inv",
             "azi RMS (deg)",
             "azi within 2 sigma",
             "inc RMS (deg)",
@@ -446,6 +449,7 @@ pub fn csv(study: &LateralStudy) -> String {
         "stations",
         "invalid_stations",
         "azimuth_undetermined_stations",
+        "azimuth_lost_stations",
         "motion_seen_stations",
         "rms_station_azimuth_deg",
         "azimuth_within_2_sigma",
@@ -508,6 +512,7 @@ pub fn csv(study: &LateralStudy) -> String {
             s.stations.to_string(),
             s.invalid_stations.to_string(),
             s.azimuth_undetermined_stations.to_string(),
+            s.azimuth_lost_stations.to_string(),
             s.motion_seen_stations.to_string(),
             f(s.rms_station_azimuth_deg),
             f(s.azimuth_within_2_sigma.fraction),
