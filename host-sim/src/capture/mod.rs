@@ -11,6 +11,7 @@ use std::path::Path;
 use anyhow::Context;
 use mwd_core::earth::Position;
 use mwd_core::probe::{Navigator, TieIn};
+use mwd_core::protocol::bytes::OutOfRoom;
 use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
 use mwd_core::protocol::uplink::Reply;
 use mwd_core::protocol::{Decoder, DecoderStats, Frame, FrameEncoder, MAX_WIRE_LEN};
@@ -112,24 +113,24 @@ impl<W: Write> CaptureWriter<W> {
 
     /// Encodes and writes one frame.
     pub fn write(&mut self, payload: &Payload) -> io::Result<()> {
-        let mut buf = [0u8; MAX_WIRE_LEN];
-        let n = self
-            .encoder
-            .encode(payload, &mut buf)
-            .map_err(|_| io::Error::other("frame larger than MAX_WIRE_LEN"))?;
-        self.out.write_all(&buf[..n])?;
-        self.bytes += n as u64;
-        Ok(())
+        self.write_encoded("frame", |encoder, buf| encoder.encode(payload, buf))
     }
 
     /// Encodes and writes a reply to an uplink command (kind 5), numbered
     /// in the same sequence as the frames, as the probe numbers it.
     pub fn write_reply(&mut self, reply: &Reply) -> io::Result<()> {
+        self.write_encoded("reply", |encoder, buf| encoder.encode_reply(reply, buf))
+    }
+
+    /// Writes what `encode` puts in a wire-sized buffer (a `what`).
+    fn write_encoded(
+        &mut self,
+        what: &str,
+        encode: impl FnOnce(&mut FrameEncoder, &mut [u8]) -> Result<usize, OutOfRoom>,
+    ) -> io::Result<()> {
         let mut buf = [0u8; MAX_WIRE_LEN];
-        let n = self
-            .encoder
-            .encode_reply(reply, &mut buf)
-            .map_err(|_| io::Error::other("reply larger than MAX_WIRE_LEN"))?;
+        let n = encode(&mut self.encoder, &mut buf)
+            .map_err(|_| io::Error::other(format!("{what} larger than MAX_WIRE_LEN")))?;
         self.out.write_all(&buf[..n])?;
         self.bytes += n as u64;
         Ok(())
@@ -257,16 +258,21 @@ impl Capture {
     /// `on_new` sees each as it comes.
     pub fn feed(&mut self, decoder: &mut Decoder, bytes: &[u8], mut on_new: impl FnMut(Received)) {
         stream::feed(decoder, bytes, |item| {
-            match item {
-                Item::Frame(frame) => self.frames.push(frame),
-                Item::Reply { seq, reply } => self.replies.push(CapturedReply {
-                    after_frames: self.frames.len(),
-                    seq,
-                    reply,
-                }),
-            }
+            self.push(item);
             on_new(item.received());
         });
+    }
+
+    /// Keeps one good item, in order.
+    fn push(&mut self, item: Item) {
+        match item {
+            Item::Frame(frame) => self.frames.push(frame),
+            Item::Reply { seq, reply } => self.replies.push(CapturedReply {
+                after_frames: self.frames.len(),
+                seq,
+                reply,
+            }),
+        }
     }
 }
 
@@ -306,14 +312,7 @@ pub fn decode_reader(reader: impl Read) -> io::Result<Capture> {
     let mut stream = FrameStream::new(reader);
     let mut capture = Capture::default();
     while let Some(item) = stream.next_item()? {
-        match item {
-            Item::Frame(frame) => capture.frames.push(frame),
-            Item::Reply { seq, reply } => capture.replies.push(CapturedReply {
-                after_frames: capture.frames.len(),
-                seq,
-                reply,
-            }),
-        }
+        capture.push(item);
     }
     capture.stats = *stream.stats();
     Ok(capture)
@@ -371,62 +370,60 @@ pub fn write_csv(frames: &[Frame], mut out: impl Write) -> io::Result<()> {
 
 /// Writes one frame as a row of the CSV export (after [`CSV_HEADER`]).
 pub fn write_csv_row(frame: &Frame, mut out: impl Write) -> io::Result<()> {
-    {
-        let (kind, body) = match &frame.payload {
-            Payload::Raw(r) => ("raw", raw_csv(r)),
-            Payload::Nav(n) => {
-                let mut cells = format!(",{},{}", n.time_us, n.sample_counter);
-                cells += &empties(RAW_COLS);
-                cells += &join([n.mode as u32, n.flags as u32]);
-                cells += &join(&n.attitude[..2]);
-                cells += &azimuth_cells(n);
-                cells += &join(n.velocity_ned);
-                cells += &join([n.latitude, n.longitude]);
-                cells += &join(
-                    std::iter::once(&n.height)
-                        .chain(&n.attitude_std)
-                        .chain(&n.velocity_std)
-                        .chain(&n.position_std_ned),
-                );
-                cells += &empties(EVENT_COLS + STATION_COLS);
-                ("nav", cells)
-            }
-            Payload::Event(e) => {
-                let mut cells = format!(",{},", e.time_us);
-                cells += &empties(RAW_COLS + NAV_COLS);
-                cells += &join([
-                    e.kind.to_byte() as u32,
-                    e.part as u32,
-                    e.code as u32,
-                    e.value,
-                ]);
-                cells += &empties(STATION_COLS);
-                ("event", cells)
-            }
-            Payload::Station(st) => {
-                // The end sample goes in the sample_counter column.
-                let mut cells = format!(",{},{}", st.time_us, st.end_sample);
-                cells += &empties(RAW_COLS + NAV_COLS + EVENT_COLS);
-                cells += &join([
-                    u32::from(st.station),
-                    u32::from(st.flags),
-                    st.start_sample,
-                    st.end_sample,
-                ]);
-                cells += &join([st.angles[0]]);
-                cells += &station_azimuth_cells(st);
-                cells += &join(
-                    [st.angles[2]]
-                        .iter()
-                        .chain(&st.angles_std)
-                        .chain(&st.correlations)
-                        .chain([&st.still_quality]),
-                );
-                ("station", cells)
-            }
-        };
-        writeln!(out, "{},{kind}{body}", frame.seq)
-    }
+    let (kind, body) = match &frame.payload {
+        Payload::Raw(r) => ("raw", raw_csv(r)),
+        Payload::Nav(n) => {
+            let mut cells = format!(",{},{}", n.time_us, n.sample_counter);
+            cells += &empties(RAW_COLS);
+            cells += &join([n.mode as u32, n.flags as u32]);
+            cells += &join(&n.attitude[..2]);
+            cells += &azimuth_cells(n);
+            cells += &join(n.velocity_ned);
+            cells += &join([n.latitude, n.longitude]);
+            cells += &join(
+                std::iter::once(&n.height)
+                    .chain(&n.attitude_std)
+                    .chain(&n.velocity_std)
+                    .chain(&n.position_std_ned),
+            );
+            cells += &empties(EVENT_COLS + STATION_COLS);
+            ("nav", cells)
+        }
+        Payload::Event(e) => {
+            let mut cells = format!(",{},", e.time_us);
+            cells += &empties(RAW_COLS + NAV_COLS);
+            cells += &join([
+                e.kind.to_byte() as u32,
+                e.part as u32,
+                e.code as u32,
+                e.value,
+            ]);
+            cells += &empties(STATION_COLS);
+            ("event", cells)
+        }
+        Payload::Station(st) => {
+            // The end sample goes in the sample_counter column.
+            let mut cells = format!(",{},{}", st.time_us, st.end_sample);
+            cells += &empties(RAW_COLS + NAV_COLS + EVENT_COLS);
+            cells += &join([
+                u32::from(st.station),
+                u32::from(st.flags),
+                st.start_sample,
+                st.end_sample,
+            ]);
+            cells += &join([st.angles[0]]);
+            cells += &station_azimuth_cells(st);
+            cells += &join(
+                [st.angles[2]]
+                    .iter()
+                    .chain(&st.angles_std)
+                    .chain(&st.correlations)
+                    .chain([&st.still_quality]),
+            );
+            ("station", cells)
+        }
+    };
+    writeln!(out, "{},{kind}{body}", frame.seq)
 }
 
 /// The azimuth and its status ([`AzimuthStatus`]): in [0, 2 pi) rad when
