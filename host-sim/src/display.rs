@@ -31,17 +31,7 @@ pub fn azimuth_is_determined(sigma_rad: f64) -> bool {
 /// decimals, "undetermined" when its sigma says so, "n/a" for a
 /// placeholder.
 pub fn azimuth_text(azimuth_rad: f64, sigma_rad: f64, decimals: usize) -> String {
-    if !azimuth_rad.is_finite() || sigma_rad.is_nan() {
-        "n/a".to_string()
-    } else if !azimuth_is_determined(sigma_rad) {
-        "undetermined".to_string()
-    } else {
-        format!(
-            "{:.decimals$} +- {:.decimals$} deg (1 sigma)",
-            deg_0_360(azimuth_rad),
-            sigma_rad.to_degrees()
-        )
-    }
+    AzimuthStatus::of_sigma(azimuth_rad, sigma_rad).text(azimuth_rad, sigma_rad, decimals)
 }
 
 /// "12.345 +- 0.050" (deg), "n/a" for a NaN value or sigma.
@@ -58,13 +48,8 @@ pub fn angle_with_sigma(value_deg: f64, sigma_rad: f64) -> String {
 /// when the heading was lost since the last tie-in (only a new one brings
 /// it back, unlike a heading the alignment has not found yet).
 pub fn station_azimuth_text(s: &StationSurvey) -> String {
-    if s.flags & station_flags::HEADING_LOST != 0 {
-        HEADING_LOST_TEXT.to_string()
-    } else if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
-        "undetermined".to_string()
-    } else {
-        azimuth_text(f64::from(s.angles[1]), f64::from(s.angles_std[1]), 3)
-    }
+    let (azimuth, sigma) = (f64::from(s.angles[1]), f64::from(s.angles_std[1]));
+    AzimuthStatus::of_station(s).text(azimuth, sigma, 3)
 }
 
 /// An azimuth whose heading was lost since the last tie-in (station and
@@ -72,15 +57,11 @@ pub fn station_azimuth_text(s: &StationSurvey) -> String {
 pub const HEADING_LOST_TEXT: &str = "undetermined (heading lost: needs a tie-in)";
 
 /// A navigation frame's azimuth for people: [`azimuth_text`], with the
-/// reason when its infinite sigma is a heading lost since the last tie-in
-/// (navigation bit 8).
+/// reason when it is undetermined because the heading was lost since the
+/// last tie-in (navigation bit 8).
 pub fn nav_azimuth_text(nav: &NavSolution, decimals: usize) -> String {
-    let sigma = f64::from(nav.attitude_std[2]);
-    if nav.flags & nav_flags::HEADING_LOST != 0 && sigma.is_infinite() {
-        HEADING_LOST_TEXT.to_string()
-    } else {
-        azimuth_text(f64::from(nav.attitude[2]), sigma, decimals)
-    }
+    let (azimuth, sigma) = (f64::from(nav.attitude[2]), f64::from(nav.attitude_std[2]));
+    AzimuthStatus::of_nav(nav).text(azimuth, sigma, decimals)
 }
 
 /// What an azimuth is, as the CSV exports and the dashboard say beside it
@@ -98,34 +79,52 @@ pub enum AzimuthStatus {
 }
 
 impl AzimuthStatus {
-    /// A navigation frame's.
-    pub fn of_nav(nav: &NavSolution) -> Self {
-        let (azimuth, sigma) = (f64::from(nav.attitude[2]), f64::from(nav.attitude_std[2]));
-        if !azimuth.is_finite() || sigma.is_nan() {
+    /// From the azimuth and its 1-sigma alone (rad): a placeholder (NaN),
+    /// determined ([`azimuth_is_determined`]) or undetermined.
+    pub fn of_sigma(azimuth_rad: f64, sigma_rad: f64) -> Self {
+        if !azimuth_rad.is_finite() || sigma_rad.is_nan() {
             Self::Placeholder
-        } else if azimuth_is_determined(sigma) {
+        } else if azimuth_is_determined(sigma_rad) {
             Self::Determined
-        } else if nav.flags & nav_flags::HEADING_LOST != 0 {
-            Self::Lost
         } else {
             Self::Undetermined
         }
     }
 
-    /// A station survey's: its flags can call an azimuth undetermined (or
-    /// lost) whatever its sigma.
+    /// A navigation frame's: undetermined after a heading lost since the
+    /// last tie-in is lost.
+    pub fn of_nav(nav: &NavSolution) -> Self {
+        let (azimuth, sigma) = (f64::from(nav.attitude[2]), f64::from(nav.attitude_std[2]));
+        match Self::of_sigma(azimuth, sigma) {
+            Self::Undetermined if nav.flags & nav_flags::HEADING_LOST != 0 => Self::Lost,
+            status => status,
+        }
+    }
+
+    /// A station survey's: its flags call an azimuth lost or undetermined
+    /// whatever its sigma.
     pub fn of_station(s: &StationSurvey) -> Self {
-        let (azimuth, sigma) = (f64::from(s.angles[1]), f64::from(s.angles_std[1]));
-        if !azimuth.is_finite() || sigma.is_nan() {
-            Self::Placeholder
-        } else if s.flags & station_flags::HEADING_LOST != 0 {
+        if s.flags & station_flags::HEADING_LOST != 0 {
             Self::Lost
-        } else if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0
-            || !azimuth_is_determined(sigma)
-        {
+        } else if s.flags & station_flags::AZIMUTH_UNDETERMINED != 0 {
             Self::Undetermined
         } else {
-            Self::Determined
+            Self::of_sigma(f64::from(s.angles[1]), f64::from(s.angles_std[1]))
+        }
+    }
+
+    /// The azimuth for people in this status: "123.46 +- 1.23 deg (1
+    /// sigma)" with `decimals` decimals when determined, else "n/a",
+    /// "undetermined" or [`HEADING_LOST_TEXT`], never a number.
+    fn text(self, azimuth_rad: f64, sigma_rad: f64, decimals: usize) -> String {
+        match self {
+            Self::Determined => format!(
+                "{:.decimals$} +- {:.decimals$} deg (1 sigma)",
+                deg_0_360(azimuth_rad),
+                sigma_rad.to_degrees()
+            ),
+            Self::Lost => HEADING_LOST_TEXT.to_string(),
+            status => status.word().to_string(),
         }
     }
 
