@@ -240,7 +240,7 @@ pub fn run(
                 latest = Some(solution);
             }
         });
-        if let Err(e) = replayer.write_settled(sink(&mut sinks.csv), false) {
+        if let Err(e) = replayer.write_settled(sinks.csv.as_deref_mut(), false) {
             break StreamEnd::OutputFailed(e);
         }
         let due = last_shown.is_none_or(|t| t.elapsed() >= options.display_interval);
@@ -255,19 +255,11 @@ pub fn run(
     };
     // Raw frames the replay held for their navigation frame are replayed.
     replayer.end_of_stream();
-    let end = match replayer.write_settled(sink(&mut sinks.csv), true) {
+    let end = match replayer.write_settled(sinks.csv.as_deref_mut(), true) {
         Err(e) if !matches!(end, StreamEnd::OutputFailed(_)) => StreamEnd::OutputFailed(e),
         _ => end,
     };
     outcome(decoder, capture, replayer, end)
-}
-
-/// The CSV sink, reborrowed for one call.
-fn sink<'s>(csv: &'s mut Option<&mut dyn Write>) -> Option<&'s mut dyn Write> {
-    match csv {
-        Some(w) => Some(&mut **w),
-        None => None,
-    }
 }
 
 fn outcome(

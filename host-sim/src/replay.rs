@@ -311,6 +311,11 @@ pub fn replayed_station_links(
 /// wait for their navigation frame before they are replayed without it.
 pub const SETTLE_AFTER_SAMPLES: usize = 64;
 
+/// How many items a replay of a file takes between writing out (and
+/// forgetting) its settled rows ([`Replayer::write_settled`]): no one
+/// waits for a file's rows, so they go in batches.
+pub const FILE_BATCH_ITEMS: usize = 4096;
+
 /// The replay one frame at a time, for a live stream: a raw frame is
 /// replayed as soon as the probe's navigation frame of its sample (or a
 /// later one) has come, which places it among the commands' replies (see
@@ -940,7 +945,11 @@ impl Replayer {
     /// Writes the settled rows (all of them when `all`: the stream ended)
     /// to `csv` as CSV rows, flushed, and forgets them: a replay streaming
     /// its rows out keeps only the ones still settling.
-    pub fn write_settled(&mut self, csv: Option<&mut dyn Write>, all: bool) -> io::Result<()> {
+    pub fn write_settled(
+        &mut self,
+        csv: Option<&mut (dyn Write + '_)>,
+        all: bool,
+    ) -> io::Result<()> {
         let rows = self.settled_rows(all);
         if let Some(out) = csv {
             if !rows.is_empty() {

@@ -226,15 +226,14 @@ fn replay_file(
         replayer.knows_sent_command(*seq, command);
     }
     let mut summary = CaptureSummary::default();
-    let mut since_written = 0;
+    let mut items = 0usize;
     while let Some(item) = capture.next_item()? {
         summary.note(item.received());
         replayer.push_received(item.received());
-        since_written += 1;
-        if since_written == 4096 {
+        items += 1;
+        if items % replay::FILE_BATCH_ITEMS == 0 {
             let sink = out.as_mut().map(|w| w as &mut dyn Write);
             replayer.write_settled(sink, false).map_err(csv_error)?;
-            since_written = 0;
         }
     }
     summary.stats = *capture.stats();

@@ -7,7 +7,7 @@ use super::limits::number_in;
 use super::survey::{Args, Resolved};
 use anyhow::{bail, Context, Result};
 use host_sim::capture::{Item, ProbeCaptureFile};
-use host_sim::replay::{replayed_station_links, Replayer};
+use host_sim::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use host_sim::survey_error::Site;
 use host_sim::survey_listing::depth_log::DepthLog;
 use host_sim::survey_listing::drilling::AzimuthSigmaTrack;
@@ -187,18 +187,15 @@ fn read_stations(path: &Path, resolved: &Resolved) -> Result<CaptureStations> {
     let mut azimuth_sigma_before = Vec::new();
     // A station frame sent again (on request) starts where the first did.
     let mut starts: HashMap<(u16, u32), Option<f64>> = HashMap::new();
-    let mut since_forgotten = 0;
+    let mut items = 0usize;
     while let Some(item) = capture.next_item()? {
         if let Item::Frame(frame) = &item {
             match &frame.payload {
                 Payload::Nav(n) => track.push(n),
                 Payload::Station(st) => {
-                    let key = (st.station, st.start_sample);
-                    let sigma = match starts.get(&key) {
-                        Some(sigma) => *sigma,
-                        None => track.station_start(st),
-                    };
-                    starts.insert(key, sigma);
+                    let sigma = *starts
+                        .entry((st.station, st.start_sample))
+                        .or_insert_with(|| track.station_start(st));
                     stations.push(*st);
                     azimuth_sigma_before.push(sigma);
                 }
@@ -206,11 +203,10 @@ fn read_stations(path: &Path, resolved: &Resolved) -> Result<CaptureStations> {
             }
         }
         replayer.push_received(item.received());
-        since_forgotten += 1;
-        if since_forgotten == 4096 {
-            replayer.settled_rows(false);
-            replayer.forget_settled();
-            since_forgotten = 0;
+        items += 1;
+        if items % FILE_BATCH_ITEMS == 0 {
+            // No CSV here: the rows are only forgotten (never fails).
+            replayer.write_settled(None, false)?;
         }
     }
     let links = replayed_station_links(&mut replayer, &stations);
