@@ -118,10 +118,7 @@ pub fn study(
         run(config, seed)
     });
     let mut summary = summarise(&results);
-    summary.interrupted = (results.len() < runs).then_some(Interruption {
-        jobs_done: results.len(),
-        jobs: runs,
-    });
+    summary.interrupted = Interruption::of(results.len(), runs);
     summary.wall_s = started.elapsed().as_secs_f64();
     summary
 }

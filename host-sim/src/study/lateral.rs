@@ -254,11 +254,7 @@ pub fn study(
             });
         }
     }
-    let jobs_done = outcomes.iter().flatten().count();
-    let interrupted = (jobs_done < jobs.len()).then_some(Interruption {
-        jobs_done,
-        jobs: jobs.len(),
-    });
+    let interrupted = Interruption::of(outcomes.iter().flatten().count(), jobs.len());
     for (job, outcome) in jobs.iter().zip(outcomes) {
         let Some(outcome) = outcome else { continue };
         match (*job, outcome) {

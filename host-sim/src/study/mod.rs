@@ -30,6 +30,14 @@ pub struct Interruption {
     pub jobs: usize,
 }
 
+impl Interruption {
+    /// The interruption of a study that did `jobs_done` of its `jobs`,
+    /// `None` when it did them all.
+    pub fn of(jobs_done: usize, jobs: usize) -> Option<Self> {
+        (jobs_done < jobs).then_some(Self { jobs_done, jobs })
+    }
+}
+
 /// Runs seeds `first_seed..first_seed + runs` on `threads` threads (each
 /// takes the next seed when done), calling `progress` after each; the
 /// outcomes in seed order, errors as "seed N: ...".

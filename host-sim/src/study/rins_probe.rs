@@ -354,10 +354,7 @@ pub fn study(
     });
     let outcomes: Vec<_> = results.into_iter().map(|r| r.1).collect();
     let mut summary = summarise(config.grade, config.reference_sigma, &outcomes);
-    summary.interrupted = (outcomes.len() < runs).then_some(Interruption {
-        jobs_done: outcomes.len(),
-        jobs: runs,
-    });
+    summary.interrupted = Interruption::of(outcomes.len(), runs);
     summary.wall_s = started.elapsed().as_secs_f64();
     summary
 }
