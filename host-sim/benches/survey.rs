@@ -18,7 +18,7 @@
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{criterion_group, criterion_main, Criterion};
-use host_sim::survey_error::{self, Site, Station as ErrStation};
+use host_sim::survey::iscwsa::{self, Site, Station as ErrStation};
 use mwd_core::survey::{positions, TieOn, TrueNorth, TrueStation};
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -106,17 +106,15 @@ impl Measurement for CpuTime {
 }
 
 fn bench_survey(c: &mut Criterion) {
-    let terms = survey_error::load_term_table(
+    let terms = iscwsa::load_term_table(
         &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/mwd_rev5_model_terms.csv"),
     )
     .expect("term table");
     let stations = well();
     let err_stations = with_tvd(&stations);
-    survey_error::check_stations(&err_stations).expect("valid survey");
+    iscwsa::check_stations(&err_stations).expect("valid survey");
     let site = site();
-    assert!(survey_error::run(&terms, &err_stations, &site)
-        .missing
-        .is_empty());
+    assert!(iscwsa::run(&terms, &err_stations, &site).missing.is_empty());
     let mut group = c.benchmark_group("survey_10001");
     group.sample_size(20);
     group.warm_up_time(Duration::from_millis(500));
@@ -129,12 +127,12 @@ fn bench_survey(c: &mut Criterion) {
         })
     });
     group.bench_function("covariance", |b| {
-        b.iter(|| survey_error::run(black_box(&terms), black_box(&err_stations), &site))
+        b.iter(|| iscwsa::run(black_box(&terms), black_box(&err_stations), &site))
     });
     group.bench_function("positions_and_covariance", |b| {
         b.iter(|| {
             let s = with_tvd(black_box(&stations));
-            survey_error::run(black_box(&terms), &s, &site)
+            iscwsa::run(black_box(&terms), &s, &site)
         })
     });
     group.finish();
@@ -142,7 +140,7 @@ fn bench_survey(c: &mut Criterion) {
 
 /// The same covariance benches in on-CPU time.
 fn bench_survey_cpu(c: &mut Criterion<CpuTime>) {
-    let terms = survey_error::load_term_table(
+    let terms = iscwsa::load_term_table(
         &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/mwd_rev5_model_terms.csv"),
     )
     .expect("term table");
@@ -154,12 +152,12 @@ fn bench_survey_cpu(c: &mut Criterion<CpuTime>) {
     group.warm_up_time(Duration::from_millis(500));
     group.measurement_time(Duration::from_secs(5));
     group.bench_function("covariance", |b| {
-        b.iter(|| survey_error::run(black_box(&terms), black_box(&err_stations), &site))
+        b.iter(|| iscwsa::run(black_box(&terms), black_box(&err_stations), &site))
     });
     group.bench_function("positions_and_covariance", |b| {
         b.iter(|| {
             let s = with_tvd(black_box(&stations));
-            survey_error::run(black_box(&terms), &s, &site)
+            iscwsa::run(black_box(&terms), &s, &site)
         })
     });
     group.finish();

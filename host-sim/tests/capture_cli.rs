@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use host_sim::capture::{self, CaptureWriter};
+use host_sim::formats::capture::{self, CaptureWriter};
 use mwd_core::protocol::Payload;
 
 const HOST_SIM: &str = env!("CARGO_BIN_EXE_host-sim");

@@ -160,7 +160,7 @@ fn a_replayed_capture_streams_to_its_end_and_a_reconnect_resumes() {
 /// A capture of 100 s with three stations whose azimuth is determined,
 /// and the depth log that pairs them with MD.
 fn capture_with_stations(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
-    use host_sim::capture::CaptureWriter;
+    use host_sim::formats::capture::CaptureWriter;
     use mwd_core::protocol::frame::station_flags;
     use mwd_core::protocol::{Payload, RawSample, StationSurvey};
     let mut writer = CaptureWriter::new(Vec::new());

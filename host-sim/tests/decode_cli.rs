@@ -4,7 +4,7 @@
 
 use std::process::Command;
 
-use host_sim::capture::{CaptureWriter, SiSample};
+use host_sim::formats::capture::{CaptureWriter, SiSample};
 use mwd_core::protocol::example;
 
 #[test]

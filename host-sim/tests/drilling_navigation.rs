@@ -2,7 +2,7 @@
 //! the drilling simulator's samples go through `mwd_core::probe::Navigator`
 //! as raw frames, the navigator is tied in at the end of its levelling, and
 //! its station surveys are compared with the simulator's truth.
-use host_sim::capture::{raw_sample_from_si, SiSample};
+use host_sim::formats::capture::{raw_sample_from_si, SiSample};
 use host_sim::sim::plan::Plan;
 use host_sim::sim::{DeterministicErrors, DrillState, Drilling, DrillingSimulator, SensorModel};
 use mwd_core::calibration::{GyroCalibration, ProbeCalibration, TriadCalibration};

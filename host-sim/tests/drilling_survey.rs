@@ -6,11 +6,11 @@
 mod common;
 
 use common::{run, s, scratch};
-use host_sim::survey_error::Site;
-use host_sim::survey_listing::depth_log::DepthLog;
-use host_sim::survey_listing::drilling::{survey, survey_terms};
-use host_sim::survey_listing::drilling_text::listing;
-use host_sim::survey_listing::TieOnInput;
+use host_sim::formats::depth_log::DepthLog;
+use host_sim::survey::iscwsa::Site;
+use host_sim::survey::listing::drilling::{survey, survey_terms};
+use host_sim::survey::listing::drilling_text::listing;
+use host_sim::survey::listing::TieOnInput;
 use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::StationSurvey;
 use std::path::{Path, PathBuf};

@@ -11,7 +11,7 @@
 //! well #1 and 4.6e-4 m^2 on well #2, tests/data/iscwsa/README.md). A value
 //! passes if it is within `abs_tol` or within REL_TOL of the reference.
 
-use host_sim::survey_error::{
+use host_sim::survey::iscwsa::{
     check_stations, load_term_table, run, run_with, Cov6, ErrorTerm, ModelResult, Options, Site,
     Station,
 };

@@ -1,7 +1,7 @@
 //! Controllability / observability on systems with known answers, then the
 //! MGWD static alignment problem.
 
-use host_sim::observability::matrices::*;
+use host_sim::alignment::observability::matrices::*;
 use mwd_core::conventions::{dcm_from_quat, quat_from_euler, Euler};
 use mwd_core::earth::{gravity_n, Position};
 use mwd_core::error_model::{

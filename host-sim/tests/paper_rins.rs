@@ -1,8 +1,8 @@
-//! The redundant-RINS reproduction (`host_sim::rins`, `host-sim paper
+//! The redundant-RINS reproduction (`host_sim::paper::rins`, `host-sim paper
 //! rins`) against the checks. Each 120 h scenario runs once (~9 s
 //! in the debug test build) and its results are shared by the tests.
 
-use host_sim::rins::{run, Results, Scenario};
+use host_sim::paper::rins::{run, Results, Scenario};
 use mwd_core::conventions::DEG;
 use std::process::Command;
 use std::sync::OnceLock;

@@ -10,7 +10,7 @@
 //! equal within their noise (over 1000 runs LS - TLS = 0.14 +- 0.19 percent
 //! points, TLS better in 52 % of runs), so that is what is asserted there.
 
-use host_sim::analysis::paper_tls::{error_percent, monte_carlo, run_once, Experiment};
+use host_sim::paper::tls::{error_percent, monte_carlo, run_once, Experiment};
 
 const RUNS: u64 = 400;
 const ANGLES: [f64; 2] = [0.001, 0.005];

@@ -10,7 +10,7 @@
 mod common;
 
 use common::{refused, run, s, scratch};
-use host_sim::capture::{self, CaptureWriter};
+use host_sim::formats::capture::{self, CaptureWriter};
 use host_sim::replay::commands::CommandOutcome;
 use host_sim::replay::{self, Replayer, StepLossReason};
 use mwd_core::earth::Position;

@@ -1,11 +1,11 @@
-//! The error-state simulation of a rotating INS (`host_sim::rins::system`)
+//! The error-state simulation of a rotating INS (`host_sim::paper::rins::system`)
 //! against the full strapdown mechanization of the same sensor errors and
-//! initial attitude error (`host_sim::rins::strapdown_check`). Spans and
+//! initial attitude error (`host_sim::paper::rins::strapdown_check`). Spans and
 //! rates are shortened for the debug build; `host-sim paper rins
 //! --strapdown-check` runs the long ones.
 
-use host_sim::rins::strapdown_check::{compare, Check, Comparison, System};
-use host_sim::rins::Scenario;
+use host_sim::paper::rins::strapdown_check::{compare, Check, Comparison, System};
+use host_sim::paper::rins::Scenario;
 
 /// Largest difference over the run relative to the largest error, per
 /// quantity. Measured ~4e-4 (1 h, 10 Hz): the error model's first-order

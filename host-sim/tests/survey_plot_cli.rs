@@ -7,7 +7,7 @@
 mod common;
 
 use common::{s, Run};
-use host_sim::survey_listing::plot::{ELLIPSE_COLOUR, SIZE};
+use host_sim::survey::listing::plot::{ELLIPSE_COLOUR, SIZE};
 use std::path::{Path, PathBuf};
 
 fn host_sim(args: &[&str]) -> Run {

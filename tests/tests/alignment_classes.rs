@@ -7,8 +7,8 @@
 //! reproduction gives `--prior-heading 155` for a tool heading 135).
 //! A class fails when its misses show a coverage below 90 % (see
 //! `below_ninety_percent`); every class's figures are printed.
-use host_sim::coarse;
-use host_sim::samples_csv::Record;
+use host_sim::alignment::coarse;
+use host_sim::formats::samples_csv::Record;
 use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory};
 use mwd_core::alignment::AlignmentConfig;
 use mwd_core::conventions::{wrap_pi, DrillingAngles, DEG};

@@ -2,8 +2,8 @@
 //! 2-sigma bounds must cover the actual errors in at least 90 % of 200
 //! seeded trials, and must not be vacuous where the data determine the
 //! answer.
-use host_sim::coarse;
-use host_sim::samples_csv::Record;
+use host_sim::alignment::coarse;
+use host_sim::formats::samples_csv::Record;
 use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory};
 use mwd_core::alignment::{AlignmentConfig, COVERAGE_FACTOR, MAX_DETERMINED_SIGMA};
 use mwd_core::conventions::{wrap_pi, Euler, DEG};

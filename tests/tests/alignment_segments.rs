@@ -4,8 +4,8 @@
 //! indexed run (2 x 300 s, 180 deg apart) keeps both toolfaces and leaves
 //! out no more than the turn and a block either side; every sample is
 //! either in a segment or reported left out with its reason.
-use host_sim::coarse::{self, LeftOutReason, BLOCK};
-use host_sim::samples_csv::Record;
+use host_sim::alignment::coarse::{self, LeftOutReason, BLOCK};
+use host_sim::formats::samples_csv::Record;
 use host_sim::sim::{Motion, SensorModel, SensorSimulator, Trajectory};
 use mwd_core::conventions::{DrillingAngles, DEG};
 use mwd_core::earth::Position;

@@ -4,7 +4,7 @@
 //! navigation frames bit for bit, both through the library and through the
 //! `host-sim replay` summary it backs. No QEMU needed.
 
-use host_sim::capture;
+use host_sim::formats::capture;
 use host_sim::replay::{self, ReplaySummary};
 use mwd_core::earth::Position;
 use mwd_core::protocol::frame::nav_mode;
@@ -101,7 +101,7 @@ fn a_lost_raw_frame_stops_the_comparison_and_a_restart_resumes_it() {
 fn simulated_raw_parts_carry_the_probes_flags() {
     use firmware::app::raw_part;
     use firmware::scc1300::{AccelCounts, Error, GyroCounts, PartReading, Slave};
-    use host_sim::capture::{raw_sample_from_si, SiSample};
+    use host_sim::formats::capture::{raw_sample_from_si, SiSample};
 
     for rate_deg_s in [-400.0, -299.0, 0.5, 299.0, 301.0, 1000.0] {
         let sample = SiSample {

@@ -15,7 +15,7 @@
 
 use hil_mock::source::BodySource;
 use hil_mock::StillProbe;
-use host_sim::capture::{raw_sample_from_si, SiSample};
+use host_sim::formats::capture::{raw_sample_from_si, SiSample};
 use mwd_core::conventions::wrap_pi;
 use mwd_core::earth::LocalEarth;
 use mwd_core::probe::navigator::TILT_SIGMA_LIMIT_RAD;

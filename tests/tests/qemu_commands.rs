@@ -30,7 +30,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use hil_mock::StillProbe;
-use host_sim::capture;
+use host_sim::formats::capture;
 use host_sim::replay::commands::CommandOutcome;
 use host_sim::replay::{self, Replayer};
 use mwd_core::conventions::{wrap_pi, DrillingAngles};

@@ -219,7 +219,7 @@ fn a_simulated_drilling_stream_runs_on_the_qemu_probe_and_replays_bit_for_bit() 
     // The same physics as the host's own capture of the run (`.bin`,
     // quantised from the f64 samples where the stream carries f32): each
     // count within 1 of it, most identical.
-    let host_raws: Vec<RawSample> = host_sim::capture::decode_bytes(&host_capture)
+    let host_raws: Vec<RawSample> = host_sim::formats::capture::decode_bytes(&host_capture)
         .frames
         .iter()
         .filter_map(|f| match f.payload {

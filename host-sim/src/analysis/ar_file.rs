@@ -12,8 +12,8 @@
 //! ```
 
 use super::arfit::{ArFit, ArMethod};
-use super::text_records::excerpt;
 use super::units::Quantity;
+use crate::formats::text_records::excerpt;
 use anyhow::{bail, Context, Result};
 use mwd_core::ar::{Ar4, ArModel};
 use mwd_core::error_model::AugmentedModel;
@@ -134,7 +134,7 @@ impl ArModelEntry {
 /// calibration"), for the AR models of this file and of the sensor-model
 /// file (`sim::model_file`).
 pub mod limits {
-    use crate::analysis::ranges::Range;
+    use crate::formats::ranges::Range;
     use mwd_core::conventions::DEG;
     use mwd_core::sensor_units::{
         ACCEL_LSB_PER_G, ACCEL_RANGE_G, GYRO_LSB_PER_DEG_S, GYRO_RANGE_DEG_S, STANDARD_GRAVITY,
@@ -292,7 +292,7 @@ impl ArModelFile {
 
     /// Loads and checks a model file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::analysis::text_records::read_small_file(path)
+        let text = crate::formats::text_records::read_small_file(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
         Self::parse(&text).with_context(|| format!("in {}", path.display()))
     }

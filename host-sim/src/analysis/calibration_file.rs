@@ -3,7 +3,7 @@
 //! units) and, per gyro, its bias (rad/s). It loads into the correction
 //! types of `mwd_core::calibration`, which the simulator and probe apply.
 
-use super::text_records::excerpt;
+use crate::formats::text_records::excerpt;
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::{GyroCalibration, ProbeCalibration, TriadCalibration};
 use serde::{Deserialize, Serialize};
@@ -81,7 +81,7 @@ impl GyroEntry {
 /// calibration"). A value outside is a unit mistake, a failed fit or a
 /// failed part, never a calibration to load into a probe.
 pub mod limits {
-    use crate::analysis::ranges::Range;
+    use crate::formats::ranges::Range;
     // The probe's own bounds for an uplinked calibration: a file the host
     // accepts, the probe accepts (one place for the numbers).
     use mwd_core::protocol::uplink::fields as probe;
@@ -205,7 +205,7 @@ impl CalibrationFile {
 
     /// Loads a calibration file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::analysis::text_records::read_small_file(path)
+        let text = crate::formats::text_records::read_small_file(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
         Self::parse(&text).with_context(|| format!("in {}", path.display()))
     }

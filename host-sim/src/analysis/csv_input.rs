@@ -4,10 +4,10 @@
 //! the field, so a bad export is found without a debugger; they quote at
 //! most a short excerpt of the input.
 
-use super::text_records::for_each_record;
-pub use super::text_records::{excerpt, name_list};
 use super::units::InputUnit;
-use crate::samples_csv::Record;
+use crate::formats::samples_csv::Record;
+use crate::formats::text_records::for_each_record;
+pub use crate::formats::text_records::{excerpt, name_list};
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use std::io::Read;
@@ -165,7 +165,7 @@ pub fn is_capture(path: &Path) -> bool {
 /// simulated CSV). Samples with a faulty part are left out (and counted on
 /// standard error), as are CRC failures and other corrupt frames.
 pub fn capture_records(path: &Path) -> Result<Vec<Record>> {
-    use crate::capture::{FrameStream, Item};
+    use crate::formats::capture::{FrameStream, Item};
     use mwd_core::protocol::Payload;
     let context = || format!("cannot read capture {}", path.display());
     let file = std::fs::File::open(path).with_context(context)?;

@@ -12,9 +12,13 @@
 //!   gyro biases (paper Table 3), by least squares or total least squares;
 //!   [`six_position`] runs it on a table's columns and makes the file.
 //! - [`tls`]: total least squares and Moore-Penrose reconstruction (TLS
-//!   paper eq. 14-23); [`paper_tls`] reproduces that paper's experiment.
-//! - [`csv_input`], [`text_records`], [`plot`], [`stats`]: file input
-//!   (streamed, bounded lines), SVG plots, chi-square.
+//!   paper eq. 14-23).
+//! - [`csv_input`], [`units`], [`plot`], [`stats`]: the analysis commands'
+//!   column input and units, SVG plots, chi-square.
+//!
+//! Stage 4 of the data's way (see `lib.rs`): uses `formats` (the capture,
+//! the sample CSV, the model files it writes); not `sim` or `replay`, which
+//! it does not need, nor any later stage.
 
 pub mod allan;
 pub mod allan_analysis;
@@ -25,11 +29,8 @@ pub mod arfit;
 pub mod calibration;
 pub mod calibration_file;
 pub mod csv_input;
-pub mod paper_tls;
 pub mod plot;
-pub mod ranges;
 pub mod six_position;
 pub mod stats;
-pub mod text_records;
 pub mod tls;
 pub mod units;

@@ -60,7 +60,7 @@ fn bounds(series: &[Series]) -> Option<((f64, f64), (f64, f64))> {
 
 /// Writes a log-log plot of `series` to an SVG file.
 pub fn loglog_svg(path: &Path, labels: &Labels, series: &[Series]) -> Result<()> {
-    crate::survey_listing::plot::register_font()?;
+    crate::formats::figure::register_font()?;
     let ((x0, x1), (y0, y1)) =
         bounds(series).ok_or_else(|| anyhow!("nothing positive to plot in {}", path.display()))?;
     let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
@@ -137,7 +137,7 @@ pub type Curve<'a> = (&'a str, Vec<(f64, f64)>);
 /// Writes a line plot of `curves` over `x_range` to an SVG file; the y
 /// axis spans the finite values with a 5 % margin.
 pub fn line_svg(path: &Path, labels: &Labels, x_range: Range<f64>, curves: &[Curve]) -> Result<()> {
-    crate::survey_listing::plot::register_font()?;
+    crate::formats::figure::register_font()?;
     let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
     let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
     for (_, pts) in curves {

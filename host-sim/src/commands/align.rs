@@ -1,9 +1,9 @@
 //! `host-sim align`: coarse alignment of a recorded or simulated static file.
 use anyhow::{bail, Context, Result};
+use host_sim::alignment::coarse;
 use host_sim::analysis::calibration_file::CalibrationFile;
 use host_sim::analysis::csv_input::{capture_records, is_capture};
-use host_sim::coarse;
-use host_sim::samples_csv::{self, Record};
+use host_sim::formats::samples_csv::{self, Record};
 use host_sim::sim::{DeterministicErrors, SensorModel, SensorModelFile};
 use mwd_core::alignment::AlignmentConfig;
 use mwd_core::calibration::ProbeCalibration;

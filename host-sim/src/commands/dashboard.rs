@@ -13,8 +13,8 @@ use host_sim::dashboard::server::{self, App};
 use host_sim::dashboard::source::{self, Shared};
 use host_sim::dashboard::state::{DashboardState, SourceInfo, LIMITS};
 use host_sim::dashboard::stations::SurveySetup;
-use host_sim::job::Job;
-use host_sim::survey_listing::depth_log::DepthLog;
+use host_sim::formats::depth_log::DepthLog;
+use host_sim::survey::job::Job;
 use mwd_core::calibration::ProbeCalibration;
 
 #[derive(clap::Args, Debug)]

@@ -7,7 +7,7 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 use anyhow::Context;
-use host_sim::capture::{self, CaptureSummary, Item, ProbeCaptureFile};
+use host_sim::formats::capture::{self, CaptureSummary, Item, ProbeCaptureFile};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {

@@ -3,9 +3,9 @@
 //! on the first 5 s as the paper did and on the whole minute, then shows
 //! what toolface indexing buys; each result next to the truth.
 use anyhow::Result;
-use host_sim::coarse;
-use host_sim::paper_mgwd::COARSE_SAMPLES;
-use host_sim::samples_csv::Record;
+use host_sim::alignment::coarse;
+use host_sim::formats::samples_csv::Record;
+use host_sim::paper::mgwd::COARSE_SAMPLES;
 use host_sim::sim::{DeterministicErrors, Motion, SensorModel, SensorSimulator, Trajectory};
 use mwd_core::alignment::AlignmentConfig;
 use mwd_core::conventions::DEG;
@@ -80,7 +80,7 @@ fn print_setup(traj: &Trajectory) {
         traj.position.height,
         traj.start.roll / DEG,
         traj.start.pitch / DEG,
-        host_sim::display::deg_0_360(traj.start.heading)
+        host_sim::formats::display::deg_0_360(traj.start.heading)
     );
     outln!("Prior heading for the north/south ambiguity: truth + 30 deg.\n");
 }

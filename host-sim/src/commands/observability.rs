@@ -2,8 +2,8 @@
 //! zero-position updates can determine, at one toolface or over toolface
 //! indexing, with a per-state report from the SVD.
 use anyhow::{ensure, Result};
-use host_sim::observability::{analyse, Analysis, Measurements, STATE_NAMES};
-use host_sim::paper_mgwd::PUBLISHED;
+use host_sim::alignment::observability::{analyse, Analysis, Measurements, STATE_NAMES};
+use host_sim::paper::mgwd::PUBLISHED;
 use mwd_core::conventions::{Euler, DEG};
 
 use super::site::SiteArgs;

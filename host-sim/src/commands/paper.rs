@@ -3,7 +3,7 @@
 
 use super::print_out;
 use anyhow::Result;
-use host_sim::analysis::paper_tls::{error_percent, tables, Experiment, TableRow, PAPER_TABLES};
+use host_sim::paper::tls::{error_percent, tables, Experiment, TableRow, PAPER_TABLES};
 use std::fmt::Write;
 
 #[derive(clap::Subcommand, Debug)]

@@ -1,13 +1,13 @@
 //! `host-sim paper mgwd`: the MGWD paper's fine-alignment experiment
 //! (section 4, Figures 13-15) reproduced, ours beside the paper's figures.
-//! The experiment is `host_sim::paper_mgwd`'s; this module reads the
+//! The experiment is `host_sim::paper::mgwd`'s; this module reads the
 //! options and reports.
 
 use anyhow::{Context, Result};
 use host_sim::analysis::ar_file::{ArModelFile, AxisSource};
 use host_sim::analysis::plot::{line_svg, Curve, Labels};
-use host_sim::display::{azimuth_text, deg_0_360};
-use host_sim::paper_mgwd::{
+use host_sim::formats::display::{azimuth_text, deg_0_360};
+use host_sim::paper::mgwd::{
     consistency, ranks, static_test, truth, Consistency, History, Ranks, Settings, StaticTest,
     PUBLISHED,
 };

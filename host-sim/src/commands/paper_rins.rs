@@ -1,10 +1,10 @@
 //! `host-sim paper rins`: the redundant-RINS paper's 120 h semi-physical
 //! simulation (section 4.1, Figures 3-6) reproduced, ours beside the
-//! paper's figures. The experiment is `host_sim::rins`'s; this module reads
+//! paper's figures. The experiment is `host_sim::paper::rins`'s; this module reads
 //! the options and reports.
 
 use anyhow::Result;
-use host_sim::rins::{self, Results, Scenario};
+use host_sim::paper::rins::{self, Results, Scenario};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -72,7 +72,7 @@ pub fn run(args: RinsArgs) -> Result<()> {
     let results = rins::run(&scenario)?;
     let wall = started.elapsed().as_secs_f64();
     if let Some(dir) = &args.plot {
-        host_sim::survey_listing::plot::prepare_dir(dir)?;
+        host_sim::formats::figure::prepare_dir(dir)?;
         let files = rins::plot::write_figures(dir, &results, scenario.failure_hour)?;
         if !args.json {
             outln!("Figures 3-6: {} files in {}", files.len(), dir.display());

@@ -7,8 +7,8 @@
 //! 1 when any command was refused (NAK) or never answered.
 
 use anyhow::{bail, Context, Result};
-use host_sim::display::{reply_text, station_text};
-use host_sim::job::Job;
+use host_sim::formats::display::{reply_text, station_text};
+use host_sim::survey::job::Job;
 use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::uplink::fields::{INDEX_DWELL_S, INDEX_POSITIONS};
 use mwd_core::protocol::uplink::reply::decode_reply_body;

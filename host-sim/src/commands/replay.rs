@@ -19,14 +19,14 @@ use std::time::Duration;
 
 use anyhow::Context;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::capture::{CaptureSummary, ProbeCaptureFile};
-use host_sim::display;
-use host_sim::job::Job;
-use host_sim::live::{self, LiveOptions, LiveSinks};
+use host_sim::formats::capture::{CaptureSummary, ProbeCaptureFile};
+use host_sim::formats::display;
 use host_sim::replay::commands::{decode_uplink_log, CommandRow};
+use host_sim::replay::live::{self, LiveOptions, LiveSinks};
 use host_sim::replay::{
     self, ReplayRow, ReplaySummary, Replayer, StationRow, StationSummary, StepLoss,
 };
+use host_sim::survey::job::Job;
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;

@@ -3,15 +3,15 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::job::Job;
-use host_sim::paper_mgwd::PUBLISHED;
+use host_sim::formats::{capture, samples_csv};
+use host_sim::paper::mgwd::PUBLISHED;
 use host_sim::sim::plan::Vibration;
 use host_sim::sim::stream::SensorStreamWriter;
 use host_sim::sim::{
     DeterministicErrors, Drilling, DrillingSimulator, Motion, Plan, SensorModel, SensorModelFile,
     SensorSimulator, SimSample, Trajectory, Truth,
 };
-use host_sim::{capture, samples_csv};
+use host_sim::survey::job::Job;
 use mwd_core::conventions::{Euler, DEG};
 use mwd_core::earth::Position;
 use mwd_core::probe::TieIn;

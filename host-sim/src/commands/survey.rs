@@ -4,10 +4,10 @@
 use super::limits::number_in;
 use super::site::SiteArgs;
 use anyhow::{bail, Context, Result};
-use host_sim::job::{Job, SurveyJob};
-use host_sim::survey_error::Site;
-use host_sim::survey_listing::separation as sep;
-use host_sim::survey_listing::{
+use host_sim::survey::iscwsa::Site;
+use host_sim::survey::job::{Job, SurveyJob};
+use host_sim::survey::listing::separation as sep;
+use host_sim::survey::listing::{
     self as listing, ellipse::scale_2d, plot, AzimuthReference, KnownModel, LengthUnit, Row,
     StationFile, TieOnInput,
 };
@@ -293,7 +293,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(dir) = &args.plot {
         // refused before any work: a file in the way is the user's mistake
-        plot::prepare_dir(dir)?;
+        host_sim::formats::figure::prepare_dir(dir)?;
     }
     let file = read(&args.stations)?;
     let mut survey = compute(&args, &resolved, &file)?;

@@ -6,12 +6,12 @@
 use super::limits::number_in;
 use super::survey::{Args, Resolved};
 use anyhow::{bail, Context, Result};
-use host_sim::capture::{Item, ProbeCaptureFile};
+use host_sim::formats::capture::{Item, ProbeCaptureFile};
+use host_sim::formats::depth_log::DepthLog;
 use host_sim::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
-use host_sim::survey_error::Site;
-use host_sim::survey_listing::depth_log::DepthLog;
-use host_sim::survey_listing::drilling::AzimuthSigmaTrack;
-use host_sim::survey_listing::{drilling, drilling_text, LengthUnit};
+use host_sim::survey::iscwsa::Site;
+use host_sim::survey::listing::drilling::AzimuthSigmaTrack;
+use host_sim::survey::listing::{drilling, drilling_text, LengthUnit};
 use mwd_core::probe::StationLink;
 use mwd_core::protocol::{DecoderStats, Frame, Payload, StationSurvey};
 use std::collections::HashMap;
@@ -61,7 +61,7 @@ pub fn run(args: &Args, resolved: &Resolved) -> Result<()> {
     // another is a job for another tool.
     if let Some(name) = &resolved.job.error_model {
         let probe = drilling::MODEL_NAME;
-        if host_sim::survey_listing::model(name)?.name != probe {
+        if host_sim::survey::listing::model(name)?.name != probe {
             bail!(
                 "the job's error model {name} is not the probe's ({probe}): a capture survey \
                  (--depth) has the probe's own uncertainty"

@@ -21,7 +21,7 @@ use mwd_core::protocol::uplink::fields::{INDEX_DWELL_S, INDEX_POSITIONS};
 use mwd_core::protocol::uplink::{Command, IndexingProcedure};
 
 use super::source::{lock, CommandBatch, Shared};
-use crate::job::Job;
+use crate::survey::job::Job;
 
 /// How often a page gets an update.
 const UPDATE_INTERVAL: Duration = Duration::from_millis(250);

@@ -18,8 +18,8 @@ use mwd_core::protocol::uplink::{encode_command, Command, Reply, MAX_COMMAND_WIR
 use mwd_core::protocol::{Decoder, Frame, Payload};
 
 use super::state::DashboardState;
-use crate::capture::decode_bytes;
-use crate::display::reply_text;
+use crate::formats::capture::decode_bytes;
+use crate::formats::display::reply_text;
 
 pub type Shared = Arc<Mutex<DashboardState>>;
 

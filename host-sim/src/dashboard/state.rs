@@ -22,7 +22,7 @@ use super::stations::{stations_json, SurveySetup};
 use super::view::{
     attitude_channels, event_text, latest_json, sensor_channels, ATTITUDE_CHANNELS, SENSOR_CHANNELS,
 };
-use crate::survey_listing::drilling::AzimuthSigmaTrack;
+use crate::survey::listing::drilling::AzimuthSigmaTrack;
 
 /// The bounds of the dashboard's buffers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

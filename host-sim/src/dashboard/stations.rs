@@ -6,11 +6,11 @@
 use mwd_core::protocol::StationSurvey;
 use serde_json::{json, Value};
 
-use crate::display;
-use crate::survey_error::{ErrorTerm, Site};
-use crate::survey_listing::depth_log::DepthLog;
-use crate::survey_listing::drilling::{self, DrillingRow};
-use crate::survey_listing::TieOnInput;
+use crate::formats::depth_log::DepthLog;
+use crate::formats::display;
+use crate::survey::iscwsa::{ErrorTerm, Site};
+use crate::survey::listing::drilling::{self, DrillingRow};
+use crate::survey::listing::TieOnInput;
 
 /// What pairing stations with MD needs; `depth: None` lists the stations
 /// only.

@@ -1,7 +1,7 @@
 //! What the dashboard shows of each frame, as JSON for the page: sensor
 //! readings in physical units, the attitude as drilling angles with their
 //! 1-sigma, flags and events in words. The people-facing rules (azimuth
-//! "undetermined", "n/a" for placeholders) are `crate::display`'s.
+//! "undetermined", "n/a" for placeholders) are `crate::formats::display`'s.
 
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::protocol::frame::{nav_flags, EventKind, NO_PART};
@@ -11,8 +11,8 @@ use mwd_core::sensor_units::{
 };
 use serde_json::{json, Value};
 
-use crate::display;
-use crate::live::mode_name;
+use crate::formats::display;
+use crate::replay::live::mode_name;
 
 /// Sensor channels of one sample: both parts' gyro rate (deg/s), both
 /// parts' accelerometer triads in body axes (m/s^2, so that the two parts'

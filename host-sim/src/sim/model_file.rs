@@ -83,7 +83,7 @@ fn ar_from_file(ar: &Option<Ar4File>, unit: f64, quantity: ArQuantity) -> Result
 /// tool"): the SCC1300's datasheet figures (0.86 deg/sqrt(h), 2.1 deg/h,
 /// 100 s) lie well inside; a value outside is a unit mistake.
 pub mod limits {
-    use crate::analysis::ranges::Range;
+    use crate::formats::ranges::Range;
 
     /// Gyro angle random walk.
     pub const ARW_DEG_PER_SQRT_H: Range = Range::new(0.0, 10.0, "deg/sqrt(h)");
@@ -232,7 +232,7 @@ impl SensorModelFile {
     }
 
     pub fn load(path: &std::path::Path, seed: u64) -> Result<SensorModel> {
-        let text = crate::analysis::text_records::read_small_file(path)
+        let text = crate::formats::text_records::read_small_file(path)
             .with_context(|| format!("reading {}", path.display()))?;
         let file: SensorModelFile = serde_json::from_str(&text)
             .with_context(|| format!("{} is not a sensor model JSON", path.display()))?;

@@ -190,27 +190,10 @@ impl AxisErrors {
     }
 }
 
+pub use crate::formats::samples_csv::SimSample;
+
 fn normal(rng: &mut ChaCha8Rng) -> f64 {
     StandardNormal.sample(rng)
-}
-
-/// One output sample of the probe's sensors (body frame, SI), with the truth.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimSample {
-    /// End of the sample interval (s).
-    pub time: f64,
-    /// Measured rates (rad/s); only x and z exist on the probe (y is NaN).
-    pub gyro: Vector3<f64>,
-    /// Measured specific force (m/s^2).
-    pub accel: Vector3<f64>,
-    /// True mean omega_ib^b over the interval (rad/s).
-    pub true_rate: Vector3<f64>,
-    /// True mean specific force over the interval (m/s^2).
-    pub true_accel: Vector3<f64>,
-    /// True attitude at `time`.
-    pub truth: mwd_core::conventions::Euler,
-    /// Six-position runs: the calibration position code (1-6).
-    pub position_code: Option<u8>,
 }
 
 /// Interval means of the ideal rate and specific force.

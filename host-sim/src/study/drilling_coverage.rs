@@ -8,8 +8,8 @@
 use super::drilling_run::{run, RunConfig, RunOutcome};
 use super::stats::{median, rms};
 use super::Interruption;
-use crate::survey_listing::drilling::station_valid;
-use crate::survey_listing::ellipse::scale_2d;
+use crate::survey::listing::drilling::station_valid;
+use crate::survey::listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
 use std::sync::atomic::AtomicBool;

@@ -1,19 +1,19 @@
 //! One seeded run of the drilling-coverage study: a lateral simulated in
 //! process (no files), the probe's `Navigator` driven through it from a
 //! tie-in, its station surveys paired with the truth and surveyed as
-//! `host-sim survey CAPTURE --depth` does ([`crate::survey_listing::drilling`]).
+//! `host-sim survey CAPTURE --depth` does ([`crate::survey::listing::drilling`]).
 //! The gyro grade ([`super::grade`]) decides the sensors: the SCC1300 (the
 //! default) reaches the navigator as the probe's raw frames, as today;
 //! other gyros as calibrated SI samples (`Navigator::step_sample`) with
 //! the navigator modelling their error budget.
 
 use super::grade::Grade;
-use crate::capture::{raw_sample_from_si, SiSample};
+use crate::formats::capture::{raw_sample_from_si, SiSample};
+use crate::formats::depth_log::DepthLog;
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
-use crate::survey_error::{ErrorTerm, Site};
-use crate::survey_listing::depth_log::DepthLog;
-use crate::survey_listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
-use crate::survey_listing::{
+use crate::survey::iscwsa::{ErrorTerm, Site};
+use crate::survey::listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
+use crate::survey::listing::{
     compute, AzimuthReference, InputStation, LengthUnit, StationFile, TieOnInput,
 };
 use anyhow::{anyhow, Context, Result};

@@ -31,8 +31,8 @@
 //! ARW (both are the part's short-term noise).
 
 use crate::analysis::ar_file::{check_ar, ArQuantity};
-use crate::analysis::ranges::Range;
-use crate::analysis::text_records::excerpt;
+use crate::formats::ranges::Range;
+use crate::formats::text_records::excerpt;
 use crate::sim::model_file::Ar4File;
 use crate::sim::{DeterministicErrors, SensorModel};
 use anyhow::{bail, ensure, Context, Result};
@@ -112,7 +112,7 @@ pub struct GradeFile {
 /// mistake. Zero ARW or instability is refused: no gyro has none, and the
 /// filter needs a positive variance in every state.
 pub mod limits {
-    use crate::analysis::ranges::Range;
+    use crate::formats::ranges::Range;
 
     pub const ARW_DEG_PER_SQRT_H: Range = Range::new(1e-6, 10.0, "deg/sqrt(h)");
     pub const BIAS_INSTABILITY_DEG_PER_H: Range = Range::new(1e-6, 1000.0, "deg/h");
@@ -252,7 +252,7 @@ impl Grade {
 
     /// A grade file from disk.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::analysis::text_records::read_small_file(path)
+        let text = crate::formats::text_records::read_small_file(path)
             .with_context(|| format!("reading the grade file {}", path.display()))?;
         Self::parse(&text, &path.display().to_string())
     }
@@ -338,8 +338,8 @@ impl Grade {
         file.title = format!(
             "{} with bias instability {} deg/h and ARW {} deg/sqrt(h)",
             file.title,
-            crate::analysis::ranges::number(bias_instability_deg_per_h),
-            crate::analysis::ranges::number(arw_deg_per_sqrt_h)
+            crate::formats::ranges::number(bias_instability_deg_per_h),
+            crate::formats::ranges::number(arw_deg_per_sqrt_h)
         );
         Self::new(file).context("the swept grade")
     }

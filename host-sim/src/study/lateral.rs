@@ -85,7 +85,7 @@ impl Well {
 
     /// A plan file.
     pub fn load(path: &Path, overrides: &DrillingOverrides) -> Result<Self> {
-        let text = crate::analysis::text_records::read_small_file(path)
+        let text = crate::formats::text_records::read_small_file(path)
             .with_context(|| format!("reading the plan {}", path.display()))?;
         Self::parse(&path.display().to_string(), &text, overrides)
     }

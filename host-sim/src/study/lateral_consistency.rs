@@ -32,7 +32,7 @@
 
 use super::drilling_run::{RunOutcome, StationCheck};
 use super::stats::rms;
-use crate::survey_listing::drilling::azimuth_usable;
+use crate::survey::listing::drilling::azimuth_usable;
 use serde::Serialize;
 use std::collections::BTreeMap;
 

@@ -19,8 +19,10 @@
 //! within the Monte Carlo's spread.
 
 use super::drilling_run::RunOutcome;
-use crate::survey_error::probe_station::{azimuth_chain_correlations, links_in_order, AngleSigma};
-use crate::survey_listing::drilling::azimuth_usable;
+use crate::survey::iscwsa::probe_station::{
+    azimuth_chain_correlations, links_in_order, AngleSigma,
+};
+use crate::survey::listing::drilling::azimuth_usable;
 use serde::Serialize;
 
 /// The station distances the study reports.

@@ -11,7 +11,7 @@ use super::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
 use super::grade::Grade;
 use super::lateral_summary::GradeWellSummary;
 use super::stats::rms;
-use crate::survey_listing::drilling::station_valid;
+use crate::survey::listing::drilling::station_valid;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
 

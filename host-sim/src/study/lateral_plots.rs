@@ -9,7 +9,8 @@
 
 pub mod contour;
 
-use crate::survey_listing::plot::{plot_error, write_svg_png, Figure, FONT, SIZE};
+use crate::formats::figure::{plot_error, write_svg_png, Figure, FONT};
+use crate::survey::listing::plot::SIZE;
 use anyhow::{anyhow, bail, Result};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;

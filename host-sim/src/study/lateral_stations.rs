@@ -5,7 +5,7 @@
 
 use super::drilling_run::RunOutcome;
 use super::lateral_table::csv_field;
-use crate::survey_listing::drilling::{azimuth_determined, station_valid};
+use crate::survey::listing::drilling::{azimuth_determined, station_valid};
 
 /// One station of one run; angles in degrees, errors signed (estimate
 /// less truth, wrapped). Undetermined or invalid values are empty fields

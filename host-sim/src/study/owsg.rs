@@ -1,7 +1,7 @@
 //! The industry's generic gyro survey tool models, OWSG GYRO-MWD and
 //! GYRO-NS (SPE 90408 Tables 1 and 4, as transcribed in
 //! `host-sim/data/owsg_gyro_*_terms.csv`), run by the ISCWSA engine
-//! ([`crate::survey_error`]) on a study well, for the lateral study's
+//! ([`crate::survey::iscwsa`]) on a study well, for the lateral study's
 //! "side by side with the industry's models" column (issue 14).
 //!
 //! Stations are those a drilling run surveys ([`study_stations`]): the
@@ -32,9 +32,9 @@
 //! the note, never printed as a prediction.
 
 use crate::sim::BuiltPlan;
-use crate::survey_error::probe_weighting::MAX_FIRST_ORDER_AZIMUTH_SIGMA_DEG;
-use crate::survey_error::{self, Cov6, ErrorTerm, Site, Station};
-use crate::survey_listing::ellipse::{scale_2d, Ellipse};
+use crate::survey::iscwsa::probe_weighting::MAX_FIRST_ORDER_AZIMUTH_SIGMA_DEG;
+use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site, Station};
+use crate::survey::listing::ellipse::{scale_2d, Ellipse};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Serialize;
 
@@ -86,7 +86,7 @@ impl OwsgModel {
 
     /// The embedded term table.
     pub fn terms(self) -> Result<Vec<ErrorTerm>> {
-        crate::survey_listing::terms(crate::survey_listing::model(self.name())?)
+        crate::survey::listing::terms(crate::survey::listing::model(self.name())?)
     }
 
     /// The stated inclination range, read from the metadata file.
@@ -267,7 +267,7 @@ pub fn predict(model: OwsgModel, plan: &BuiltPlan, site: &Site) -> Result<OwsgPr
 pub fn predict_on(model: OwsgModel, stations: &[Station], site: &Site) -> Result<OwsgPrediction> {
     let terms = model.terms()?;
     let range = model.range()?;
-    survey_error::check_stations(stations).map_err(|e| anyhow!("{}: {e}", model.name()))?;
+    iscwsa::check_stations(stations).map_err(|e| anyhow!("{}: {e}", model.name()))?;
     ensure_two(stations, model)?;
     let outside: Vec<f64> = stations
         .iter()
@@ -369,7 +369,7 @@ fn is_gyro(t: &ErrorTerm) -> bool {
 
 /// The engine's figures on `stations` (at least two).
 fn figures(terms: &[ErrorTerm], stations: &[Station], site: &Site) -> Result<Figures> {
-    let result = survey_error::run(terms, stations, site);
+    let result = iscwsa::run(terms, stations, site);
     if !result.missing.is_empty() {
         bail!(
             "the engine does not implement the weighting of {}",
@@ -443,7 +443,7 @@ fn station_azimuth_sigma(terms: &[ErrorTerm], s: &Station, site: &Site) -> f64 {
             ..*s
         },
     ];
-    let r = survey_error::run(&gyro, &leg, site);
+    let r = iscwsa::run(&gyro, &leg, site);
     let c = r.total[1];
     let (sa, ca) = s.azi.sin_cos();
     // variance along the across-hole horizontal unit vector (-sin A, cos A)

@@ -22,7 +22,7 @@ use super::drilling_run::{raw, tie_in};
 use super::stats::{percentile, rms};
 use super::Interruption;
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
-use crate::survey_listing::drilling::azimuth_usable;
+use crate::survey::listing::drilling::azimuth_usable;
 use anyhow::Result;
 use mwd_core::conventions::{dcm_from_quat, wrap_pi, DrillingAngles};
 use mwd_core::probe::navigator::MAX_STATION_SAMPLES;

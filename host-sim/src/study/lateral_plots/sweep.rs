@@ -8,7 +8,7 @@
 
 use super::contour::{contour_segments, Segment};
 use super::{log_range, tick, Sweep};
-use crate::survey_listing::plot::{plot_error, Figure, FONT};
+use crate::formats::figure::{plot_error, Figure, FONT};
 use anyhow::{bail, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -152,7 +152,7 @@ fn station_azimuth_sigma_matches_the_tables_closed_forms() {
     // B2 cos A / Oh, G1 cos A sin I / Oh, G4 sin A tan I / Oh,
     // RN sqrt(1 - cos^2 A sin^2 I) / (Oh cos I)
     let site = study_site(45.0_f64.to_radians());
-    let oh = survey_error::EARTH_RATE * site.latitude.cos();
+    let oh = iscwsa::EARTH_RATE * site.latitude.cos();
     let terms = OwsgModel::GyroMwd.terms().expect("table");
     let sig = |code: &str| {
         terms
@@ -256,7 +256,7 @@ fn the_engine_at_and_beyond_90_deg() {
             tvd: 2000.0,
             toolface: None,
         };
-        let r = survey_error::run(&terms, &[s(3000.0), s(3028.0)], &site);
+        let r = iscwsa::run(&terms, &[s(3000.0), s(3028.0)], &site);
         let c = r.total[1];
         (c[0] + c[1]).sqrt()
     };

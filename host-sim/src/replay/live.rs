@@ -27,8 +27,8 @@ use mwd_core::protocol::frame::nav_mode;
 use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
-use crate::capture::CaptureSummary;
-use crate::display;
+use crate::formats::capture::CaptureSummary;
+use crate::formats::display;
 use crate::replay::commands::CommandRow;
 use crate::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
 
@@ -234,7 +234,7 @@ pub fn run(
                 break StreamEnd::OutputFailed(e);
             }
         }
-        crate::capture::feed(&mut decoder, &buf[..n], |item| {
+        crate::formats::capture::feed(&mut decoder, &buf[..n], |item| {
             capture.note(item.received());
             if let Some(solution) = replayer.push_received(item.received()) {
                 latest = Some(solution);
@@ -290,7 +290,7 @@ fn outcome(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::capture::CaptureWriter;
+    use crate::formats::capture::CaptureWriter;
     use crate::replay;
     use mwd_core::protocol::frame::raw_flags;
     use mwd_core::protocol::{Payload, RawPart, RawSample};
@@ -366,7 +366,7 @@ mod tests {
             "{}",
             outcome.end
         );
-        let whole = crate::capture::decode_bytes(&bytes);
+        let whole = crate::formats::capture::decode_bytes(&bytes);
         assert_eq!(outcome.capture.stats, whole.stats);
         assert_eq!(outcome.capture.stats.frames[0], 120);
         let (rows, summary) = replay::replay(&whole.frames, Position::paper_site());

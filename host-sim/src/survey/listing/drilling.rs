@@ -2,7 +2,7 @@
 //! the probe's station surveys paired with MD from the surface depth log
 //! by time, positioned by minimum curvature from the tie-on, with their
 //! position covariance from the probe's own station sigmas
-//! ([`crate::survey_error::probe_station`]) and the depth log's scale and
+//! ([`crate::survey::iscwsa::probe_station`]) and the depth log's scale and
 //! stretch errors (the engine's DSF/DST sources); and a continuous
 //! trajectory from the 20 Hz solutions. docs/drilling-survey.md.
 //!
@@ -13,10 +13,10 @@
 //! referenced to the parent well's MD at the window). Either way the depth
 //! errors counted are those of the MD drilled from the tie-on.
 
-use super::depth_log::DepthLog;
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
-use crate::survey_error::probe_station::{angle_covariance, links_in_order, AngleSigma};
-use crate::survey_error::{self, Cov6, ErrorTerm, Site, Station};
+use crate::formats::depth_log::DepthLog;
+use crate::survey::iscwsa::probe_station::{angle_covariance, links_in_order, AngleSigma};
+use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site, Station};
 use anyhow::{anyhow, bail, Result};
 use mwd_core::probe::StationLink;
 use mwd_core::protocol::frame::{nav_flags, nav_mode, station_flags};
@@ -82,7 +82,7 @@ pub fn survey_terms() -> Result<Vec<ErrorTerm>> {
 /// The azimuth 1-sigma the probe reported in its 20 Hz solutions, by
 /// sample counter: the sigma each station's earth-rate updates started
 /// from, for the stations' carried fraction
-/// ([`crate::survey_error::probe_station`]). Empty when the solutions are
+/// ([`crate::survey::iscwsa::probe_station`]). Empty when the solutions are
 /// not at hand: the model then takes each station's start as the previous
 /// station's sigma.
 #[derive(Clone, Debug, Default)]
@@ -377,7 +377,7 @@ pub fn covariance(
     let mut others = vec![[0.0; 6]; valid];
     let mut method = vec![[0.0; 6]; valid];
     if valid > 1 {
-        let result = survey_error::run(terms, &from_tie_on, site);
+        let result = iscwsa::run(terms, &from_tie_on, site);
         if !result.missing.is_empty() {
             bail!(
                 "survey terms not implemented: {}",

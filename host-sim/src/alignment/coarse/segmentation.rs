@@ -12,7 +12,7 @@
 //! (robustly, from the differences of consecutive blocks), so coloured
 //! noise and any sensor are covered. Every sample left out is reported
 //! with its reason.
-use crate::samples_csv::Record;
+use crate::formats::samples_csv::Record;
 use mwd_core::alignment::MAX_SEGMENTS;
 use std::ops::Range;
 

@@ -1,8 +1,8 @@
 //! Coarse alignment of a recorded or simulated static run: calibration,
 //! splitting into static segments (toolface positions), and the core's
 //! levelling and heading estimators, with a report for people.
-use crate::display::{azimuth_is_determined, azimuth_text, deg_0_360};
-use crate::samples_csv::Record;
+use crate::formats::display::{azimuth_is_determined, azimuth_text, deg_0_360};
+use crate::formats::samples_csv::Record;
 use anyhow::{bail, Result};
 use mwd_core::alignment::{
     analytical, gyrocompass, level_segment, AlignmentConfig, HeadingEstimate, LevelEstimate,
@@ -243,7 +243,7 @@ impl CoarseReport {
 /// only separable from earth rate (and printed) with more than one.
 /// `prior_given`: whether a heading prior chose between mirror candidates
 /// (then the text does not ask for one). An undetermined azimuth is never
-/// shown as a number ([`crate::display`]), nor is its mirror candidate.
+/// shown as a number ([`crate::formats::display`]), nor is its mirror candidate.
 pub fn describe_heading(
     h: &HeadingEstimate,
     segments: usize,

@@ -21,8 +21,8 @@ use mwd_core::sensor_units::{
 };
 use mwd_core::timing::sample_time_us;
 
-use crate::display::AzimuthStatus;
-use crate::sim::SimSample;
+use crate::formats::display::AzimuthStatus;
+use crate::formats::samples_csv::SimSample;
 
 mod stream;
 pub use stream::{feed, CaptureSummary, FrameStream, Item, ProbeCaptureFile};
@@ -431,7 +431,7 @@ pub fn write_csv_row(frame: &Frame, mut out: impl Write) -> io::Result<()> {
 fn azimuth_cells(n: &mwd_core::protocol::NavSolution) -> String {
     match AzimuthStatus::of_nav(n) {
         AzimuthStatus::Determined => {
-            let wrapped = crate::display::deg_0_360(f64::from(n.attitude[2])).to_radians();
+            let wrapped = crate::formats::display::deg_0_360(f64::from(n.attitude[2])).to_radians();
             format!(",{},determined", wrapped as f32)
         }
         status => format!(",,{}", status.word()),

@@ -2,13 +2,31 @@
 //! reads until the binary UART capture takes over. One row per 20 Hz sample,
 //! SI units named in the header; the truth columns are present in simulated
 //! files only.
-use crate::analysis::text_records::{excerpt, for_each_record};
-use crate::sim::SimSample;
+use crate::formats::text_records::{excerpt, for_each_record};
 use anyhow::{bail, Context, Result};
 use mwd_core::conventions::Euler;
 use mwd_core::probe_sample::ProbeSample;
 use nalgebra::Vector3;
 use std::io::{Read, Write};
+
+/// One output sample of the probe's sensors (body frame, SI), with the truth.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimSample {
+    /// End of the sample interval (s).
+    pub time: f64,
+    /// Measured rates (rad/s); only x and z exist on the probe (y is NaN).
+    pub gyro: Vector3<f64>,
+    /// Measured specific force (m/s^2).
+    pub accel: Vector3<f64>,
+    /// True mean omega_ib^b over the interval (rad/s).
+    pub true_rate: Vector3<f64>,
+    /// True mean specific force over the interval (m/s^2).
+    pub true_accel: Vector3<f64>,
+    /// True attitude at `time`.
+    pub truth: mwd_core::conventions::Euler,
+    /// Six-position runs: the calibration position code (1-6).
+    pub position_code: Option<u8>,
+}
 
 const MEASURED: [&str; 6] = [
     "time_s",
@@ -74,7 +92,7 @@ pub fn write<W: Write>(mut out: W, samples: impl IntoIterator<Item = SimSample>)
 }
 
 /// Reads a sample CSV as it streams in (separators, quoting, BOM and the
-/// line-length limit of [`crate::analysis::text_records`]), checking every
+/// line-length limit of [`crate::formats::text_records`]), checking every
 /// row; a bad value names its line and column.
 pub fn read<R: Read>(input: R) -> Result<Vec<Record>> {
     let mut header: Option<Header> = None;

@@ -1,7 +1,7 @@
 //! The surface depth log (`time_s,md_m`, as `host-sim simulate --depth-log`
 //! writes it): read, checked, and interpolated in time.
 
-use crate::analysis::text_records::{excerpt, for_each_record};
+use crate::formats::text_records::{excerpt, for_each_record};
 use anyhow::{anyhow, bail, Result};
 use std::io::Read;
 

@@ -4,8 +4,8 @@
 //! physically scaled settings), ZUPT and zero-position updates.
 //! The CLI (`host-sim paper mgwd`) prints and plots what this computes.
 
-use crate::coarse;
-use crate::samples_csv::Record;
+use crate::alignment::coarse;
+use crate::formats::samples_csv::Record;
 use crate::sim::{DeterministicErrors, SensorModel, SensorSimulator, Trajectory};
 use anyhow::Result;
 use mwd_core::alignment::AlignmentConfig;
@@ -341,7 +341,7 @@ pub struct Ranks {
 }
 
 pub fn ranks(coupling: Coupling) -> Ranks {
-    use crate::observability::matrices::{
+    use crate::alignment::observability::matrices::{
         controllability_matrix, dynamic, observability_matrix, observability_matrix_discrete, rank,
         ObservabilityReport,
     };

@@ -240,7 +240,7 @@ impl fmt::Display for CaptureSummary {
             )?;
         }
         for st in &self.stations {
-            write!(f, "\nprobe {}", crate::display::station_text(st))?;
+            write!(f, "\nprobe {}", crate::formats::display::station_text(st))?;
         }
         Ok(())
     }
@@ -249,7 +249,7 @@ impl fmt::Display for CaptureSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::capture::{decode_bytes, without_frame, CaptureWriter, SiSample};
+    use crate::formats::capture::{decode_bytes, without_frame, CaptureWriter, SiSample};
     use mwd_core::protocol::uplink::reply::{Reply, ReplyStatus};
     use std::io::Write;
 

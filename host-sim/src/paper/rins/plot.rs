@@ -2,7 +2,7 @@
 //! survey figures' renderer (`survey_listing::plot::write_svg_png`).
 
 use super::{Record, Results};
-use crate::survey_listing::plot::{plot_error, write_svg_png, Figure, FONT};
+use crate::formats::figure::{plot_error, write_svg_png, Figure, FONT};
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -1,6 +1,6 @@
 //! `host-sim survey`: a station file (CSV) read, positioned by minimum
 //! curvature (`mwd_core::survey`) and, with an error model, given its NEV
-//! covariance and error ellipse at every station ([`crate::survey_error`]).
+//! covariance and error ellipse at every station ([`crate::survey::iscwsa`]).
 //!
 //! Input: a header line, then one station a line. Columns (any order):
 //! `md_m` or `md_ft` (one of them: feet and metres are never mixed, and
@@ -8,15 +8,14 @@
 //! `azi_deg` required; `toolface_deg`, `time_s` optional (carried to the
 //! outputs). Outputs are in metres whatever the input unit.
 
-pub mod depth_log;
 pub mod drilling;
 pub mod drilling_text;
 pub mod ellipse;
 pub mod plot;
 pub mod separation;
 
-use crate::analysis::text_records::{excerpt, for_each_record};
-use crate::survey_error::{self, Cov6, ErrorTerm, Site};
+use crate::formats::text_records::{excerpt, for_each_record};
+use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site};
 use anyhow::{anyhow, bail, Context, Result};
 use ellipse::Ellipse;
 use mwd_core::survey::{positions, GridConvergence, Station, TieOn, TrueNorth};
@@ -309,11 +308,11 @@ pub enum Validity {
     /// This probe's gyrocompass (docs/probe-tool-model.md): every
     /// inclination, but only where (1) the azimuth sensitivity `S =
     /// sqrt(1 - sin^2 I sin^2 A)` is at least
-    /// [`survey_error::probe_weighting::MIN_AZIMUTH_SENSITIVITY`] (below
+    /// [`iscwsa::probe_weighting::MIN_AZIMUTH_SENSITIVITY`] (below
     /// it, a tool near horizontal heading near east or west, the azimuth is
     /// undetermined), and (2) the single-station first-order azimuth sigma
     /// from the model's own gyro terms (`PRB-GN`, `PRB-GXB`, `PRB-GZB`)
-    /// is within [`survey_error::probe_weighting::first_order_azimuth_limit`]
+    /// is within [`iscwsa::probe_weighting::first_order_azimuth_limit`]
     /// (above it the first-order model understates the spread).
     AzimuthSensitivity,
 }
@@ -329,7 +328,7 @@ pub struct Invalid {
 
 /// The gyro error magnitudes of a term table's `PRB-*` terms (rad/s,
 /// root-sum-square over terms of the same weighting function).
-fn probe_gyro_errors(terms: &[ErrorTerm]) -> survey_error::probe_weighting::GyroErrors {
+fn probe_gyro_errors(terms: &[ErrorTerm]) -> iscwsa::probe_weighting::GyroErrors {
     let rss = |name: &str| {
         terms
             .iter()
@@ -338,7 +337,7 @@ fn probe_gyro_errors(terms: &[ErrorTerm]) -> survey_error::probe_weighting::Gyro
             .sum::<f64>()
             .sqrt()
     };
-    survey_error::probe_weighting::GyroErrors {
+    iscwsa::probe_weighting::GyroErrors {
         noise: rss("PRB-GN"),
         bias_x: rss("PRB-GXB"),
         bias_z: rss("PRB-GZB"),
@@ -354,7 +353,7 @@ impl Validity {
                 (row.inc_deg > max).then(|| format!("is stated for inclinations up to {max} deg"))
             }
             Self::AzimuthSensitivity => {
-                use survey_error::probe_weighting as pw;
+                use iscwsa::probe_weighting as pw;
                 let (inc, azi) = (row.inc_deg.to_radians(), row.azi_deg.to_radians());
                 let s = pw::azimuth_sensitivity(inc.sin(), azi.sin());
                 if !pw::azimuth_determined(inc, azi) {
@@ -410,21 +409,21 @@ pub struct KnownModel {
 pub const MODELS: [KnownModel; 4] = [
     KnownModel {
         name: "ISCWSA MWD Rev5",
-        table: include_str!("../../data/mwd_rev5_model_terms.csv"),
+        table: include_str!("../../../data/mwd_rev5_model_terms.csv"),
         file: "mwd_rev5_model_terms.csv",
         validity: Validity::MaxInclination(180.0),
         magnetic: true,
     },
     KnownModel {
         name: "GYRO-MWD",
-        table: include_str!("../../data/owsg_gyro_mwd_terms.csv"),
+        table: include_str!("../../../data/owsg_gyro_mwd_terms.csv"),
         file: "owsg_gyro_mwd_terms.csv",
         validity: Validity::MaxInclination(89.0),
         magnetic: false,
     },
     KnownModel {
         name: "GYRO-NS",
-        table: include_str!("../../data/owsg_gyro_ns_terms.csv"),
+        table: include_str!("../../../data/owsg_gyro_ns_terms.csv"),
         file: "owsg_gyro_ns_terms.csv",
         validity: Validity::MaxInclination(89.0),
         magnetic: false,
@@ -434,7 +433,7 @@ pub const MODELS: [KnownModel; 4] = [
     // (never for the SCC1300 at 120 s stations)
     KnownModel {
         name: "PROBE-SCC1300",
-        table: include_str!("../../data/probe_scc1300_terms.csv"),
+        table: include_str!("../../../data/probe_scc1300_terms.csv"),
         file: "probe_scc1300_terms.csv",
         validity: Validity::AzimuthSensitivity,
         magnetic: false,
@@ -464,7 +463,7 @@ pub fn model(name: &str) -> Result<&'static KnownModel> {
 
 /// The model's terms, parsed from the embedded table.
 pub fn terms(model: &KnownModel) -> Result<Vec<ErrorTerm>> {
-    survey_error::parse_term_table(model.table, model.file).map_err(|e| anyhow!("{e}"))
+    iscwsa::parse_term_table(model.table, model.file).map_err(|e| anyhow!("{e}"))
 }
 
 /// Where a term table read from a file is valid, from its weighting
@@ -492,7 +491,7 @@ pub fn file_validity(terms: &[ErrorTerm]) -> Validity {
 pub fn model_from_file(path: &std::path::Path) -> Result<&'static KnownModel> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).with_context(|| format!("error model file {name}"))?;
-    let terms = survey_error::parse_term_table(&text, &name)
+    let terms = iscwsa::parse_term_table(&text, &name)
         .map_err(|e| anyhow!("error model file {name}: {e}"))?;
     if let Some(t) = terms.iter().find(|t| !t.magnitude_si.is_finite()) {
         bail!(
@@ -502,14 +501,14 @@ pub fn model_from_file(path: &std::path::Path) -> Result<&'static KnownModel> {
         );
     }
     let probe = [
-        survey_error::Station {
+        iscwsa::Station {
             md: 0.0,
             inc: 0.5,
             azi: 0.5,
             tvd: 0.0,
             toolface: None,
         },
-        survey_error::Station {
+        iscwsa::Station {
             md: 30.0,
             inc: 0.5,
             azi: 0.5,
@@ -526,7 +525,7 @@ pub fn model_from_file(path: &std::path::Path) -> Result<&'static KnownModel> {
         latitude: 0.8,
         gyro_noise_reduction: 1.0,
     };
-    let missing = survey_error::run(&terms, &probe, &site).missing;
+    let missing = iscwsa::run(&terms, &probe, &site).missing;
     if !missing.is_empty() {
         // `missing` names the terms; the file's reader wants the functions
         let which: Vec<String> = terms
@@ -581,9 +580,9 @@ pub fn apply_model(
             .map(|reason| Invalid { station: k, reason })
     });
     let valid_to = invalid.as_ref().map_or(rows.len(), |i| i.station);
-    let stations: Vec<survey_error::Station> = rows[..valid_to]
+    let stations: Vec<iscwsa::Station> = rows[..valid_to]
         .iter()
-        .map(|r| survey_error::Station {
+        .map(|r| iscwsa::Station {
             md: r.md_m,
             inc: r.inc_deg.to_radians(),
             azi: r.azi_deg.to_radians(),
@@ -592,8 +591,8 @@ pub fn apply_model(
         })
         .collect();
     if !stations.is_empty() {
-        survey_error::check_stations(&stations).map_err(|e| anyhow!("{e}"))?;
-        let result = survey_error::run(terms, &stations, site);
+        iscwsa::check_stations(&stations).map_err(|e| anyhow!("{e}"))?;
+        let result = iscwsa::run(terms, &stations, site);
         if !result.missing.is_empty() {
             bail!(
                 "error model {}: weighting functions not implemented for {}",

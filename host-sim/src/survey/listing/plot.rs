@@ -2,14 +2,7 @@
 //! vertical section of the well path with the stations' 2-sigma error
 //! ellipses, each written as SVG and PNG.
 //!
-//! The reusable part is [`Figure`] + [`write_svg_png`]: one drawing
-//! function, generic over the plotters backend, rendered once into an SVG
-//! and once into a PNG of the same size. PNG text needs glyphs, so the
-//! DejaVu Sans font is embedded in the binary (`host-sim/assets/fonts/`,
-//! Bitstream Vera licence, which allows redistribution inside other
-//! software; its text is in `LICENSE-DejaVu.txt` beside the font) and
-//! registered with plotters' `ab_glyph` renderer: a machine without system
-//! fonts still gets labelled PNGs.
+//! Rendered through [`crate::formats::figure`] (SVG and PNG of one drawing).
 //!
 //! Ellipses: the 2-sigma ellipse of a 2x2 covariance (k = 2 times the
 //! 1-sigma semi-axes; it holds 1 - e^-2 = 86.5 % of a 2-D normal). In the
@@ -19,8 +12,9 @@
 //! the unit vectors (cos A, sin A, 0) and (0, 0, 1), A the section azimuth.
 
 use super::{LengthUnit, Row};
-use crate::survey_error::Cov6;
-use anyhow::{anyhow, bail, Result};
+use crate::formats::figure::{plot_error, prepare_dir, write_svg_png, Figure, FONT};
+use crate::survey::iscwsa::Cov6;
+use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -29,8 +23,6 @@ use std::path::{Path, PathBuf};
 pub const SIZE: (u32, u32) = (1000, 800);
 /// Ellipse scale: semi-axes are this many 1-sigma.
 pub const SIGMA: f64 = 2.0;
-/// Font family name the embedded font is registered under.
-pub const FONT: &str = "sans-serif";
 /// Stroke colour of the error ellipses (and of nothing else drawn as a
 /// line), so a reader (or a test) can tell them apart in the SVG.
 pub const ELLIPSE_COLOUR: RGBColor = RGBColor(214, 39, 40);
@@ -38,57 +30,6 @@ const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
 const OTHER_COLOUR: RGBColor = RGBColor(44, 160, 44);
 /// Points per ellipse outline.
 const ELLIPSE_POINTS: usize = 73;
-
-static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-
-/// Registers the embedded font as [`FONT`] (once per process). Every
-/// plotters text (SVG layout too) needs it with the `ab_glyph` feature.
-pub fn register_font() -> Result<()> {
-    static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *DONE.get_or_init(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, DEJAVU_SANS).is_ok()
-    });
-    if !ok {
-        bail!("the embedded font DejaVuSans.ttf could not be read");
-    }
-    Ok(())
-}
-
-/// A drawing that can be rendered on any plotters backend.
-pub trait Figure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>;
-}
-
-/// A plotters drawing error as an `anyhow` one.
-pub fn plot_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
-    anyhow!("drawing: {e}")
-}
-
-/// Renders `figure` to `DIR/STEM.svg` and `DIR/STEM.png` (`size` pixels);
-/// returns the two paths.
-pub fn write_svg_png(
-    dir: &Path,
-    stem: &str,
-    size: (u32, u32),
-    figure: &impl Figure,
-) -> Result<[PathBuf; 2]> {
-    register_font()?;
-    let svg = dir.join(format!("{stem}.svg"));
-    let png = dir.join(format!("{stem}.png"));
-    {
-        let root = SVGBackend::new(&svg, size).into_drawing_area();
-        figure.draw(&root)?;
-        root.present()
-            .map_err(|e| anyhow!("writing {}: {e}", svg.display()))?;
-    }
-    {
-        let root = BitMapBackend::new(&png, size).into_drawing_area();
-        figure.draw(&root)?;
-        root.present()
-            .map_err(|e| anyhow!("writing {}: {e}", png.display()))?;
-    }
-    Ok([svg, png])
-}
 
 /// Outline of the `k`-sigma ellipse of the covariance
 /// `[[sxx, sxy], [sxy, syy]]` of (x, y) around `centre`: the eigenvectors
@@ -404,22 +345,10 @@ impl SurveyPlot<'_> {
     }
 }
 
-/// Creates `dir` if missing; an existing non-directory is an error.
-pub fn prepare_dir(dir: &Path) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        bail!(
-            "--plot {}: exists and is not a directory (give a directory for the figures)",
-            dir.display()
-        );
-    }
-    std::fs::create_dir_all(dir)
-        .map_err(|e| anyhow!("--plot {}: cannot create the directory: {e}", dir.display()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::survey_listing::ellipse::Ellipse;
+    use crate::survey::listing::ellipse::Ellipse;
 
     fn close(a: f64, b: f64, tol: f64) {
         assert!((a - b).abs() <= tol, "{a} vs {b}");

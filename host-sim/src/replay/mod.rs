@@ -36,6 +36,7 @@
 //! stops it too and says so.
 
 pub mod commands;
+pub mod live;
 
 use std::collections::{HashMap, VecDeque};
 use std::io::{self, Write};
@@ -53,8 +54,8 @@ use mwd_core::protocol::{
     encode_body, EventKind, Frame, NavSolution, Payload, RawSample, StationSurvey,
 };
 
-use crate::capture::{Capture, Received};
-use crate::display;
+use crate::formats::capture::{Capture, Received};
+use crate::formats::display;
 use commands::{CommandRow, Effect};
 
 /// One replayed solution and how it compares with the probe's own.
@@ -207,7 +208,7 @@ impl std::fmt::Display for StepLoss {
                 } else {
                     "no frame was lost: the replay DIFFERS from the probe"
                 };
-                let name = |mode| crate::live::mode_name(mode).trim_end();
+                let name = |mode| crate::replay::live::mode_name(mode).trim_end();
                 format!(
                     "the probe's navigation mode is {} ({probe_mode}), the replay's {} \
                      ({replay_mode}); {cause}",

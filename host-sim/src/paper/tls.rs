@@ -16,7 +16,7 @@
 //! errors of references and outputs. N serves, as in the paper, both as the
 //! number of calibration samples and as the time of the reported rate.
 
-use super::tls::{fit_row, FitMethod};
+use crate::analysis::tls::{fit_row, FitMethod};
 use anyhow::Result;
 use mwd_core::sensor_units::STANDARD_GRAVITY as G;
 use nalgebra::{DMatrix, DVector, Vector3};

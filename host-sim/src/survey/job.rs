@@ -47,8 +47,8 @@
 //! does not refuse.
 
 use crate::analysis::calibration_file::CalibrationFile;
-use crate::analysis::text_records::read_small_file;
-use crate::survey_listing::{self, LengthUnit};
+use crate::formats::text_records::read_small_file;
+use crate::survey::listing::{self, LengthUnit};
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{DrillingAngles, DEG};
@@ -233,7 +233,7 @@ impl SurveyEntry {
             east: checked("east", t.east)?,
         };
         if let Some(name) = &self.error_model {
-            survey_listing::model(name).context("survey.error_model")?;
+            listing::model(name).context("survey.error_model")?;
         }
         Ok(SurveyJob {
             tie_on,

@@ -42,7 +42,7 @@
 //! undetermined.
 
 use super::Row;
-use crate::survey_error::Cov6;
+use crate::survey::iscwsa::Cov6;
 use anyhow::{anyhow, bail, Result};
 use mwd_core::survey::{Segment, Station, TrueNorth};
 use nalgebra::{Matrix3, Vector3};
@@ -260,7 +260,7 @@ pub fn minimum(seps: &[Separation]) -> Option<(usize, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::survey_listing::{InputStation, Row};
+    use crate::survey::listing::{InputStation, Row};
 
     fn row(md: f64, inc_deg: f64, azi_deg: f64, n: f64, e: f64, v: f64, cov: Option<Cov6>) -> Row {
         Row {

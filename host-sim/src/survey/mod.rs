@@ -1,0 +1,17 @@
+//! Surveys: stations to positions with their uncertainty, the survey of a
+//! drilling capture, and the job file that describes a run.
+//!
+//! Stage 6 of the data's way (see `lib.rs`): uses `formats` (the station
+//! and depth files), `sim` (the simulator's plans where a survey is checked
+//! against its truth) and `replay` (a capture's stations).
+//!
+//! - [`iscwsa`]: the ISCWSA wellbore position-uncertainty model (SPE 67616,
+//!   SPE 90408) and the probe's own tool model.
+//! - [`listing`]: a station file positioned by minimum curvature with its
+//!   NEV covariance and ellipses, a drilling capture's stations paired with
+//!   depth, the listing, its figures, anti-collision.
+//! - [`job`]: the job file (site, tie-in, calibration, tool model).
+
+pub mod iscwsa;
+pub mod job;
+pub mod listing;
