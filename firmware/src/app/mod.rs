@@ -8,16 +8,19 @@
 //! RAM for QEMU; [`power_cut`]: a write cut on purpose, for QEMU's
 //! power-cut test), [`uplink_rx`] receives the host's commands and
 //! [`uplink_service`] answers them from the main loop; [`boot`] packs the
-//! boot event's reset cause and configuration source.
+//! boot event's reset cause and configuration source; [`main_loop`] is
+//! the probe's main loop, the same on every board.
 //! Pure code (no registers, no heap), so the host tests it and every board
 //! binary runs the same logic; a board only supplies the timer interrupt,
-//! its UART ([`Transmitter`]), the sensors' SPI and the watchdog.
+//! its UART ([`Transmitter`]), the sensors' SPI, the watchdog and the
+//! rest of what the main loop needs of it ([`Board`]).
 
 pub mod boot;
 pub mod budget;
 pub mod config_store;
 pub mod cycle;
 pub mod frame_queue;
+pub mod main_loop;
 pub mod power_cut;
 pub mod probe;
 pub mod ram_flash;
@@ -32,10 +35,11 @@ pub mod watchdog;
 
 pub use cycle::{AcquisitionCycle, CycleReport};
 pub use frame_queue::{FrameQueue, TX_QUEUE_LEN};
+pub use main_loop::{Board, Pass};
 pub use probe::{ProbeState, RecoveryJob, Sensors};
 pub use sample_inbox::{SampleInbox, NAV_INBOX_LEN};
 pub use sensor_wire::{fault_code, raw_part, reset_event_code, sensor_fault_event};
 pub use shared::{Shared, SharedProbe, FIRMWARE_VERSION};
 pub use start_up::{start_parts, START_ATTEMPTS};
 pub use transmitter::Transmitter;
-pub use watchdog::WATCHDOG_TIMEOUT_MS;
+pub use watchdog::{Watchdog, WATCHDOG_TIMEOUT_MS};

@@ -15,4 +15,12 @@ pub trait Transmitter {
 
     /// The UART's interrupt: it can take the next byte, if one waits.
     fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>);
+
+    /// No byte waits in the transmitter itself (its buffer is empty). A
+    /// transmitter that cannot tell says so (the default) and its board
+    /// waits for the line itself where it matters
+    /// ([`Board::reboot`](super::main_loop::Board::reboot)).
+    fn is_idle(&self) -> bool {
+        true
+    }
 }

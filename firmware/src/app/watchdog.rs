@@ -8,6 +8,14 @@
 
 use super::budget::WATCHDOG_UNFED_WORST_MS;
 
+/// A board's watchdog, as the main loop feeds it
+/// ([`main_loop`](super::main_loop)); started by the board, with
+/// [`WATCHDOG_TIMEOUT_MS`].
+pub trait Watchdog {
+    /// Restarts the watchdog's count.
+    fn feed(&mut self);
+}
+
 /// LSI frequency range of the STM32F411 (datasheet) and the nominal value
 /// stm32f4xx-hal 0.22 converts with (`watchdog.rs`, `LSI_KHZ`).
 pub const LSI_MIN_HZ: u32 = 17_000;

@@ -8,11 +8,13 @@
 //! - UART0 TX interrupt: moves the next queued byte into the transmitter;
 //!   UART0 RX interrupt: moves each received byte into the uplink's
 //!   bounded inbox (`firmware::app::uplink_rx`), nothing more;
-//! - main loop: start-up, blocking sensor recovery, the navigation on each
-//!   raw sample (navigation frames), then the host's commands
+//! - main loop (`firmware::app::main_loop`, the same on every board):
+//!   start-up, blocking sensor recovery, the navigation on each raw sample
+//!   (navigation frames), then the host's commands
 //!   (`firmware::app::uplink_service`: a bounded number of bytes per pass,
 //!   each command answered on the downlink); feeds the watchdog between
-//!   those steps (`firmware::app::budget`); sleeps otherwise.
+//!   those steps (`firmware::app::budget`); sleeps otherwise. This board
+//!   adds the run's measurements and end at the end of each pass.
 //!
 //! The configuration lives in RAM that survives a reset (`persistent.rs`),
 //! behind the same NOR-flash trait as the real board's flash; the boot
@@ -21,7 +23,7 @@
 //!
 //! What the contexts share and do is `firmware::app::SharedProbe`, as on
 //! the real board; this file adds UART0 as its `Transmitter`, SysTick, the
-//! watchdog and the run's measurements.
+//! watchdog and the run's measurements, and is the main loop's `Board`.
 //!
 //! The run ends after `PROBE_QEMU_RUN_SECONDS` simulated seconds (a
 //! compile-time setting, default 60): the queue is drained, a summary is
@@ -40,22 +42,22 @@ mod stack_paint;
 #[cfg(feature = "qemu-drilling")]
 mod stream_file;
 
-use core::sync::atomic::Ordering;
-
 use core::cell::RefCell;
+use core::convert::Infallible;
+use core::ops::ControlFlow;
+use core::sync::atomic::Ordering;
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception};
 use critical_section::Mutex;
-use firmware::app::boot::boot_event_value;
+use firmware::app::main_loop::{self, Board, Pass};
 use firmware::app::ram_flash::RamNorFlash;
 use firmware::app::uplink_rx::{InboxWriter, UplinkInbox, UplinkStats};
-use firmware::app::uplink_service::{BoardAction, UplinkService};
-use firmware::app::{FrameQueue, SharedProbe, Transmitter, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS};
-use mwd_core::config::ProbeConfig;
-use mwd_core::probe::Navigator;
-use mwd_core::protocol::frame::nav_mode;
+use firmware::app::uplink_service::UplinkService;
+use firmware::app::{
+    FrameQueue, SharedProbe, Transmitter, Watchdog, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS,
+};
 use mwd_core::timing::{SAMPLE_PERIOD_US, SAMPLE_RATE_HZ};
 
 use mock_sensors::{MockBus, TickDelay, TICKS};
@@ -87,11 +89,6 @@ const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
 const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// When the watchdog run (feature `qemu-stall-demo`) hangs its main loop.
 const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
-/// Uplink bytes the main loop takes per pass, once per sample period: the
-/// inbox's capacity, more than the 576 B a period brings at 115200 baud,
-/// so the line is drained as fast as it fills, while a flood costs each
-/// period at most this.
-const UPLINK_BYTES_PER_PASS: usize = firmware::app::uplink_rx::UPLINK_QUEUE_LEN;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
@@ -133,6 +130,10 @@ impl Transmitter for Uart0 {
         self.busy = false;
         self.kick(queue);
     }
+
+    fn is_idle(&self) -> bool {
+        !self.busy
+    }
 }
 
 /// Everything the contexts share.
@@ -172,24 +173,6 @@ pub fn on_uart_rx() {
     });
 }
 
-/// The navigator the configuration asks for (site, calibration and still
-/// settings; its tie-in is applied once the navigator levels, in the main
-/// loop).
-fn navigator_for(config: &ProbeConfig) -> Navigator {
-    Navigator::with_calibration(config.site, config.calibration)
-}
-
-/// Starts the navigation over from `config`. Not inlined: the new
-/// navigator (~9 KiB, most of it the filter's covariance) is built in this
-/// call's frame, not in a second navigator-sized slot of `main`'s frame,
-/// which would stay on the stack under every navigation step (the stack
-/// high-water mark rose by 9 KiB when it did; docs/budgets.md).
-#[inline(never)]
-fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
-    *navigator = navigator_for(config);
-    navigator.apply_still_settings(&config.still);
-}
-
 /// UART0 TX: the transmitter's buffer went empty.
 pub fn on_uart_tx() {
     registers::uart_clear_tx_interrupt();
@@ -215,6 +198,108 @@ struct CycleCost {
     longest_mode_change: u64,
 }
 
+/// The QEMU board as the main loop sees it (`firmware::app::main_loop`):
+/// SysTick's periods for its clock and delay, the CMSDK watchdog, and at
+/// the end of each pass the run's measurements, its end and the watchdog
+/// run's hang.
+struct Qemu {
+    cost: CycleCost,
+    delay: TickDelay,
+    watchdog: CmsdkWatchdog,
+}
+
+/// The CMSDK watchdog (started in `main`).
+struct CmsdkWatchdog;
+
+impl Watchdog for CmsdkWatchdog {
+    fn feed(&mut self) {
+        registers::watchdog_feed();
+    }
+}
+
+impl Board for Qemu {
+    type Gyro = MockBus;
+    type Accel = MockBus;
+    type Uart = Uart0;
+    type Flash = ConfigFlash;
+    type Delay = TickDelay;
+    type Watchdog = CmsdkWatchdog;
+    type Stop = Infallible;
+
+    fn delay_and_watchdog(&mut self) -> (&mut TickDelay, &mut CmsdkWatchdog) {
+        (&mut self.delay, &mut self.watchdog)
+    }
+
+    fn ticks(&self) -> u32 {
+        TICKS.load(Ordering::Relaxed)
+    }
+
+    fn wait_for_interrupt(&mut self) {
+        cortex_m::asm::wfi();
+    }
+
+    /// With the reset mark saying "software".
+    fn reboot(&mut self) -> ! {
+        persistent::mark_software_reset();
+        registers::system_reset()
+    }
+
+    /// The watchdog run's hang, the end of the run (its summary), and the
+    /// pass's cost.
+    fn end_of_pass(
+        &mut self,
+        probe: &SharedProbe<MockBus, MockBus, Uart0>,
+        uplink: &UplinkService<ConfigFlash>,
+        pass: &Pass,
+    ) -> ControlFlow<Infallible> {
+        if cfg!(feature = "qemu-stall-demo")
+            && probe.with(|s| s.probe().cycle().samples()) >= STALL_AT_SAMPLE
+        {
+            // A hung main loop (the watchdog run): interrupts go on.
+            loop {
+                cortex_m::asm::wfi();
+            }
+        }
+        let (samples, idle) = probe.with(|s| {
+            let p = s.probe();
+            let done =
+                p.queue().is_empty() && s.transmitter().is_idle() && p.nav_inbox().is_empty();
+            (p.cycle().samples(), done)
+        });
+        if samples >= mock_sensors::samples_to_run() && idle {
+            exit::finish(&summary(&self.cost, uplink));
+        }
+        self.cost.count(pass, samples);
+        ControlFlow::Continue(())
+    }
+}
+
+impl CycleCost {
+    /// The pass's work is done: SysTick counts since its period began
+    /// (only if no new period started meanwhile).
+    fn count(&mut self, pass: &Pass, samples: u32) {
+        let elapsed = RELOAD - SYST::get_current();
+        let now_tick = TICKS.load(Ordering::Relaxed);
+        if pass.mode_changed {
+            let periods = now_tick.wrapping_sub(pass.tick);
+            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
+            self.mode_changes += 1;
+            self.longest_mode_change = self.longest_mode_change.max(ticks);
+        } else if now_tick != pass.tick {
+            // Whole periods plus this one's part (read before the tick
+            // count, so possibly one period short: a lower bound).
+            let periods = now_tick.wrapping_sub(pass.tick);
+            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
+            self.overruns += 1;
+            self.longest_overrun = self.longest_overrun.max(ticks);
+        } else if samples > 0 {
+            self.worst = self.worst.max(elapsed);
+            self.total += u64::from(elapsed);
+            self.cycles += 1;
+        }
+    }
+}
+
 #[entry]
 fn main() -> ! {
     stack_paint::paint();
@@ -234,126 +319,27 @@ fn main() -> ! {
     let Some(flash_memory) = persistent::config_flash() else {
         exit::fail("configuration flash taken twice")
     };
-    let mut uplink = UplinkService::load(config_flash(flash_memory), 0);
     let Some(inbox) = cortex_m::singleton!(: UplinkInbox = UplinkInbox::new()) else {
         exit::fail("uplink inbox taken twice")
     };
     let (writer, mut uplink_reader) = inbox.split();
     critical_section::with(|cs| *UPLINK_WRITER.borrow_ref_mut(cs) = Some(writer));
-
-    PROBE.announce_boot_with(boot_event_value(
-        reset_cause,
-        uplink.source(),
-        uplink.config().version,
-    ));
     registers::watchdog_start(WATCHDOG_TIMEOUT_MS);
-    PROBE.start_streaming(
+
+    let mut board = Qemu {
+        cost: CycleCost::default(),
+        delay: TickDelay,
+        watchdog: CmsdkWatchdog,
+    };
+    // The loop never returns here (`Infallible`).
+    match main_loop::run(
+        &mut board,
+        &PROBE,
         mock_sensors::power_up(),
-        &mut TickDelay,
-        &mut registers::watchdog_feed,
-    );
-
-    let mut cost = CycleCost::default();
-    // The configured site and calibration (the defaults: the MGWD paper's
-    // test site, uncorrected sensors).
-    let mut navigator = navigator_for(uplink.config());
-    navigator.apply_still_settings(&uplink.config().still);
-    let mut tie_in_pending = uplink.config().tie_in;
-    let mut mode = nav_mode::INITIALISING;
-    let mut last_pass_tick = None;
-    loop {
-        let tick = TICKS.load(Ordering::Relaxed);
-        // One pass per sample period: every byte received wakes the main
-        // loop (its interrupt), and a pass per byte would cost a stream of
-        // them far more than the pass's work (all of which follows a new
-        // sample); their bytes wait in the inbox for the next period.
-        if last_pass_tick == Some(tick) {
-            cortex_m::asm::wfi();
-            continue;
-        }
-        last_pass_tick = Some(tick);
-        let mut mode_changed = false;
-        PROBE.main_loop_pass(
-            &mut TickDelay,
-            &mut navigator,
-            &mut registers::watchdog_feed,
-            |_, _| {},
-            |solution| {
-                mode_changed |= solution.mode != mode && mode != nav_mode::INITIALISING;
-                mode = solution.mode;
-            },
-        );
-        // A tie-in replaces the probe's own levelling as soon as it has
-        // one (`Navigator::start_from_tie_in`).
-        if let Some(tie_in) = tie_in_pending.filter(|_| navigator.is_navigating()) {
-            navigator.start_from_tie_in(&tie_in);
-            tie_in_pending = None;
-        }
-        registers::watchdog_feed();
-        match uplink.serve(
-            &PROBE,
-            &mut navigator,
-            &mut uplink_reader,
-            UPLINK_BYTES_PER_PASS,
-        ) {
-            Some(BoardAction::Realign) => {
-                realign(&mut navigator, uplink.config());
-                tie_in_pending = uplink.config().tie_in;
-                mode = nav_mode::INITIALISING;
-            }
-            Some(BoardAction::Reboot) => reboot(),
-            None => {}
-        }
-        if cfg!(feature = "qemu-stall-demo")
-            && PROBE.with(|s| s.probe().cycle().samples()) >= STALL_AT_SAMPLE
-        {
-            // A hung main loop (the watchdog run): interrupts go on.
-            loop {
-                cortex_m::asm::wfi();
-            }
-        }
-        let (samples, idle) = PROBE.with(|s| {
-            let p = s.probe();
-            let done = p.queue().is_empty() && !s.transmitter().busy && p.nav_inbox().is_empty();
-            (p.cycle().samples(), done)
-        });
-        if samples >= mock_sensors::samples_to_run() && idle {
-            exit::finish(&summary(&cost, &uplink));
-        }
-        // The cycle's work is done: SysTick counts since the period began
-        // (only if no new period started meanwhile).
-        let elapsed = RELOAD - SYST::get_current();
-        let now_tick = TICKS.load(Ordering::Relaxed);
-        if mode_changed {
-            let periods = now_tick.wrapping_sub(tick);
-            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
-            cost.mode_changes += 1;
-            cost.longest_mode_change = cost.longest_mode_change.max(ticks);
-        } else if now_tick != tick {
-            // Whole periods plus this one's part (read before the tick
-            // count, so possibly one period short: a lower bound).
-            let periods = now_tick.wrapping_sub(tick);
-            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
-            cost.overruns += 1;
-            cost.longest_overrun = cost.longest_overrun.max(ticks);
-        } else if samples > 0 {
-            cost.worst = cost.worst.max(elapsed);
-            cost.total += u64::from(elapsed);
-            cost.cycles += 1;
-        }
-        cortex_m::asm::wfi();
-    }
-}
-
-/// The reboot command: once its ACK (and all queued before it) has left
-/// the UART, restart with the reset mark saying "software".
-fn reboot() -> ! {
-    while !PROBE.with(|s| s.probe().queue().is_empty() && !s.transmitter().busy) {
-        registers::watchdog_feed();
-        cortex_m::asm::wfi();
-    }
-    persistent::mark_software_reset();
-    registers::system_reset()
+        config_flash(flash_memory),
+        reset_cause,
+        &mut uplink_reader,
+    ) {}
 }
 
 /// The run's figures for the host (semihosting stdout).

@@ -9,8 +9,9 @@
 //! - USART1: each received byte into the uplink's bounded inbox
 //!   (`firmware::app::uplink_rx`), nothing more; on TX empty, the next
 //!   queued byte into the transmitter;
-//! - main loop: start-up, blocking sensor recovery, the navigation on each
-//!   raw sample (navigation frames), then the host's commands
+//! - main loop (`firmware::app::main_loop`, the same on every board):
+//!   start-up, blocking sensor recovery, the navigation on each raw sample
+//!   (navigation frames), then the host's commands
 //!   (`firmware::app::uplink_service`: a bounded number of bytes per
 //!   sample period, each command answered on the downlink); feeds the
 //!   watchdog between those steps (`firmware::app::budget`); sleeps
@@ -25,9 +26,9 @@
 //! `HardFault` handler below), after panic-probe has logged it.
 //!
 //! What the contexts share and do is `firmware::app::SharedProbe`, as on
-//! the QEMU board (`probe_qemu/main.rs`, whose main loop this one
-//! follows); this file adds USART1 as its `Transmitter` and receiver, TIM2,
-//! the NVIC, the flash and the watchdog.
+//! the QEMU board; this file adds USART1 as its `Transmitter` and
+//! receiver, TIM2, the NVIC, the flash and the watchdog, and is the main
+//! loop's `Board`.
 #![no_std]
 #![no_main]
 
@@ -35,23 +36,25 @@ mod board;
 mod flash;
 
 use core::cell::RefCell;
+use core::convert::Infallible;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use critical_section::Mutex;
 use defmt_rtt as _;
-use firmware::app::boot::{boot_event_value, ResetCause};
-use firmware::app::uplink_rx::{InboxWriter, UplinkInbox, UPLINK_QUEUE_LEN};
-use firmware::app::uplink_service::{BoardAction, UplinkService};
-use firmware::app::{FrameQueue, SharedProbe, Transmitter, FIRMWARE_VERSION, TX_QUEUE_LEN};
-use mwd_core::config::ProbeConfig;
-use mwd_core::probe::Navigator;
+use firmware::app::boot::ResetCause;
+use firmware::app::main_loop;
+use firmware::app::uplink_rx::{InboxWriter, UplinkInbox};
+use firmware::app::{
+    FrameQueue, SharedProbe, Transmitter, Watchdog, FIRMWARE_VERSION, TX_QUEUE_LEN,
+};
 use mwd_core::timing::SAMPLE_RATE_HZ;
 use panic_probe as _;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, NVIC};
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::serial::{RxISR, RxListen, TxISR, TxListen};
-use stm32f4xx_hal::timer::{Event as TimerEvent, Flag};
+use stm32f4xx_hal::timer::{Event as TimerEvent, Flag, SysDelay};
+use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
 use board::{Device, Timer, Uart, UartRx};
 use flash::SectorFlash;
@@ -61,10 +64,6 @@ const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// NVIC priorities (upper 4 bits on the F411; lower number = more urgent).
 const PRIORITY_ACQUISITION: u8 = 0x10;
 const PRIORITY_UART: u8 = 0x20;
-/// Uplink bytes the main loop takes per sample period: the inbox's
-/// capacity, more than the 576 B a period brings at 115200 baud (as on
-/// the QEMU board).
-const UPLINK_BYTES_PER_PASS: usize = UPLINK_QUEUE_LEN;
 
 /// USART1's transmitter, driven by its TX-empty interrupt.
 struct Usart1 {
@@ -151,20 +150,50 @@ fn USART1() {
     PROBE.with(|shared| shared.transmitter_ready());
 }
 
-/// The navigator the configuration asks for (site, calibration and still
-/// settings; its tie-in is applied once the navigator levels, in the main
-/// loop).
-fn navigator_for(config: &ProbeConfig) -> Navigator {
-    Navigator::with_calibration(config.site, config.calibration)
+/// The real board as the main loop sees it (`firmware::app::main_loop`):
+/// TIM2's periods for its clock, SysTick for its delay, the independent
+/// watchdog.
+struct Stm32 {
+    delay: SysDelay,
+    watchdog: Iwdg,
 }
 
-/// Starts the navigation over from `config`; not inlined, so the new
-/// navigator is built in this call's frame, not in `main`'s (as on the
-/// QEMU board, docs/budgets.md).
-#[inline(never)]
-fn realign(navigator: &mut Navigator, config: &ProbeConfig) {
-    *navigator = navigator_for(config);
-    navigator.apply_still_settings(&config.still);
+/// The independent watchdog (started in `board::init`).
+struct Iwdg(IndependentWatchdog);
+
+impl Watchdog for Iwdg {
+    fn feed(&mut self) {
+        self.0.feed();
+    }
+}
+
+impl main_loop::Board for Stm32 {
+    type Gyro = Device;
+    type Accel = Device;
+    type Uart = Usart1;
+    type Flash = SectorFlash;
+    type Delay = SysDelay;
+    type Watchdog = Iwdg;
+    type Stop = Infallible;
+
+    fn delay_and_watchdog(&mut self) -> (&mut SysDelay, &mut Iwdg) {
+        (&mut self.delay, &mut self.watchdog)
+    }
+
+    fn ticks(&self) -> u32 {
+        TICKS.load(Ordering::Relaxed)
+    }
+
+    fn wait_for_interrupt(&mut self) {
+        cortex_m::asm::wfi();
+    }
+
+    /// The last byte may still be on the line (the transmitter cannot say):
+    /// its 87 us at 115200 baud, then the reset.
+    fn reboot(&mut self) -> ! {
+        self.delay.delay_ms(1);
+        cortex_m::peripheral::SCB::sys_reset()
+    }
 }
 
 #[entry]
@@ -183,8 +212,8 @@ fn main() -> ! {
         mut uart_rx,
         flash,
         mut timer,
-        mut delay,
-        mut watchdog,
+        delay,
+        watchdog,
     } = board;
     defmt::info!("probe-stm32 v{=u16}: booting", FIRMWARE_VERSION);
     if timer.start(SAMPLES_PER_SECOND.Hz()).is_err() {
@@ -192,7 +221,6 @@ fn main() -> ! {
     }
     timer.listen(TimerEvent::Update);
     PROBE.with(|shared| shared.transmitter_mut().uart = Some(uart));
-    let mut uplink = UplinkService::load(SectorFlash::new(flash), 0);
     let Some(inbox) = cortex_m::singleton!(: UplinkInbox = UplinkInbox::new()) else {
         defmt::panic!("uplink inbox taken twice");
     };
@@ -211,80 +239,21 @@ fn main() -> ! {
         NVIC::unmask(Interrupt::USART1);
     }
 
-    PROBE.announce_boot_with(boot_event_value(
-        reset_cause,
-        uplink.source(),
-        uplink.config().version,
-    ));
-    defmt::info!(
-        "configuration version {=u32} ({=str})",
-        uplink.config().version,
-        match uplink.source() {
-            firmware::app::boot::ConfigSource::Flash => "flash",
-            _ => "defaults",
-        }
-    );
     // The watchdog runs since `board::init`; the start-up feeds it after
     // each attempt.
-    watchdog.feed();
-    PROBE.start_streaming(sensors, &mut delay, &mut || watchdog.feed());
-    defmt::info!("streaming at {=u32} Hz", SAMPLES_PER_SECOND);
-
-    // The configured site and calibration (the defaults: the MGWD paper's
-    // test site, uncorrected sensors).
-    let mut navigator = navigator_for(uplink.config());
-    navigator.apply_still_settings(&uplink.config().still);
-    let mut tie_in_pending = uplink.config().tie_in;
-    let mut last_pass_tick = None;
-    loop {
-        // One pass per sample period: each received byte wakes the loop,
-        // its bytes wait in the inbox for the period's pass.
-        let tick = TICKS.load(Ordering::Relaxed);
-        if last_pass_tick == Some(tick) {
-            cortex_m::asm::wfi();
-            continue;
-        }
-        last_pass_tick = Some(tick);
-        PROBE.main_loop_pass(
-            &mut delay,
-            &mut navigator,
-            &mut || watchdog.feed(),
-            |part, code| defmt::warn!("part {=u8} recovered, code {=u16}", part, code),
-            |_| {},
-        );
-        // A tie-in replaces the probe's own levelling as soon as it has
-        // one (`Navigator::start_from_tie_in`).
-        if let Some(tie_in) = tie_in_pending.filter(|_| navigator.is_navigating()) {
-            navigator.start_from_tie_in(&tie_in);
-            tie_in_pending = None;
-        }
-        watchdog.feed();
-        match uplink.serve(
-            &PROBE,
-            &mut navigator,
-            &mut uplink_reader,
-            UPLINK_BYTES_PER_PASS,
-        ) {
-            Some(BoardAction::Realign) => {
-                realign(&mut navigator, uplink.config());
-                tie_in_pending = uplink.config().tie_in;
-                defmt::info!("re-aligning");
-            }
-            Some(BoardAction::Reboot) => {
-                defmt::info!("rebooting");
-                // Once the ACK (and all queued before it) has left.
-                while !PROBE.with(|s| s.probe().queue().is_empty()) {
-                    watchdog.feed();
-                    cortex_m::asm::wfi();
-                }
-                // The last byte's 87 us on the line at 115200 baud.
-                delay.delay_ms(1);
-                cortex_m::peripheral::SCB::sys_reset()
-            }
-            None => {}
-        }
-        cortex_m::asm::wfi();
-    }
+    let mut board = Stm32 {
+        delay,
+        watchdog: Iwdg(watchdog),
+    };
+    // The loop never returns here (`Infallible`).
+    match main_loop::run(
+        &mut board,
+        &PROBE,
+        sensors,
+        SectorFlash::new(flash),
+        reset_cause,
+        &mut uplink_reader,
+    ) {}
 }
 
 /// Why the chip restarted, from RCC_CSR's reset flags (RM0383 6.3.21),
