@@ -5,11 +5,30 @@
 use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
 
-use crate::Summary;
+use firmware::app::uplink_rx::UplinkStats;
 
 /// SysTick counts per instruction under `-icount shift=0`: one instruction
 /// is 1 ns of virtual time, one 25 MHz count 40 ns.
 const INSTRUCTIONS_PER_TICK: u32 = 40;
+
+/// The run's figures for the host (semihosting stdout).
+pub struct Summary {
+    pub samples: u32,
+    pub skipped: u32,
+    pub queued: u32,
+    pub dropped: u32,
+    pub worst_ticks: u32,
+    pub mean_ticks: u32,
+    pub stack_bytes: usize,
+    pub nav_dropped: u32,
+    pub nav_inbox_high_water: usize,
+    pub overruns: u32,
+    pub longest_overrun_ticks: u64,
+    pub mode_changes: u32,
+    pub longest_mode_change_ticks: u64,
+    pub uplink: UplinkStats,
+    pub replies_dropped: u32,
+}
 
 pub fn finish(summary: &Summary) -> ! {
     hprintln!(
@@ -88,18 +107,4 @@ unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
 #[exception]
 unsafe fn NonMaskableInt() {
     fail("watchdog: the main loop stalled");
-}
-
-/// Every interrupt without its own handler lands here: dispatch the UART's two,
-/// and treat any other as a fault (nothing else is enabled).
-#[allow(unsafe_code)]
-#[exception]
-unsafe fn DefaultHandler(irqn: i16) {
-    if irqn == crate::registers::UART0_TX_IRQ {
-        crate::on_uart_tx();
-    } else if irqn == crate::registers::UART0_RX_IRQ {
-        crate::on_uart_rx();
-    } else {
-        fail("unexpected interrupt");
-    }
 }

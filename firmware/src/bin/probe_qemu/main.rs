@@ -38,6 +38,7 @@ mod exit;
 mod mock_sensors;
 mod persistent;
 mod registers;
+mod run_length;
 mod stack_paint;
 #[cfg(feature = "qemu-drilling")]
 mod stream_file;
@@ -53,15 +54,17 @@ use cortex_m_rt::{entry, exception};
 use critical_section::Mutex;
 use firmware::app::main_loop::{self, Board, Pass};
 use firmware::app::ram_flash::RamNorFlash;
-use firmware::app::uplink_rx::{InboxWriter, UplinkInbox, UplinkStats};
+use firmware::app::uplink_rx::{InboxWriter, UplinkInbox};
 use firmware::app::uplink_service::UplinkService;
 use firmware::app::{
     FrameQueue, SharedProbe, Transmitter, Watchdog, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS,
 };
-use mwd_core::timing::{SAMPLE_PERIOD_US, SAMPLE_RATE_HZ};
+use mwd_core::timing::SAMPLE_PERIOD_US;
 
+use exit::Summary;
 use mock_sensors::{MockBus, TickDelay, TICKS};
 use registers::SYSTEM_CLOCK_HZ;
+use run_length::SAMPLES_PER_SECOND;
 
 /// The configuration's flash: RAM kept across resets, whose writes the
 /// power-cut test (feature `power-cut-test`) cuts short on purpose
@@ -81,30 +84,10 @@ fn config_flash(memory: &'static mut [u8]) -> ConfigFlash {
     firmware::app::power_cut::PowerCutFlash::new(RamNorFlash::new(memory), persistent::PowerCut)
 }
 
-/// Simulated seconds of streaming before the probe exits.
-const RUN_SECONDS: u32 = parse_seconds(option_env!("PROBE_QEMU_RUN_SECONDS"), 60);
-#[cfg_attr(feature = "qemu-drilling", allow(dead_code))]
-const SAMPLES_TO_RUN: u32 = RUN_SECONDS * SAMPLES_PER_SECOND;
-/// The sample rate, for counting seconds in samples.
-const SAMPLES_PER_SECOND: u32 = SAMPLE_RATE_HZ as u32;
 /// When the watchdog run (feature `qemu-stall-demo`) hangs its main loop.
 const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
-
-const fn parse_seconds(text: Option<&str>, default: u32) -> u32 {
-    let Some(text) = text else { return default };
-    let bytes = text.as_bytes();
-    let mut value = 0u32;
-    let mut i = 0;
-    while i < bytes.len() {
-        let digit = bytes[i].wrapping_sub(b'0');
-        assert!(digit < 10, "PROBE_QEMU_RUN_SECONDS must be a number");
-        value = value * 10 + digit as u32;
-        i += 1;
-    }
-    value
-}
 
 /// CMSDK UART0's transmitter: a one-byte buffer whose interrupt fires when
 /// it empties.
@@ -342,25 +325,6 @@ fn main() -> ! {
     ) {}
 }
 
-/// The run's figures for the host (semihosting stdout).
-struct Summary {
-    samples: u32,
-    skipped: u32,
-    queued: u32,
-    dropped: u32,
-    worst_ticks: u32,
-    mean_ticks: u32,
-    stack_bytes: usize,
-    nav_dropped: u32,
-    nav_inbox_high_water: usize,
-    overruns: u32,
-    longest_overrun_ticks: u64,
-    mode_changes: u32,
-    longest_mode_change_ticks: u64,
-    uplink: UplinkStats,
-    replies_dropped: u32,
-}
-
 fn summary(cost: &CycleCost, uplink: &UplinkService<ConfigFlash>) -> Summary {
     let mean_ticks = (cost.total / u64::from(cost.cycles.max(1))) as u32;
     PROBE.with(|s| Summary {
@@ -380,4 +344,18 @@ fn summary(cost: &CycleCost, uplink: &UplinkService<ConfigFlash>) -> Summary {
         uplink: *uplink.stats(),
         replies_dropped: uplink.replies_dropped(),
     })
+}
+
+/// Every interrupt without its own handler lands here: dispatch the UART's two,
+/// and treat any other as a fault (nothing else is enabled).
+#[allow(unsafe_code)]
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    if irqn == registers::UART0_TX_IRQ {
+        on_uart_tx();
+    } else if irqn == registers::UART0_RX_IRQ {
+        on_uart_rx();
+    } else {
+        exit::fail("unexpected interrupt");
+    }
 }

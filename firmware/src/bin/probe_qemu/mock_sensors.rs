@@ -26,7 +26,7 @@ use hil_mock::{MountedSource, StillProbe};
 #[cfg(not(feature = "qemu-drilling"))]
 use mwd_core::sensor_units::PART_MOUNTINGS;
 
-use crate::SAMPLES_PER_SECOND;
+use crate::run_length::SAMPLES_PER_SECOND;
 
 /// Timer periods since boot, counted by the SysTick interrupt.
 pub static TICKS: AtomicU32 = AtomicU32::new(0);
@@ -119,7 +119,7 @@ fn part_source(index: usize) -> PartSource {
 /// How many samples the run streams.
 #[cfg(not(feature = "qemu-drilling"))]
 pub fn samples_to_run() -> u32 {
-    crate::SAMPLES_TO_RUN
+    crate::run_length::SAMPLES_TO_RUN
 }
 
 /// Called by the timer just before it takes raw sample `sample` (counted

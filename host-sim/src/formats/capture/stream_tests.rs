@@ -1,11 +1,11 @@
 //! Tests of a capture read as a stream and of its summary.
 
 use super::*;
-use mwd_core::protocol::DecoderStats;
-use std::io::{self, Read};
 use crate::formats::capture::{decode_bytes, without_frame, CaptureWriter, SiSample};
 use mwd_core::protocol::uplink::reply::{Reply, ReplyStatus};
+use mwd_core::protocol::DecoderStats;
 use std::io::Write;
+use std::io::{self, Read};
 
 /// A short capture: raw frames, a reply among them, a station frame.
 fn capture_bytes() -> Vec<u8> {

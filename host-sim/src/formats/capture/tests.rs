@@ -2,10 +2,10 @@
 
 use super::*;
 use mwd_core::earth::Position;
+use mwd_core::protocol::example;
 use mwd_core::protocol::frame::{raw_flags, Payload};
 use mwd_core::protocol::Frame;
 use mwd_core::sensor_units::GYRO_TEMPERATURE;
-use mwd_core::protocol::example;
 use mwd_core::sensor_units::{accel_count_to_m_s2, gyro_count_to_rad_s, STANDARD_GRAVITY};
 
 fn sample(i: u32) -> SiSample {
