@@ -289,11 +289,28 @@ fn imports(files: &[SourceFile]) -> Vec<BTreeSet<usize>> {
             let t = &f.tokens;
             let mut out = BTreeSet::new();
             let mut reexport = false;
+            // Inline modules (`mod x { ... }`) open around the tokens: their
+            // names and the brace depth inside each.
+            let mut inline: Vec<(String, usize)> = Vec::new();
+            let mut depth = 0usize;
             let mut i = 0;
             while i < t.len() {
                 let tok = t[i].as_str();
-                if tok == ";" {
-                    reexport = false;
+                match tok {
+                    ";" => reexport = false,
+                    "{" => {
+                        depth += 1;
+                        if i >= 2 && t[i - 2] == "mod" {
+                            inline.push((t[i - 1].clone(), depth));
+                        }
+                    }
+                    "}" => {
+                        if inline.last().is_some_and(|(_, d)| *d == depth) {
+                            inline.pop();
+                        }
+                        depth = depth.saturating_sub(1);
+                    }
+                    _ => {}
                 }
                 if tok == "pub" && t[i + 1..].iter().take(5).any(|s| s == "use") {
                     reexport = true;
@@ -307,6 +324,7 @@ fn imports(files: &[SourceFile]) -> Vec<BTreeSet<usize>> {
                     continue;
                 }
                 let mut base = f.module.clone();
+                base.extend(inline.iter().map(|(name, _)| name.clone()));
                 let mut j = i;
                 match tok {
                     "crate" => {
