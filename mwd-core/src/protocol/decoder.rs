@@ -9,7 +9,8 @@
 //! boot events, and a large gap is checked against the raw frames' sample
 //! counters (`docs/protocol.md`, "Losses").
 
-use super::frame::{decode_body, EventKind, Frame, FrameError, FrameKind, Payload, MAX_BODY_LEN};
+use super::codec::{decode_body, FrameError};
+use super::frame::{EventKind, Frame, FrameKind, Payload, MAX_BODY_LEN};
 use super::wire::{wire_len, DELIMITER};
 
 /// Largest chunk kept between delimiters: the longest valid encoded body.
@@ -460,7 +461,7 @@ mod tests {
         let mut seen = 0;
         for seq in 0..3u16 {
             let mut body = [0u8; MAX_BODY_LEN];
-            let n = super::super::frame::encode_body(seq, &event(0), &mut body).unwrap();
+            let n = super::super::codec::encode_body(seq, &event(0), &mut body).unwrap();
             if seq == 1 {
                 body[1] = 0x77;
                 let crc = crc32c(&body[..n - 4]).to_le_bytes();

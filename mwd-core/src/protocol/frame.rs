@@ -6,8 +6,6 @@
 //! ```
 //! The CRC covers everything before it.
 
-pub use super::codec::{decode_body, encode_body, FrameError};
-
 /// Version byte of this layout; a decoder rejects other versions.
 pub const PROTOCOL_VERSION: u8 = 1;
 /// version + kind + sequence number.

@@ -21,10 +21,11 @@ pub mod frame;
 pub mod uplink;
 pub mod wire;
 
+pub use codec::{decode_body, encode_body, FrameError};
 pub use decoder::{Decoder, DecoderStats};
 pub use frame::{
-    decode_body, encode_body, Event, EventKind, Frame, FrameError, FrameKind, NavSolution, Payload,
-    RawPart, RawSample, StationSurvey, PROTOCOL_VERSION,
+    Event, EventKind, Frame, FrameKind, NavSolution, Payload, RawPart, RawSample, StationSurvey,
+    PROTOCOL_VERSION,
 };
 pub use wire::{encode_frame, wire_len, FrameEncoder, MAX_WIRE_LEN};
 

@@ -8,7 +8,8 @@
 //! separator. COBS comes from the `cobs` crate (no_std, no heap).
 
 use super::bytes::OutOfRoom;
-use super::frame::{encode_body, Payload, MAX_BODY_LEN};
+use super::codec::encode_body;
+use super::frame::{Payload, MAX_BODY_LEN};
 
 /// Delimiter between frames.
 pub const DELIMITER: u8 = 0x00;
@@ -74,7 +75,8 @@ impl FrameEncoder {
 
 #[cfg(test)]
 mod tests {
-    use super::super::frame::{decode_body, FrameKind, NavSolution, RawSample};
+    use super::super::codec::decode_body;
+    use super::super::frame::{FrameKind, NavSolution, RawSample};
     use super::*;
 
     #[test]
