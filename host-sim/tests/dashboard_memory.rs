@@ -7,7 +7,7 @@
 #![cfg(feature = "dashboard")]
 
 use host_sim::dashboard::state::{DashboardState, Limits, SourceInfo, LIMITS};
-use host_sim::dashboard::stations::SurveySetup;
+use host_sim::survey::stations::{job_tie_on, SurveySetup};
 use mwd_core::protocol::frame::{nav_mode, EventKind, NO_PART};
 use mwd_core::protocol::{Event, Frame, NavSolution, Payload, RawSample, StationSurvey};
 use serde_json::Value;
@@ -20,7 +20,8 @@ fn state(limits: Limits) -> DashboardState {
         controls_disabled: None,
         calibration: vec![],
         job: None,
-        survey: SurveySetup::new(None, 45.0).unwrap(),
+        depth: None,
+        survey: SurveySetup::probe(job_tie_on(None), 45f64.to_radians()).unwrap(),
     };
     DashboardState::new(info, 7, limits)
 }

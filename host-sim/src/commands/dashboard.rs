@@ -12,9 +12,9 @@ use anyhow::{Context, Result};
 use host_sim::dashboard::server::{self, App};
 use host_sim::dashboard::source::{self, Shared};
 use host_sim::dashboard::state::{DashboardState, SourceInfo, LIMITS};
-use host_sim::dashboard::stations::SurveySetup;
 use host_sim::formats::depth_log::DepthLog;
 use host_sim::survey::job::Job;
+use host_sim::survey::stations::{job_tie_on, SurveySetup};
 use mwd_core::calibration::ProbeCalibration;
 
 #[derive(clap::Args, Debug)]
@@ -126,7 +126,8 @@ pub fn run(args: Args) -> Result<()> {
         controls_disabled: None,
         calibration: calibration_lines(job.as_ref()),
         job: args.job.as_ref().map(|p| p.display().to_string()),
-        survey: SurveySetup::new(depth, latitude_deg)?,
+        depth,
+        survey: SurveySetup::probe(job_tie_on(job.as_ref()), latitude_deg.to_radians())?,
     };
     let session = rand::random::<u64>() >> 12;
     let (state, commands): (Shared, _) = match (&args.port, &args.file) {

@@ -14,15 +14,16 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use mwd_core::protocol::uplink::Reply;
-use mwd_core::protocol::{DecoderStats, Frame, NavSolution, Payload, StationSurvey};
+use mwd_core::protocol::{DecoderStats, Frame, NavSolution, Payload};
 use serde_json::{json, Value};
 
 use super::ring::{BucketMean, Ring};
-use super::stations::{stations_json, SurveySetup};
+use super::stations::stations_json;
 use super::view::{
     attitude_channels, event_text, latest_json, sensor_channels, ATTITUDE_CHANNELS, SENSOR_CHANNELS,
 };
-use crate::survey::listing::drilling::AzimuthSigmaTrack;
+use crate::formats::depth_log::DepthLog;
+use crate::survey::stations::{StationCollector, SurveySetup};
 
 /// The bounds of the dashboard's buffers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,7 +63,10 @@ pub struct SourceInfo {
     pub calibration: Vec<String>,
     /// The job file "configure" sends, if one was given.
     pub job: Option<String>,
-    /// Pairing of stations with MD, if a depth log was given.
+    /// The depth log pairing stations with MD, if one was given.
+    pub depth: Option<DepthLog>,
+    /// The tie-on and the probe's error model the stations are positioned
+    /// with (as `survey CAPTURE --job` positions them).
     pub survey: SurveySetup,
 }
 
@@ -104,11 +108,8 @@ pub struct DashboardState {
     time_offset_s: f64,
     last_time_s: f64,
     latest: Option<NavSolution>,
-    stations: VecDeque<StationSurvey>,
-    /// Each station's azimuth sigma at its start, from `azimuth_track`.
-    stations_azi_before: VecDeque<Option<f64>>,
-    /// The solutions' azimuth sigmas since the last station.
-    azimuth_track: AzimuthSigmaTrack,
+    /// The stations held (at most `limits.stations`), each with its start.
+    stations: StationCollector,
     stations_dropped: u64,
     stations_view: Value,
     stations_update: u64,
@@ -130,7 +131,8 @@ pub struct DashboardState {
 
 impl DashboardState {
     pub fn new(source: SourceInfo, session: u64, limits: Limits) -> Self {
-        let stations_view = stations_json(&[], &[], 0, &source.survey);
+        let stations = StationCollector::default();
+        let stations_view = stations_json(&stations, 0, &source);
         Self {
             limits,
             session,
@@ -144,9 +146,7 @@ impl DashboardState {
             time_offset_s: 0.0,
             last_time_s: f64::NEG_INFINITY,
             latest: None,
-            stations: VecDeque::new(),
-            stations_azi_before: VecDeque::new(),
-            azimuth_track: AzimuthSigmaTrack::default(),
+            stations,
             stations_dropped: 0,
             stations_view,
             stations_update: 0,
@@ -203,7 +203,7 @@ impl DashboardState {
                     self.long_attitude.push(update, (t, channels));
                 }
                 self.solutions_seen += 1;
-                self.azimuth_track.push(nav);
+                self.stations.push_solution(nav);
                 self.latest = Some(*nav);
             }
             Payload::Event(event) => {
@@ -211,18 +211,13 @@ impl DashboardState {
                 self.events_update = update;
             }
             Payload::Station(station) => {
-                if self.stations.len() == self.limits.stations {
-                    self.stations.pop_front();
-                    self.stations_azi_before.pop_front();
+                if self.stations.stations().len() == self.limits.stations {
+                    self.stations.drop_oldest();
                     self.stations_dropped += 1;
                 }
-                self.stations.push_back(*station);
-                let start = self.azimuth_track.station_start(station);
-                self.stations_azi_before.push_back(start);
-                let list: Vec<StationSurvey> = self.stations.iter().copied().collect();
-                let before: Vec<Option<f64>> = self.stations_azi_before.iter().copied().collect();
+                self.stations.push_station(station);
                 self.stations_view =
-                    stations_json(&list, &before, self.stations_dropped, &self.source.survey);
+                    stations_json(&self.stations, self.stations_dropped, &self.source);
                 self.stations_update = update;
             }
         }
@@ -285,7 +280,7 @@ impl DashboardState {
             attitude: self.attitude.len(),
             long_sensors: self.long_sensors.len(),
             long_attitude: self.long_attitude.len(),
-            stations: self.stations.len(),
+            stations: self.stations.stations().len(),
             events: self.events.len(),
             commands: self.commands.len(),
         }

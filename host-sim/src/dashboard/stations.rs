@@ -1,46 +1,17 @@
 //! The stations on the page: each as the probe sent it, with MD and
-//! positions by minimum curvature when a depth log pairs them with depth
-//! (the pairing and positioning of `host-sim survey CAPTURE --depth`,
-//! `survey_listing::drilling`), for the plan view and the vertical section.
+//! positions by minimum curvature from the job's tie-on when a depth log
+//! pairs them with depth (the stations of `host-sim survey CAPTURE --depth
+//! --job`, collected and positioned by [`crate::survey::stations`]), for the
+//! plan view and the vertical section.
 
 use mwd_core::protocol::StationSurvey;
 use serde_json::{json, Value};
 
-use crate::formats::depth_log::DepthLog;
+use super::state::SourceInfo;
 use crate::formats::display;
-use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::listing::drilling::{self, DrillingRow};
 use crate::survey::listing::TieOnInput;
-
-/// What pairing stations with MD needs; `depth: None` lists the stations
-/// only.
-#[derive(Debug, Clone)]
-pub struct SurveySetup {
-    pub depth: Option<DepthLog>,
-    pub terms: Vec<ErrorTerm>,
-    pub site: Site,
-}
-
-impl SurveySetup {
-    /// As `host-sim survey CAPTURE --depth` sets it up for a site at
-    /// `latitude_deg`: the probe's own angle sigmas plus the depth log's
-    /// scale and stretch terms (no magnetic terms: the probe has none).
-    pub fn new(depth: Option<DepthLog>, latitude_deg: f64) -> anyhow::Result<Self> {
-        Ok(Self {
-            depth,
-            terms: drilling::survey_terms()?,
-            site: Site {
-                gravity: 9.806_65,
-                b_total: 0.0,
-                dip: 0.0,
-                declination: 0.0,
-                vertical_limit: 0.0001_f64.to_radians(),
-                latitude: latitude_deg.to_radians(),
-                gyro_noise_reduction: 1.0,
-            },
-        })
-    }
-}
+use crate::survey::stations::StationCollector;
 
 /// "12.34 +- 0.56 m" from a value and a variance; "n/a" when the variance
 /// is not a valid one (never a sigma of 0 for it).
@@ -92,36 +63,20 @@ fn positioned(row: &mut Value, d: &DrillingRow) {
 /// The stations for the page: the list, the note on positions, and the
 /// plan view (east, north) and vertical section (section, TVD) of the
 /// stations whose position is determined.
-pub fn stations_json(
-    stations: &[StationSurvey],
-    azi_before: &[Option<f64>],
-    dropped: u64,
-    setup: &SurveySetup,
-) -> Value {
+pub fn stations_json(collected: &StationCollector, dropped: u64, source: &SourceInfo) -> Value {
+    let stations = collected.stations();
     let mut rows: Vec<Value> = stations.iter().map(station_row).collect();
     let mut plan = Vec::new();
     let mut section = Vec::new();
-    let note = match (&setup.depth, stations.is_empty()) {
+    let note = match (&source.depth, stations.is_empty()) {
         (None, _) => "No depth log: positions by minimum curvature need MD, so the stations \
                       are listed only (start with --depth DEPTH.csv)."
             .to_string(),
         (Some(_), true) => "No station yet.".to_string(),
         (Some(depth), false) => {
-            let tie = TieOnInput {
-                md: None,
-                tvd: 0.0,
-                north: 0.0,
-                east: 0.0,
-            };
-            match drilling::survey(
-                stations,
-                azi_before,
-                &[],
-                depth,
-                tie,
-                &setup.terms,
-                &setup.site,
-            ) {
+            // No station links: the page has the frames only, not their
+            // replay (the survey then chains the stations' azimuths alone).
+            match collected.survey(&[], &source.survey, depth) {
                 Ok(survey) => {
                     for d in &survey.rows {
                         // By number and time: a station's NaN correlations
@@ -142,10 +97,7 @@ pub fn stations_json(
                         .iter()
                         .map(|s| format!("station {}: {}", s.survey.station, s.reason))
                         .collect();
-                    let mut note = "Positions by minimum curvature from the first station \
-                                    (the tie-on, at N 0, E 0, TVD 0), MD from the depth log; \
-                                    1 sigma."
-                        .to_string();
+                    let mut note = tie_on_note(&source.survey.tie);
                     if !skipped.is_empty() {
                         note += &format!(" Left out: {}.", skipped.join("; "));
                     }
@@ -164,4 +116,28 @@ pub fn stations_json(
         note
     };
     json!({"rows": rows, "note": note, "plan": plan, "section": section})
+}
+
+/// How the stations are placed: from the job's tie-on, or from the first
+/// station at the surface when the job gives none.
+fn tie_on_note(tie: &TieOnInput) -> String {
+    let at = format!(
+        "N {:.2} m, E {:.2} m, TVD {:.2} m",
+        tie.north, tie.east, tie.tvd
+    );
+    match tie.md {
+        Some(md) => format!(
+            "Positions by minimum curvature from the job's tie-on (MD {md:.2} m, {at}), MD from \
+             the depth log; 1 sigma."
+        ),
+        None if (tie.north, tie.east, tie.tvd) == (0.0, 0.0, 0.0) => {
+            "Positions by minimum curvature from the first station (the tie-on, at N 0, E 0, \
+             TVD 0), MD from the depth log; 1 sigma."
+                .to_string()
+        }
+        None => format!(
+            "Positions by minimum curvature from the first station (the tie-on, at {at}), MD \
+             from the depth log; 1 sigma."
+        ),
+    }
 }

@@ -11,7 +11,11 @@
 //!   NEV covariance and ellipses, a drilling capture's stations paired with
 //!   depth, the listing, its figures, anti-collision.
 //! - [`job`]: the job file (site, tie-in, calibration, tool model).
+//! - [`stations`]: the probe's downlink to the survey's stations (each
+//!   station's start sigma, stations sent again), positioned from the tie-on:
+//!   the one collector the capture survey, the dashboard and the studies use.
 
 pub mod iscwsa;
 pub mod job;
 pub mod listing;
+pub mod stations;
