@@ -3,7 +3,7 @@
 //! configuration came from, and the configuration's version, so one frame
 //! says both why the probe restarted and what it will survey with.
 
-/// Why the MCU restarted (issue 15: the reset flags of the MCU). Codes as
+/// Why the MCU restarted (from the MCU's reset flags). Codes as
 /// sent in the boot event's low byte.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ResetCause {

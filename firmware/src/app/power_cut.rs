@@ -3,7 +3,7 @@
 //! in [`PowerCutFlash`], which programs only the first bytes of a write
 //! and then cuts the power (a reset that the next boot reports as
 //! power-on). The end-to-end test (tests/tests/qemu_power_cut.rs) then
-//! checks what issue 15 asks of the two-slot store
+//! checks what the two-slot store promises
 //! ([`super::config_store`]): after the cut the previous configuration
 //! loads. The normal builds never construct it.
 //!
