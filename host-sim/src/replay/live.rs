@@ -23,7 +23,6 @@ use mwd_core::config::default_still_settings;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::probe::TieIn;
-use mwd_core::protocol::frame::nav_mode;
 use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
@@ -93,7 +92,7 @@ impl fmt::Display for LiveStatus {
             "t {:8.2} s {} | roll {:7.2} pitch {:7.2} deg | inc {:6.2} tf {:6.2} deg az {azimuth} | \
              frames {} lost {} crc {} restarts {} | parity {}/{}",
             s.time_us as f64 * 1e-6,
-            mode_name(s.mode),
+            display::mode_name(s.mode),
             deg(s.attitude[0]),
             deg(s.attitude[1]),
             drilling.inclination.to_degrees(),
@@ -109,17 +108,6 @@ impl fmt::Display for LiveStatus {
             write!(f, " ({} unchecked)", self.replay.unchecked)?;
         }
         Ok(())
-    }
-}
-
-/// The navigation mode as a short word for the display.
-pub fn mode_name(mode: u8) -> &'static str {
-    match mode {
-        nav_mode::INITIALISING => "init  ",
-        nav_mode::COARSE_ALIGNMENT => "coarse",
-        nav_mode::FINE_ALIGNMENT => "fine  ",
-        nav_mode::NAVIGATING => "nav   ",
-        _ => "?     ",
     }
 }
 

@@ -208,7 +208,7 @@ impl std::fmt::Display for StepLoss {
                 } else {
                     "no frame was lost: the replay DIFFERS from the probe"
                 };
-                let name = |mode| crate::replay::live::mode_name(mode).trim_end();
+                let name = |mode| display::mode_name(mode).trim_end();
                 format!(
                     "the probe's navigation mode is {} ({probe_mode}), the replay's {} \
                      ({replay_mode}); {cause}",
