@@ -29,7 +29,10 @@ use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 use crate::formats::capture::CaptureSummary;
 use crate::formats::display;
 use crate::replay::commands::CommandRow;
-use crate::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
+use crate::replay::replayer::Replayer;
+use crate::replay::rows::{ReplayRow, ReplaySummary};
+use crate::replay::rows_csv::CSV_HEADER;
+use crate::replay::step_loss::StepLoss;
 
 /// Why a live replay stopped.
 #[derive(Debug)]
@@ -190,7 +193,7 @@ pub fn run(
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];
     if let Some(csv) = sinks.csv.as_mut() {
-        if let Err(e) = writeln!(csv, "{}", replay::CSV_HEADER).and_then(|()| csv.flush()) {
+        if let Err(e) = writeln!(csv, "{}", CSV_HEADER).and_then(|()| csv.flush()) {
             return outcome(decoder, capture, replayer, StreamEnd::OutputFailed(e));
         }
     }
