@@ -12,7 +12,7 @@ use mwd_core::sensor_units::{
 use serde_json::{json, Value};
 
 use crate::formats::display;
-use crate::replay::live::mode_name;
+use crate::formats::display::mode_name;
 
 /// Sensor channels of one sample: both parts' gyro rate (deg/s), both
 /// parts' accelerometer triads in body axes (m/s^2, so that the two parts'

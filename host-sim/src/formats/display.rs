@@ -5,7 +5,7 @@
 
 use mwd_core::alignment::MAX_DETERMINED_SIGMA;
 use mwd_core::conventions::wrap_two_pi;
-use mwd_core::protocol::frame::{nav_flags, station_flags};
+use mwd_core::protocol::frame::{nav_flags, nav_mode, station_flags};
 use mwd_core::protocol::uplink::{Field, NakReason, Reply, ReplyStatus};
 use mwd_core::protocol::{NavSolution, StationSurvey};
 use mwd_core::timing::SAMPLE_INTERVAL_S;
@@ -217,6 +217,18 @@ pub fn reply_text(reply: &Reply) -> String {
         ReplyStatus::Nak(reason) => format!("{reason:?}"),
     };
     format!("NAK {why}, configuration {version}")
+}
+
+/// The navigation mode as a short word for the display, padded to six
+/// characters (the live status line's column; trim it elsewhere).
+pub fn mode_name(mode: u8) -> &'static str {
+    match mode {
+        nav_mode::INITIALISING => "init  ",
+        nav_mode::COARSE_ALIGNMENT => "coarse",
+        nav_mode::FINE_ALIGNMENT => "fine  ",
+        nav_mode::NAVIGATING => "nav   ",
+        _ => "?     ",
+    }
 }
 
 #[cfg(test)]

@@ -23,14 +23,16 @@ use mwd_core::config::default_still_settings;
 use mwd_core::conventions::{DrillingAngles, Euler};
 use mwd_core::earth::Position;
 use mwd_core::probe::TieIn;
-use mwd_core::protocol::frame::nav_mode;
 use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
 use crate::formats::capture::CaptureSummary;
 use crate::formats::display;
 use crate::replay::commands::CommandRow;
-use crate::replay::{self, ReplayRow, ReplaySummary, Replayer, StepLoss};
+use crate::replay::replayer::Replayer;
+use crate::replay::rows::{ReplayRow, ReplaySummary};
+use crate::replay::rows_csv::CSV_HEADER;
+use crate::replay::step_loss::StepLoss;
 
 /// Why a live replay stopped.
 #[derive(Debug)]
@@ -93,7 +95,7 @@ impl fmt::Display for LiveStatus {
             "t {:8.2} s {} | roll {:7.2} pitch {:7.2} deg | inc {:6.2} tf {:6.2} deg az {azimuth} | \
              frames {} lost {} crc {} restarts {} | parity {}/{}",
             s.time_us as f64 * 1e-6,
-            mode_name(s.mode),
+            display::mode_name(s.mode),
             deg(s.attitude[0]),
             deg(s.attitude[1]),
             drilling.inclination.to_degrees(),
@@ -109,17 +111,6 @@ impl fmt::Display for LiveStatus {
             write!(f, " ({} unchecked)", self.replay.unchecked)?;
         }
         Ok(())
-    }
-}
-
-/// The navigation mode as a short word for the display.
-pub fn mode_name(mode: u8) -> &'static str {
-    match mode {
-        nav_mode::INITIALISING => "init  ",
-        nav_mode::COARSE_ALIGNMENT => "coarse",
-        nav_mode::FINE_ALIGNMENT => "fine  ",
-        nav_mode::NAVIGATING => "nav   ",
-        _ => "?     ",
     }
 }
 
@@ -202,7 +193,7 @@ pub fn run(
     let mut latest: Option<NavSolution> = None;
     let mut buf = [0u8; 4096];
     if let Some(csv) = sinks.csv.as_mut() {
-        if let Err(e) = writeln!(csv, "{}", replay::CSV_HEADER).and_then(|()| csv.flush()) {
+        if let Err(e) = writeln!(csv, "{}", CSV_HEADER).and_then(|()| csv.flush()) {
             return outcome(decoder, capture, replayer, StreamEnd::OutputFailed(e));
         }
     }

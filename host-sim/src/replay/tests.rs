@@ -1,8 +1,12 @@
 //! The replay's unit tests (frames without commands).
 
 use super::*;
-use mwd_core::protocol::frame::raw_flags;
-use mwd_core::protocol::{RawPart, RawSample};
+use mwd_core::earth::Position;
+use mwd_core::probe::{Navigator, TieIn};
+use mwd_core::protocol::frame::{nav_flags, raw_flags};
+use mwd_core::protocol::{
+    EventKind, Frame, NavSolution, Payload, RawPart, RawSample, StationSurvey,
+};
 use mwd_core::sensor_units::{m_s2_to_accel_count, PART_MOUNTINGS, STANDARD_GRAVITY_M_S2};
 
 fn raw(n: u32) -> Frame {
