@@ -16,9 +16,10 @@
 //! - [`csv_input`], [`units`], [`plot`], [`stats`]: the analysis commands'
 //!   column input and units, SVG plots, chi-square.
 //!
-//! Stage 4 of the data's way (see `lib.rs`): uses `formats` (the capture,
-//! the sample CSV, the model files it writes); not `sim` or `replay`, which
-//! it does not need, nor any later stage.
+//! Stage 2 of the data's way (see `lib.rs`): uses `formats` (the capture
+//! and the sample CSV it reads). Its model files (AR models, calibration)
+//! feed the simulator and the probe's configuration, so it comes before
+//! `sim`.
 
 pub mod allan;
 pub mod allan_analysis;
