@@ -3,6 +3,10 @@
 //! boards' data and curves, the calibration, parameter setting and system
 //! control). docs/dashboard.md.
 //!
+//! Stage 9 of the data's way (see `lib.rs`), the last: uses `formats` (the
+//! frames), `replay` (the live decoding) and `survey` (the job, and the
+//! stations collected and positioned as the survey does).
+//!
 //! - [`source`]: frames from a serial port (recorded raw as they arrive)
 //!   or a capture replayed at a chosen pace; the probe's commands.
 //! - [`state`]: what the page shows, in bounded buffers, and its updates.

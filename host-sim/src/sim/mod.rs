@@ -1,6 +1,14 @@
 //! Trajectory and sensor simulation of the probe: scripted motions at one
 //! place (`trajectory`) and the drilling of a lateral along a well plan
-//! (`plan`, `drilling`).
+//! (`plan`, `drilling`), with the SCC1300's errors (`sensor`, its model
+//! file `model_file`) and the probe's physical input stream (`stream`).
+//! The simulator writes the same captures the probe sends, with the truth
+//! beside them.
+//!
+//! Stage 3 of the data's way (see `lib.rs`): uses `formats` (the sample it
+//! produces, the captures it writes) and `analysis` (the AR model and
+//! calibration files its sensor model reads).
+
 pub mod drilling;
 pub mod model_file;
 pub mod plan;
