@@ -91,13 +91,9 @@ use nalgebra::{Matrix3, Vector3};
 type Filter<T> = FineAlignment<T, STATES_WITH_BIASES>;
 
 /// The largest roll or pitch 1-sigma (rad) for which the solution is
-/// valid: the error model is linear in the attitude error phi
-/// (C_computed = (I - [phi x]) C_true, docs/filter-derivation.md section
-/// 1); its neglected second-order term is phi^2/2 against phi, a relative
-/// error of phi/2. At 3 sigma of this limit (9 deg = 0.157 rad) that is
-/// 8 %: beyond it the covariance no longer describes the error and the
-/// frames say "solution invalid" (docs/protocol.md, Kind 2).
-pub const TILT_SIGMA_LIMIT_RAD: f64 = 3.0 * DEG;
+/// valid: the error model's limit (`crate::error_model`), re-exported
+/// here where the frames and stations apply it.
+pub use crate::error_model::TILT_SIGMA_LIMIT_RAD;
 
 /// The covariance health check's bound on every variance, in the states'
 /// own units squared (rad^2, (m/s)^2, m^2, and the sensor-error states'):

@@ -20,9 +20,8 @@
 //! The three survey angles are taken as independent (a survey listing gives
 //! no correlations).
 
-use super::navigator::TILT_SIGMA_LIMIT_RAD;
 use crate::conventions::{dcm_from_euler, quat_from_euler, DrillingAngles, DEG};
-use crate::error_model::ATT;
+use crate::error_model::{ATT, TILT_SIGMA_LIMIT_RAD};
 use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
 use core::f64::consts::{PI, TAU};
 use nalgebra::{Matrix3, UnitQuaternion};
@@ -58,8 +57,8 @@ pub enum TieInError {
     /// The angle's 1-sigma is NaN, infinite, zero or negative.
     SigmaNotPositive(TieInAngle),
     /// The 1-sigma is beyond what the filter's small-angle model holds:
-    /// inclination and toolface beyond the navigator's tilt limit
-    /// (`TILT_SIGMA_LIMIT_RAD`, 3 deg: the solution would be invalid from
+    /// inclination and toolface beyond the error model's tilt limit
+    /// ([`TILT_SIGMA_LIMIT_RAD`], 3 deg: the solution would be invalid from
     /// its first frame), azimuth beyond [`MAX_AZIMUTH_SIGMA_RAD`].
     SigmaTooLarge(TieInAngle),
 }
