@@ -1,5 +1,14 @@
 use super::*;
+use crate::calibration::ProbeCalibration;
+use crate::conventions::{Euler, DEG};
+use crate::earth::Position;
+use crate::error_model::AugmentedModel;
+use crate::probe::raw::{reading, Reading};
 use crate::protocol::frame::station_flags;
+use crate::protocol::frame::{nav_flags, nav_mode};
+use crate::protocol::NavSolution;
+use crate::sensor_noise::ImuNoise;
+use crate::timing::ALIGNMENT_SAMPLES;
 extern crate std;
 use super::super::still::DETECTION_DELAY_SAMPLES;
 use crate::calibration::TriadCalibration;
