@@ -1,6 +1,6 @@
-//! The static (coarse) alignment's end: the still samples' sums levelled
-//! and gyrocompassed (`crate::alignment`), and the filter started from
-//! them for the fine alignment.
+//! The static (coarse) alignment: the still samples summed, and at its
+//! end their means levelled and gyrocompassed (`crate::alignment`), and
+//! the filter started from them for the fine alignment.
 
 use super::state::{filter_config, Navigator, Phase};
 use crate::alignment::{
@@ -9,13 +9,27 @@ use crate::alignment::{
 use crate::conventions::{quat_from_euler, Euler};
 use crate::kalman::FilterScalar;
 use crate::mechanization::NavState;
+use crate::probe_sample::ProbeSample;
+use crate::timing::ALIGNMENT_SAMPLES;
 
 impl<T: FilterScalar> Navigator<T> {
-    pub(super) fn finish_coarse_alignment(
-        &mut self,
-        segment: &StaticSegment,
-        gyrocompass_possible: bool,
-    ) {
+    /// A coarse-alignment sample (of one part when `single_part`): added
+    /// to the sums, the alignment finished at [`ALIGNMENT_SAMPLES`].
+    pub(super) fn coarse_sample(&mut self, sample: &ProbeSample, single_part: bool) {
+        let Phase::Coarse(sums) = &mut self.phase else {
+            return;
+        };
+        self.coarse_single_part |= single_part;
+        sums.add(sample);
+        if sums.samples() >= ALIGNMENT_SAMPLES as usize {
+            let segment = sums.segment();
+            // A single part in the coarse alignment: its gyro alone cannot
+            // gyrocompass.
+            self.finish_coarse_alignment(&segment, !self.coarse_single_part);
+        }
+    }
+
+    fn finish_coarse_alignment(&mut self, segment: &StaticSegment, gyrocompass_possible: bool) {
         let mut config = AlignmentConfig::probe(self.position.lat);
         config.noise = *self.noise;
         let (roll, pitch, roll_pitch_std) = match level_segment(segment, &config) {

@@ -4,27 +4,18 @@
 //! `navigator`: what the frames say).
 
 use super::commands::Refusal;
-use super::drilling::{
-    add_tool_axis_variance, aid_drilling_toolface, drilling_attitude_noise, roll_offset,
-    vibration_onset_factor, DRILLING_JITTER_LIMIT_M_S2, SINGLE_SAMPLE_ROLL_SIGMA_RAD,
-};
 use super::frame::VARIANCE_LIMIT;
 use super::state::{square, Navigator, Phase};
-use super::stations::SURVEY_SETTLE_EPOCHS;
-use crate::aid_sources::{
-    AxialSpeed, NonHolonomic, AXIAL_SPEED_VARIANCE, DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
-};
-use crate::attitude::ToolAxisRate;
 use crate::conventions::DEG;
 use crate::fine_alignment::StepNoise;
-use crate::kalman::{FilterScalar, Stacked};
-use crate::mechanization::{ProbeInput, ToolAxisSource};
+use crate::kalman::FilterScalar;
+use crate::mechanization::ProbeInput;
 use crate::probe::raw::{reading, Reading};
 use crate::probe::tie_in::TieIn;
 use crate::probe_sample::{ProbeSample, GYRO_AXES};
 use crate::protocol::frame::nav_flags;
 use crate::protocol::{NavSolution, RawSample};
-use crate::timing::{ALIGNMENT_SAMPLES, FINE_ALIGNMENT_SAMPLES, SAMPLE_INTERVAL_S};
+use crate::timing::SAMPLE_INTERVAL_S;
 
 /// The rate (rad/s) a sample the probe did not measure may be off by: a
 /// gap's held rate, or the missing gyro's stand-in in single-part mode.
@@ -197,13 +188,11 @@ impl<T: FilterScalar> Navigator<T> {
     }
 
     /// `sample`, with the gyro of index `missing_gyro` (in `GYRO_AXES`)
-    /// out when one part is. Returns, when navigating, whether the probe
-    /// was still (a zero-velocity update was made).
+    /// out when one part is, through the phase the navigator is in.
+    /// Returns, when navigating, whether the probe was still (a
+    /// zero-velocity update was made).
     fn use_sample(&mut self, sample: &ProbeSample, missing_gyro: Option<usize>) -> Option<bool> {
         let mut sample = *sample;
-        let mut coarse_done = None;
-        let mut fine_done = false;
-        let mut navigating_still = None;
         let gap_ended = self.missed > 0;
         self.missed = 0;
         if gap_ended {
@@ -230,14 +219,33 @@ impl<T: FilterScalar> Navigator<T> {
                 false
             }
         };
-        let filter = &mut self.filter;
-        // The missing gyro's stand-in: the rate of a tool turning with the
-        // navigation frame (a still tool), uncertain by
-        // `UNMEASURED_RATE_SIGMA` each step.
-        let extra = match missing_gyro {
+        let extra = self.stand_in_missing_gyro(&mut sample, missing_gyro);
+        match self.phase {
+            Phase::Coarse(_) => {
+                self.coarse_sample(&sample, missing_gyro.is_some());
+                None
+            }
+            Phase::Fine { .. } => {
+                self.fine_sample(&sample, &extra);
+                None
+            }
+            Phase::Navigating => Some(self.navigation_sample(&sample, missing_gyro, still, extra)),
+        }
+    }
+
+    /// The missing gyro's stand-in, put in `sample`: the rate of a tool
+    /// turning with the navigation frame (a still tool), uncertain by
+    /// `UNMEASURED_RATE_SIGMA` each step. Returns the step's extra noise
+    /// (none with both parts).
+    fn stand_in_missing_gyro(
+        &mut self,
+        sample: &mut ProbeSample,
+        missing_gyro: Option<usize>,
+    ) -> StepNoise {
+        match missing_gyro {
             None => StepNoise::NONE,
             Some(k) => {
-                let frame_rate = filter.frame_rate_in_body();
+                let frame_rate = self.filter.frame_rate_in_body();
                 sample.gyro[k] = frame_rate[GYRO_AXES[k]];
                 StepNoise {
                     attitude: square(UNMEASURED_RATE_SIGMA * SAMPLE_INTERVAL_S),
@@ -245,206 +253,7 @@ impl<T: FilterScalar> Navigator<T> {
                     skip_updates: false,
                 }
             }
-        };
-        match &mut self.phase {
-            Phase::Coarse(sums) => {
-                self.coarse_single_part |= missing_gyro.is_some();
-                sums.add(&sample);
-                if sums.samples() >= ALIGNMENT_SAMPLES as usize {
-                    coarse_done = Some(sums.segment());
-                }
-            }
-            Phase::Fine { samples } => {
-                let (imu, _) = self.input.imu_sample(
-                    &filter.frame_rate_in_body(),
-                    &sample,
-                    ToolAxisSource::AtRest,
-                    SAMPLE_INTERVAL_S,
-                );
-                let report = filter.step_with(&imu, &extra);
-                self.held = Some(imu);
-                if report.zero_velocity.accepted > 0 {
-                    self.flags |= nav_flags::ZUPT_APPLIED;
-                    self.coasting = false;
-                }
-                *samples += 1;
-                fine_done = *samples >= FINE_ALIGNMENT_SAMPLES;
-            }
-            Phase::Navigating => {
-                let jitter = f64::from(self.still.statistics().lateral_jitter);
-                let drilling = !still && jitter > DRILLING_JITTER_LIMIT_M_S2;
-                // Drilling: the roll is held (the accelerometer roll is
-                // vibration), and the roll estimator starts again after it:
-                // a difference across the drilling would add the roll
-                // change a second time on top of what the filter already
-                // corrected through the constraints. Still: held too, as in
-                // the fine alignment (`ToolAxisSource::AtRest`: a single
-                // sample's roll carries its 0.3 deg of noise).
-                if drilling {
-                    self.input = ProbeInput::new();
-                }
-                let source = if drilling || still {
-                    ToolAxisSource::AtRest
-                } else {
-                    ToolAxisSource::AccelerometerRoll
-                };
-                let frame_rate = filter.frame_rate_in_body();
-                let (imu, tool_axis) =
-                    self.input
-                        .imu_sample(&frame_rate, &sample, source, SAMPLE_INTERVAL_S);
-                filter.hold_tool_axis(source == ToolAxisSource::AtRest);
-                if tool_axis == ToolAxisRate::Unavailable || drilling {
-                    self.flags |= nav_flags::TOOL_AXIS_RATE_INVALID;
-                }
-                // No updates past the longest station (see
-                // `MAX_STATION_SAMPLES`): free navigation until it moves.
-                let update = still && !self.station_capped;
-                filter.set_zero_velocity(update.then_some(self.station_zupt_variance));
-                let mut extra = extra;
-                self.drilling_cycles = if drilling {
-                    self.drilling_cycles.saturating_add(1)
-                } else {
-                    0
-                };
-                if drilling {
-                    // The measured lateral jitter is the vibration's force
-                    // noise per sample: white, a velocity random walk.
-                    let onset = vibration_onset_factor(self.drilling_cycles);
-                    extra.velocity += square(jitter * SAMPLE_INTERVAL_S) * onset;
-                }
-                filter.linearize_at_gravity(drilling || still);
-                // A still tool's attitude does not change: once the
-                // station's first block has re-levelled it, the error model
-                // stays linearised there instead of following each ZUPT's
-                // correction (derivation section 4i).
-                let settled = still
-                    && self
-                        .station
-                        .as_ref()
-                        .is_some_and(|s| s.epochs >= SURVEY_SETTLE_EPOCHS);
-                filter.fix_linearization(settled);
-                let report = filter.step_with(&imu, &extra);
-                if drilling {
-                    filter.add_attitude_noise(&drilling_attitude_noise(filter.state()));
-                }
-                if report.sample_used && !update && !self.covariance_invalid {
-                    // Drilling or moving in the hole: the tool moves along
-                    // its axis (derivation sections 4b, 4d). Also still
-                    // past the station's end (the longest station, or the
-                    // gyros saw it turn): the detector cannot tell a tool
-                    // at rest from one sliding smoothly, and these hold
-                    // for both; free inertial navigation there grew
-                    // velocity errors of tens of m/s in an hour of a quiet
-                    // slide, far outside the error model's linear range.
-                    // The rows' attitude terms (v_n x r_a) are dropped:
-                    // linearised at the computed velocity, which while
-                    // drilling is mostly vibration noise (the true speed,
-                    // the rate of penetration, is < 0.01 m/s), they would
-                    // read that noise as azimuth and tilt errors; the true
-                    // speed's leak through an attitude error is in the
-                    // constraint's noise (the misalignment part, 0.5 m/s x
-                    // 1 deg; derivation section 4d).
-                    let state = filter.state();
-                    let mut cross = NonHolonomic::at(state, T::of(DRILLING_VARIANCE));
-                    cross.attitude_row = [[T::zero(); 3]; 2];
-                    let mut axial = AxialSpeed::at(state, T::of(AXIAL_SPEED_VARIANCE));
-                    axial.attitude_row = [T::zero(); 3];
-                    // One update: the axial bound's value was computed
-                    // at the solution before the cross-axis correction,
-                    // which a feedback between two updates would have
-                    // moved under it (`kalman::Stacked`).
-                    filter.aid(&Stacked(cross, axial));
-                }
-                if drilling && report.sample_used && !self.covariance_invalid {
-                    self.toolface_block.add(&sample.specific_force);
-                    if self.toolface_block.samples() >= TOOLFACE_BLOCK_SAMPLES {
-                        aid_drilling_toolface(filter, &self.toolface_block, self.noise);
-                        self.toolface_block.clear();
-                    }
-                } else {
-                    self.toolface_block.clear();
-                }
-                if still && self.drilled_since_station {
-                    // The first still cycle after drilling: the roll was
-                    // held through it, so the orienter's steps were not
-                    // sensed. The accelerometer roll shows how far off the
-                    // held roll is; that, with the sample's own roll noise,
-                    // goes into the variance about the tool axis, and the
-                    // station's zero-velocity updates re-level it.
-                    let offset = roll_offset(filter.state(), &sample);
-                    let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
-                    add_tool_axis_variance(filter, variance);
-                    // The accelerometer biases as the last station (at rest)
-                    // left them: while drilling the filter read the
-                    // vibration's rectified force as bias, and at rest
-                    // that bias is inseparable from the tilt the station
-                    // measures, so it would go straight into the toolface
-                    // (seen in the simulated lateral: 0.10-0.15 deg of
-                    // toolface error, the same sign in every seed, against
-                    // 0.035-deg sigmas).
-                    if let Some(snapshot) = &self.rest_accel_bias {
-                        filter.restore_accel_bias(snapshot);
-                    }
-                    self.drilled_since_station = false;
-                }
-                if !still && !drilling && self.was_still && report.sample_used {
-                    // The first moving cycle after a still period: the
-                    // roll was held through the still detector's delay
-                    // while the orienter may already have been turning the
-                    // tool (0.5 deg in the simulated connections, 15 times
-                    // the station's roll sigma), and from here the roll
-                    // follows the accelerometer roll's differences, so its
-                    // error stays that offset plus the difference of two
-                    // samples' roll noise. Unmodelled, the velocity it
-                    // makes went through the non-holonomic updates into
-                    // the heading (up to 8 deg per connection in the
-                    // drilling study; derivation section 4h).
-                    let offset = roll_offset(filter.state(), &sample);
-                    let variance = square(offset) + 2.0 * square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
-                    add_tool_axis_variance(filter, variance);
-                }
-                if let (true, Some(turn)) = (drilling, self.last_roll_turn) {
-                    // The first drilling cycle after the roll followed the
-                    // accelerometers: the roll is held from here, and the
-                    // vibration that made this a drilling cycle may have
-                    // begun before the orienter's turn ended. The turn of
-                    // one cycle is estimated by the last one's (noisy by
-                    // the two samples' roll noise, which is added too).
-                    let variance = square(turn) + 2.0 * square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
-                    add_tool_axis_variance(filter, variance);
-                }
-                self.last_roll_turn = match (source, tool_axis) {
-                    (ToolAxisSource::AccelerometerRoll, ToolAxisRate::Valid(rate)) => {
-                        Some((rate - frame_rate.y) * SAMPLE_INTERVAL_S)
-                    }
-                    _ => None,
-                };
-                self.was_still = still;
-                self.drilled_since_station |= drilling;
-                if still && !self.drilled_since_station {
-                    self.rest_accel_bias = filter.accel_bias();
-                }
-                self.still_gyro = (update && missing_gyro.is_none()).then_some(sample.gyro);
-                self.held = Some(imu);
-                if still {
-                    self.flags |= nav_flags::STILL;
-                }
-                if report.zero_velocity.accepted > 0 {
-                    self.flags |= nav_flags::ZUPT_APPLIED;
-                    self.coasting = false;
-                }
-                navigating_still = Some(still && report.sample_used);
-            }
         }
-        if let Some(segment) = coarse_done {
-            // A single part in the coarse alignment: its gyro alone cannot
-            // gyrocompass.
-            self.finish_coarse_alignment(&segment, !self.coarse_single_part);
-        }
-        if fine_done {
-            self.enter_navigation();
-        }
-        navigating_still
     }
 
     /// A sample with no valid data: after the coarse alignment the filter

@@ -1,12 +1,16 @@
 //! The drilling environment (derivation section 4d): when the probe is
 //! taken as drilling, the vibration's attitude and velocity noise, the
-//! held roll's toolface updates and re-rolls, the non-holonomic update on
-//! request, and the roll's variance where the tool may have turned unseen.
+//! moving tool's constraints, the held roll's toolface updates and
+//! re-rolls, and the roll's variance where the tool may have turned
+//! unseen (at the changes between still, moving and drilling).
 
 use super::state::{square, Filter, Navigator};
-use crate::aid_sources::{DrillingToolface, ForceBlock, NonHolonomic, DRILLING_VARIANCE};
+use crate::aid_sources::{
+    AxialSpeed, DrillingToolface, ForceBlock, NonHolonomic, AXIAL_SPEED_VARIANCE,
+    DRILLING_VARIANCE, TOOLFACE_BLOCK_SAMPLES,
+};
 use crate::conventions::{dcm_from_quat, euler_from_quat, DEG};
-use crate::kalman::{FilterScalar, UpdateReport};
+use crate::kalman::{FilterScalar, Stacked, UpdateReport};
 use crate::mechanization::NavState;
 use crate::probe_sample::ProbeSample;
 use crate::sensor_noise::ImuNoise;
@@ -44,6 +48,94 @@ pub const DRILLING_TOOLFACE_VARIANCE_PER_S: f64 = 100.0 * DEG * DEG / 3600.0;
 pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 
 impl<T: FilterScalar> Navigator<T> {
+    /// The moving tool's constraints, one update: drilling or moving in
+    /// the hole, the tool moves along its axis (derivation sections 4b,
+    /// 4d). Also still past the station's end (the longest station, or the
+    /// gyros saw it turn): the detector cannot tell a tool at rest from one
+    /// sliding smoothly, and these hold for both; free inertial navigation
+    /// there grew velocity errors of tens of m/s in an hour of a quiet
+    /// slide, far outside the error model's linear range. The rows'
+    /// attitude terms (v_n x r_a) are dropped: linearised at the computed
+    /// velocity, which while drilling is mostly vibration noise (the true
+    /// speed, the rate of penetration, is < 0.01 m/s), they would read that
+    /// noise as azimuth and tilt errors; the true speed's leak through an
+    /// attitude error is in the constraint's noise (the misalignment part,
+    /// 0.5 m/s x 1 deg; derivation section 4d).
+    pub(super) fn constrain_moving_tool(&mut self) {
+        let state = self.filter.state();
+        let mut cross = NonHolonomic::at(state, T::of(DRILLING_VARIANCE));
+        cross.attitude_row = [[T::zero(); 3]; 2];
+        let mut axial = AxialSpeed::at(state, T::of(AXIAL_SPEED_VARIANCE));
+        axial.attitude_row = [T::zero(); 3];
+        // One update: the axial bound's value was computed
+        // at the solution before the cross-axis correction,
+        // which a feedback between two updates would have
+        // moved under it (`kalman::Stacked`).
+        self.filter.aid(&Stacked(cross, axial));
+    }
+
+    /// A drilling sample's force into the toolface block; a full block is
+    /// one toolface update ([`aid_drilling_toolface`]).
+    pub(super) fn add_to_toolface_block(&mut self, sample: &ProbeSample) {
+        self.toolface_block.add(&sample.specific_force);
+        if self.toolface_block.samples() >= TOOLFACE_BLOCK_SAMPLES {
+            aid_drilling_toolface(&mut self.filter, &self.toolface_block, self.noise);
+            self.toolface_block.clear();
+        }
+    }
+
+    /// The first still cycle after drilling: the roll was
+    /// held through it, so the orienter's steps were not
+    /// sensed. The accelerometer roll shows how far off the
+    /// held roll is; that, with the sample's own roll noise,
+    /// goes into the variance about the tool axis, and the
+    /// station's zero-velocity updates re-level it.
+    pub(super) fn first_still_after_drilling(&mut self, sample: &ProbeSample) {
+        let offset = roll_offset(self.filter.state(), sample);
+        let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+        add_tool_axis_variance(&mut self.filter, variance);
+        // The accelerometer biases as the last station (at rest)
+        // left them: while drilling the filter read the
+        // vibration's rectified force as bias, and at rest
+        // that bias is inseparable from the tilt the station
+        // measures, so it would go straight into the toolface
+        // (seen in the simulated lateral: 0.10-0.15 deg of
+        // toolface error, the same sign in every seed, against
+        // 0.035-deg sigmas).
+        if let Some(snapshot) = &self.rest_accel_bias {
+            self.filter.restore_accel_bias(snapshot);
+        }
+        self.drilled_since_station = false;
+    }
+
+    /// The first moving cycle after a still period: the
+    /// roll was held through the still detector's delay
+    /// while the orienter may already have been turning the
+    /// tool (0.5 deg in the simulated connections, 15 times
+    /// the station's roll sigma), and from here the roll
+    /// follows the accelerometer roll's differences, so its
+    /// error stays that offset plus the difference of two
+    /// samples' roll noise. Unmodelled, the velocity it
+    /// makes went through the non-holonomic updates into
+    /// the heading (up to 8 deg per connection in the
+    /// drilling study; derivation section 4h).
+    pub(super) fn first_move_after_still(&mut self, sample: &ProbeSample) {
+        let offset = roll_offset(self.filter.state(), sample);
+        let variance = square(offset) + 2.0 * square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+        add_tool_axis_variance(&mut self.filter, variance);
+    }
+
+    /// The first drilling cycle after the roll followed the
+    /// accelerometers (by `turn`, rad, in the last cycle): the roll is
+    /// held from here, and the vibration that made this a drilling cycle
+    /// may have begun before the orienter's turn ended. The turn of
+    /// one cycle is estimated by the last one's (noisy by
+    /// the two samples' roll noise, which is added too).
+    pub(super) fn first_drilling_after_roll(&mut self, turn: f64) {
+        let variance = square(turn) + 2.0 * square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
+        add_tool_axis_variance(&mut self.filter, variance);
+    }
+
     /// One non-holonomic update at the current solution (no velocity
     /// across the tool axis, `aid_sources::NonHolonomic`, with the drilling
     /// BHA's noise [`DRILLING_VARIANCE`]), for the caller that knows the
@@ -128,7 +220,7 @@ pub(super) fn add_tool_axis_variance<T: FilterScalar>(filter: &mut Filter<T>, va
 
 /// The accelerometer roll of `sample` less the solution's roll (rad,
 /// wrapped; 0 where the roll is not defined: tool near vertical).
-pub(super) fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
+fn roll_offset(state: &NavState, sample: &ProbeSample) -> f64 {
     let levelling = crate::attitude::level(&sample.specific_force);
     if !levelling.roll_valid {
         return 0.0;

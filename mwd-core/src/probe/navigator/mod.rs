@@ -45,13 +45,13 @@
 //!
 //! The files, in the order a cycle meets them: `state.rs` (the navigator,
 //! its phases and a station in progress, its constructors and settings),
-//! `cycle.rs` (the entry points and one raw sample's way to its phase, a
-//! gap's coasting), `coarse.rs` and `fine.rs` (the static alignment and
-//! the fine alignment), `navigation.rs` and `drilling.rs` (the navigating
-//! cycle and the drilling environment's models), `stations.rs` (station
-//! surveys), `heading.rs` (the heading's loss and references), `frame.rs`
-//! (what a frame reports), `tie_in_start.rs` (a start from a tie-in) and
-//! [`commands`] (the surface's survey commands).
+//! `cycle.rs` (the entry points, one raw sample to its phase, a gap's
+//! coasting), `coarse.rs` and `fine.rs` (the static and the fine
+//! alignment), `navigation.rs` (a navigating cycle) with `drilling.rs`
+//! (the drilling environment), `stations.rs` (station surveys),
+//! `heading.rs` (the heading's loss and references), `frame.rs` (what a
+//! frame reports); `tie_in_start.rs` (a start from a tie-in) and
+//! [`commands`] (the surface's survey commands) between cycles.
 
 mod coarse;
 pub mod commands;
@@ -60,6 +60,7 @@ mod drilling;
 mod fine;
 mod frame;
 mod heading;
+mod navigation;
 mod state;
 mod stations;
 mod tie_in_start;
@@ -83,6 +84,9 @@ mod settings_tests;
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod station_tests;
 
 #[cfg(test)]
 mod slide_tests;
