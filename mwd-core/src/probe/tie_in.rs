@@ -20,9 +20,10 @@
 //! The three survey angles are taken as independent (a survey listing gives
 //! no correlations).
 
+use crate::aid_sources::attitude_angle_scalar;
 use crate::conventions::{dcm_from_euler, quat_from_euler, DrillingAngles, DEG};
-use crate::error_model::{ATT, TILT_SIGMA_LIMIT_RAD};
-use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
+use crate::error_model::TILT_SIGMA_LIMIT_RAD;
+use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement};
 use core::f64::consts::{PI, TAU};
 use nalgebra::{Matrix3, UnitQuaternion};
 
@@ -212,15 +213,11 @@ impl<T: FilterScalar> Measurement<T> for TieInTilt<T> {
     }
     fn scalar(&self, k: usize) -> Option<ScalarMeasurement<T>> {
         let row = self.rows.get(k)?;
-        let mut h = SparseRow::empty();
-        for (i, v) in row.iter().enumerate() {
-            h.push(ATT + i, *v);
-        }
-        Some(ScalarMeasurement {
-            z: self.innovation[k],
-            h,
-            r: self.variance[k],
-        })
+        Some(attitude_angle_scalar(
+            self.innovation[k],
+            row,
+            self.variance[k],
+        ))
     }
 }
 
