@@ -68,12 +68,8 @@ impl<T: FilterScalar> Navigator<T> {
         );
         self.covariance_invalid = false;
         self.coasting = false;
-        self.drilled_since_station = false;
         self.was_still = false;
-        self.drilling_cycles = 0;
-        self.last_roll_turn = None;
-        self.rest_accel_bias = None;
-        self.toolface_block.clear();
+        self.forget_drilling();
         self.phase = Phase::Fine { samples: 0 };
     }
 }

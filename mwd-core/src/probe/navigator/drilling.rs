@@ -48,6 +48,18 @@ pub const DRILLING_TOOLFACE_VARIANCE_PER_S: f64 = 100.0 * DEG * DEG / 3600.0;
 pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 
 impl<T: FilterScalar> Navigator<T> {
+    /// Drilling mode starts afresh (a new attitude from an alignment or a
+    /// tie-in): no drilling since a station, no drilling cycles, no roll
+    /// turn remembered, no accelerometer biases kept from rest, an empty
+    /// toolface block.
+    pub(super) fn forget_drilling(&mut self) {
+        self.drilled_since_station = false;
+        self.drilling_cycles = 0;
+        self.last_roll_turn = None;
+        self.rest_accel_bias = None;
+        self.toolface_block.clear();
+    }
+
     /// The moving tool's constraints, one update: drilling or moving in
     /// the hole, the tool moves along its axis (derivation sections 4b,
     /// 4d). Also still past the station's end (the longest station, or the

@@ -68,13 +68,9 @@ impl<T: FilterScalar> Navigator<T> {
         self.input = ProbeInput::new();
         self.coasting = false;
         self.coarse_single_part = false;
-        self.drilled_since_station = false;
         // `was_still` is kept: the roll is the levelling's, held as at the
         // end of the fine alignment (`enter_navigation`).
-        self.drilling_cycles = 0;
-        self.last_roll_turn = None;
-        self.rest_accel_bias = None;
-        self.toolface_block.clear();
+        self.forget_drilling();
     }
 
     /// [`start_from_tie_in`](Self::start_from_tie_in) before the probe
@@ -96,12 +92,8 @@ impl<T: FilterScalar> Navigator<T> {
         self.coasting = false;
         self.covariance_invalid = false;
         self.coarse_single_part = false;
-        self.drilled_since_station = false;
         self.was_still = false;
-        self.drilling_cycles = 0;
-        self.last_roll_turn = None;
-        self.rest_accel_bias = None;
-        self.toolface_block.clear();
+        self.forget_drilling();
         self.phase = Phase::Navigating;
     }
 }
