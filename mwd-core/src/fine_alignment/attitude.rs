@@ -14,19 +14,13 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// outside the probe's own sensors (a tie-in survey) is independent of
     /// their errors. `p_phi` must be symmetric positive semi-definite.
     pub fn set_attitude_error_covariance(&mut self, p_phi: &Matrix3<f64>) {
+        self.forget_states(ATT, 3);
         let p = &mut self.filter.p;
-        for i in ATT..ATT + 3 {
-            for j in 0..N {
-                p[(i, j)] = T::zero();
-                p[(j, i)] = T::zero();
-            }
-        }
         for i in 0..3 {
             for j in 0..3 {
                 p[(ATT + i, ATT + j)] = T::of(p_phi[(i, j)]);
             }
         }
-        self.filter.cross.forget_states(ATT, 3);
     }
 
     /// Adds `q` (rad^2, nav frame, symmetric positive semi-definite) to the
@@ -55,14 +49,9 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         let turn = nalgebra::UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
         state.attitude = turn * state.attitude;
         self.strapdown.reset(state);
-        let p = &mut self.filter.p;
-        for j in 0..N {
-            p[(ATT + 2, j)] = T::zero();
-            p[(j, ATT + 2)] = T::zero();
-        }
-        p[(ATT + 2, ATT + 2)] = T::of(variance);
+        self.forget_states(ATT + 2, 1);
+        self.filter.p[(ATT + 2, ATT + 2)] = T::of(variance);
         self.filter.x[ATT + 2] = T::zero();
-        self.filter.cross.forget_states(ATT + 2, 1);
     }
 
     /// Turns the solution about the tool axis so that its roll is `roll`

@@ -112,14 +112,8 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         if N != STATES_WITH_BIASES {
             return;
         }
-        self.filter.cross.forget_states(ACCEL_BIAS, 3);
+        self.forget_states(ACCEL_BIAS, 3);
         let p = &mut self.filter.p;
-        for i in ACCEL_BIAS..ACCEL_BIAS + 3 {
-            for j in 0..N {
-                p[(i, j)] = T::zero();
-                p[(j, i)] = T::zero();
-            }
-        }
         for i in 0..3 {
             self.filter.x[ACCEL_BIAS + i] = T::of(snapshot.estimate[i]);
             for j in 0..3 {

@@ -273,6 +273,21 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         correction
     }
 
+    /// States `first..first + count` made independent of every state:
+    /// their rows and columns of the covariance zeroed (their variances
+    /// too, for the caller to set) and their cross-covariances with the
+    /// snapshots forgotten (`kalman::CrossCovariances::forget_states`).
+    pub(super) fn forget_states(&mut self, first: usize, count: usize) {
+        let p = &mut self.filter.p;
+        for i in first..first + count {
+            for j in 0..N {
+                p[(i, j)] = T::zero();
+                p[(j, i)] = T::zero();
+            }
+        }
+        self.filter.cross.forget_states(first, count);
+    }
+
     /// Ends the alignment: no more zero-velocity or zero-position updates,
     /// and F21 takes the measured specific force (the tool may now move).
     /// The filter goes on propagating, so the estimated biases keep being
