@@ -24,12 +24,13 @@
 //!   earth-rate magnitude (two signs: the north/south ambiguity).
 //!
 //! Every heading carries its 1-sigma uncertainty from the sensor error
-//! budget ([`ImuNoise`]), propagated through the estimator by central
-//! differences, and flags for ill-conditioning and ambiguity. The local
-//! (linearised) sigma is only a floor: near east/west the misfit is far
-//! from quadratic in heading, so the printed bound also covers every
-//! heading the data allow (the profile-likelihood interval: misfit within
-//! [`COVERAGE_FACTOR`]^2 of the estimate's), and the ill-conditioning flag
+//! budget ([`ImuNoise`](crate::sensor_noise::ImuNoise)), propagated
+//! through the estimator by central differences, and flags for
+//! ill-conditioning and ambiguity. The local (linearised) sigma is only a
+//! floor: near east/west the misfit is far from quadratic in heading, so
+//! the printed bound also covers every heading the data allow (the
+//! profile-likelihood interval: misfit within [`COVERAGE_FACTOR`]^2 of
+//! the estimate's), and the ill-conditioning flag
 //! is raised when the geometry is weak anywhere in that interval, not only
 //! at the estimate, which noise can pull away from east/west.
 //!

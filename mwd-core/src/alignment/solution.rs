@@ -51,8 +51,9 @@ pub struct HeadingEstimate {
     /// True when the geometry makes heading insensitive to the earth rate
     /// anywhere among the headings the data allow (or at the prior).
     pub ill_conditioned: bool,
-    /// False when sigma exceeds [`MAX_DETERMINED_SIGMA`]: the value is then
-    /// no better than a guess.
+    /// False when sigma exceeds
+    /// [`MAX_DETERMINED_SIGMA`](super::MAX_DETERMINED_SIGMA): the value is
+    /// then no better than a guess.
     pub determined: bool,
     /// Estimated gyro biases (rad/s, body x y z; 0 for absent gyros).
     pub gyro_bias: Vector3<f64>,

@@ -76,8 +76,10 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     }
 
     /// Standard deviations of roll, pitch and heading (rad; NaN where the
-    /// variance is not valid, see [`KalmanFilter::std_dev`]), through the
-    /// Jacobian of the project's Euler convention at the current attitude.
+    /// variance is not valid, see
+    /// [`KalmanFilter::std_dev`](crate::kalman::KalmanFilter::std_dev)),
+    /// through the Jacobian of the project's Euler convention at the
+    /// current attitude.
     pub fn euler_std(&self) -> Vector3<f64> {
         let j = euler_error_jacobian(&dcm_from_quat(&self.state().attitude));
         let p = j * self.attitude_error_covariance() * j.transpose();

@@ -3,7 +3,9 @@
 //!
 //! Three tests on the corrected samples (both parts) over a sliding window
 //! of [`WINDOW`] samples (1 s), each against a threshold derived from the
-//! noise budget ([`ImuNoise::scc1300`]) rather than tuned:
+//! noise budget
+//! ([`ImuNoise::scc1300`](crate::sensor_noise::ImuNoise::scc1300))
+//! rather than tuned:
 //!
 //! 1. **rate magnitude**: `T_w = sum_k sum_i w_ki^2 / s_i^2` over the two
 //!    gyros (body x and z). The earth rate (<= 15 deg/h) and the residual
