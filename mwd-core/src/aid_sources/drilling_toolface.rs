@@ -18,10 +18,10 @@
 //! toolface - block toolface (wrapped), h = the toolface row of the
 //! drilling-angle Jacobian (`conventions::angles_and_jacobian`).
 
+use super::attitude_angle::attitude_angle_scalar;
 use crate::attitude::level;
 use crate::conventions::{angles_and_jacobian, dcm_from_quat, wrap_pi};
-use crate::error_model::ATT;
-use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
+use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement};
 use crate::mechanization::NavState;
 use nalgebra::Vector3;
 
@@ -122,15 +122,11 @@ impl<T: FilterScalar> Measurement<T> for DrillingToolface<T> {
         if k != 0 {
             return None;
         }
-        let mut h = SparseRow::empty();
-        for (i, v) in self.attitude_row.iter().enumerate() {
-            h.push(ATT + i, *v);
-        }
-        Some(ScalarMeasurement {
-            z: self.toolface_residual,
-            h,
-            r: self.variance,
-        })
+        Some(attitude_angle_scalar(
+            self.toolface_residual,
+            &self.attitude_row,
+            self.variance,
+        ))
     }
 }
 

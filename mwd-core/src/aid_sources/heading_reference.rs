@@ -16,11 +16,11 @@
 //! euler_error_jacobian`, phi the navigation-frame attitude error); z is
 //! the computed azimuth minus the reference, wrapped to (-pi, pi].
 
+use super::attitude_angle::attitude_angle_scalar;
 use crate::attitude::NEAR_VERTICAL;
 use crate::conventions::angles_and_jacobian;
 use crate::conventions::{dcm_from_quat, wrap_pi};
-use crate::error_model::ATT;
-use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
+use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement};
 use crate::mechanization::NavState;
 
 /// One reference azimuth against the filter's attitude: one scalar.
@@ -80,15 +80,11 @@ impl<T: FilterScalar> Measurement<T> for HeadingReference<T> {
         if k != 0 {
             return None;
         }
-        let mut h = SparseRow::empty();
-        for (i, v) in self.attitude_row.iter().enumerate() {
-            h.push(ATT + i, *v);
-        }
-        Some(ScalarMeasurement {
-            z: self.azimuth_residual,
-            h,
-            r: self.variance,
-        })
+        Some(attitude_angle_scalar(
+            self.azimuth_residual,
+            &self.attitude_row,
+            self.variance,
+        ))
     }
 }
 

@@ -12,6 +12,7 @@
 //! The non-holonomic constraint (no velocity across the tool axis while
 //! drilling) is not in the paper: derivation section 4b.
 
+mod attitude_angle;
 mod axial_speed;
 mod drilling_toolface;
 mod earth_rate;
@@ -20,6 +21,7 @@ mod non_holonomic;
 mod zero_position;
 mod zero_velocity;
 
+pub(crate) use attitude_angle::attitude_angle_scalar;
 pub use axial_speed::{AxialSpeed, AXIAL_SPEED_VARIANCE};
 pub use drilling_toolface::{DrillingToolface, ForceBlock, TOOLFACE_BLOCK_SAMPLES};
 pub use earth_rate::{attitude_rows, long_run_variance, predicted_rates, EarthRate};

@@ -1,6 +1,15 @@
+use super::misfit::{Misfit, GRID_POINTS};
+use super::segments::MeanSigmas;
+use super::uncertainty::{half_width, ALLOWED_CHI2};
 use super::*;
 use crate::conventions::specific_force_at_rest;
+use crate::conventions::{dcm_from_euler, wrap_pi, Euler};
+use crate::earth::earth_rate_n;
 use crate::earth::{normal_gravity, Position};
+use crate::probe_sample::ProbeSample;
+use crate::sensor_noise::ImuNoise;
+use core::f64::consts::{PI, TAU};
+use nalgebra::Vector3;
 use proptest::prelude::*;
 
 use crate::conventions::DEG;

@@ -18,6 +18,7 @@ mod bias;
 pub use augmented::{AugmentedModel, AugmentedTransition, Coupling, ProcessNoise};
 pub use bias::{BiasState, SensorBiases};
 
+use crate::conventions::DEG;
 use crate::earth::{LocalEarth, Position, EARTH_RATE};
 use crate::kalman::FilterScalar;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -44,6 +45,16 @@ pub const ACCEL_BIAS: usize = STATES;
 pub const GYRO_BIAS: usize = ACCEL_BIAS + 3;
 /// Size of the state with the six sensor biases: 33 + 3 + 3 = 39.
 pub const STATES_WITH_BIASES: usize = GYRO_BIAS + 3;
+
+/// The largest roll or pitch 1-sigma (rad) for which a solution is
+/// valid: the error model is linear in the attitude error phi
+/// (C_computed = (I - [phi x]) C_true, docs/filter-derivation.md section
+/// 1); its neglected second-order term is phi^2/2 against phi, a relative
+/// error of phi/2. At 3 sigma of this limit (9 deg = 0.157 rad) that is
+/// 8 %: beyond it the covariance no longer describes the error, and the
+/// probe's frames say "solution invalid" (docs/protocol.md, Kind 2) and
+/// a tie-in with a larger tilt sigma is refused (`probe::tie_in`).
+pub const TILT_SIGMA_LIMIT_RAD: f64 = 3.0 * DEG;
 
 /// Whether a state size is one the augmented model defines (33 or 39).
 pub const fn is_model_size(n: usize) -> bool {

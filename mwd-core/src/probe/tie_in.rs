@@ -20,10 +20,10 @@
 //! The three survey angles are taken as independent (a survey listing gives
 //! no correlations).
 
-use super::navigator::TILT_SIGMA_LIMIT_RAD;
+use crate::aid_sources::attitude_angle_scalar;
 use crate::conventions::{dcm_from_euler, quat_from_euler, DrillingAngles, DEG};
-use crate::error_model::ATT;
-use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement, SparseRow};
+use crate::error_model::TILT_SIGMA_LIMIT_RAD;
+use crate::kalman::{FilterScalar, Measurement, ScalarMeasurement};
 use core::f64::consts::{PI, TAU};
 use nalgebra::{Matrix3, UnitQuaternion};
 
@@ -58,8 +58,8 @@ pub enum TieInError {
     /// The angle's 1-sigma is NaN, infinite, zero or negative.
     SigmaNotPositive(TieInAngle),
     /// The 1-sigma is beyond what the filter's small-angle model holds:
-    /// inclination and toolface beyond the navigator's tilt limit
-    /// (`TILT_SIGMA_LIMIT_RAD`, 3 deg: the solution would be invalid from
+    /// inclination and toolface beyond the error model's tilt limit
+    /// ([`TILT_SIGMA_LIMIT_RAD`], 3 deg: the solution would be invalid from
     /// its first frame), azimuth beyond [`MAX_AZIMUTH_SIGMA_RAD`].
     SigmaTooLarge(TieInAngle),
 }
@@ -213,15 +213,11 @@ impl<T: FilterScalar> Measurement<T> for TieInTilt<T> {
     }
     fn scalar(&self, k: usize) -> Option<ScalarMeasurement<T>> {
         let row = self.rows.get(k)?;
-        let mut h = SparseRow::empty();
-        for (i, v) in row.iter().enumerate() {
-            h.push(ATT + i, *v);
-        }
-        Some(ScalarMeasurement {
-            z: self.innovation[k],
-            h,
-            r: self.variance[k],
-        })
+        Some(attitude_angle_scalar(
+            self.innovation[k],
+            row,
+            self.variance[k],
+        ))
     }
 }
 

@@ -3,11 +3,14 @@
 //! undetermined and only inclination and toolface are checked).
 
 extern crate std;
+use super::super::Navigator;
 use super::super::SURVEY_SETTLE_EPOCHS;
 use super::*;
+use crate::conventions::wrap_pi;
 use crate::conventions::{specific_force_at_rest, Euler};
 use crate::earth::Position;
 use crate::protocol::frame::nav_mode;
+use crate::protocol::frame::station_flags;
 use crate::protocol::{NavSolution, RawSample};
 use crate::timing::ALIGNMENT_SAMPLES;
 use std::vec::Vec;

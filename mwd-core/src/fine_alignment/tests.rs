@@ -1,5 +1,15 @@
 use super::*;
-use crate::earth::earth_rate_n;
+use crate::conventions::{dcm_from_quat, euler_from_quat, quat_from_euler, DEG};
+use crate::earth::{earth_rate_n, gravity_n, LocalEarth, Position};
+use crate::error_model::{
+    AugmentedModel, AugmentedTransition, LinearizationPoint, ACCEL_BIAS, ATT, GYRO_BIAS, STATES,
+    STATES_WITH_BIASES, VEL,
+};
+use crate::kalman::KalmanFilter;
+use crate::mechanization::{ImuSample, NavState};
+use crate::sensor_noise::ImuNoise;
+use linearization::COS_HALF_MAX_LINEARIZATION_TURN;
+use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
 /// A negative or NaN attitude variance gives NaN Euler sigmas, never
 /// the 0 the old `max(0.0)` made of it.

@@ -5,7 +5,14 @@
 //! moving tool's constraints hold the velocity.
 
 use super::*;
+use crate::calibration::ProbeCalibration;
+use crate::earth::Position;
+use crate::probe_sample::ProbeSample;
+use crate::protocol::frame::nav_flags;
 use crate::protocol::frame::station_flags;
+use crate::protocol::{NavSolution, StationSurvey};
+use crate::sensor_noise::ImuNoise;
+use nalgebra::Vector3;
 extern crate std;
 use crate::conventions::Euler;
 

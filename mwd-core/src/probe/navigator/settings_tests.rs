@@ -3,11 +3,17 @@
 //! samples of a still, level probe: the navigator tests' generator).
 
 extern crate std;
+use super::state::station_zupt_variance;
 use super::*;
+use crate::calibration::ProbeCalibration;
 use crate::config::default_still_settings;
+use crate::earth::Position;
 use crate::probe::still::{Hysteresis, DETECTION_DELAY_SAMPLES};
 use crate::probe::test_support::{level_sample, level_turning_sample, ALL_ALIGNMENT};
+use crate::protocol::frame::nav_flags;
 use crate::protocol::frame::station_flags;
+use crate::protocol::uplink::StillSettings;
+use crate::protocol::{NavSolution, StationSurvey};
 use std::format;
 use std::vec::Vec;
 

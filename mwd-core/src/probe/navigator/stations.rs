@@ -3,26 +3,60 @@
 //! of [`SURVEY_SETTLE_EPOCHS`] still cycles gets a rate gyrocompass
 //! (derivation section 4e) behind its consistency gate
 //! ([`EARTH_RATE_GATE`]); the station's survey is the filter's attitude as
-//! drilling angles with their covariance (`super::station`).
+//! drilling angles with their covariance (`crate::probe::station`).
 
-use super::{
-    Navigator, Station, AZIMUTH_SIGMA_LIMIT_RAD, EARTH_RATE_GATE, MIN_BIAS_UPDATE_SAMPLES,
-    SURVEY_SETTLE_EPOCHS, TILT_SIGMA_LIMIT_RAD,
-};
+use super::heading::AZIMUTH_SIGMA_LIMIT_RAD;
+use super::state::{Navigator, Station};
 use crate::aid_sources::{long_run_variance, EarthRate};
 use crate::attitude::NEAR_VERTICAL;
 use crate::conventions::dcm_from_quat;
 use crate::earth::earth_rate_n;
-use crate::error_model::ATT;
+use crate::error_model::{ATT, TILT_SIGMA_LIMIT_RAD};
 use crate::kalman::{FilterScalar, SparseRow, LINKED};
 use crate::probe::station::{angle_uncertainty, angles_and_jacobian};
 use crate::probe::station_link::{
     link_covariance, link_rows, StationLink, CHECKPOINT, PREVIOUS, SETTLED,
 };
+use crate::probe::still::Z_STAY;
 use crate::probe_sample::GYRO_AXES;
 use crate::protocol::frame::{nav_flags, station_flags};
 use crate::protocol::StationSurvey;
 use crate::timing::SAMPLE_INTERVAL_S;
+
+/// Still cycles per block of the station's survey checkpoints: a station
+/// sends the survey of the older of its last two checkpoints, 40 to 80
+/// cycles (2-4 s) before its last still cycle (or its last still cycle
+/// when it was shorter than 80). The still detector ends a station only
+/// when the motion exceeds its stay threshold, and the orienter's turn
+/// begins slowly: in the drilling simulator the toolface had moved by up
+/// to 1.5 deg between 40 samples before the last still cycle and it,
+/// twenty times the station's toolface sigma.
+pub const SURVEY_SETTLE_EPOCHS: u32 = 40;
+
+/// The fewest still cycles with both gyros in a block of
+/// [`SURVEY_SETTLE_EPOCHS`] whose means make a rate-gyrocompass update
+/// (`aid_sources::EarthRate`): three quarters of the block.
+pub const MIN_BIAS_UPDATE_SAMPLES: u32 = SURVEY_SETTLE_EPOCHS * 3 / 4;
+
+/// The rate gyrocompass's consistency gate: the largest normalised
+/// innovation squared of a block's two scalars (x and z gyro, each against
+/// the filter's covariance before either is used) a still tool passes,
+/// `Z_STAY^2` (`crate::probe::still`: two-sided 2e-7 per gyro and block, about
+/// 2e-3 over the 5,500 blocks of a 1000 m lateral's 37 stations). A block beyond it is a tool that
+/// turns while the still detector sees no motion: a smooth slide at the
+/// rate of penetration has no acceleration and turns at the build and walk
+/// rates, 5-15 deg/h, which the detector cannot see against the SCC1300's
+/// per-sample noise, but a block mean reads as earth rate (15 deg/h at
+/// most). Unchecked, a quiet slide became an hour of stations whose
+/// gyrocompass turned the heading by tens of degrees under 0.05 deg sigmas
+/// (docs/lateral-study.md, "A slide without vibration"). The block is not
+/// used, and the station ends there (station flag
+/// [`MOTION_SEEN`](crate::protocol::frame::station_flags::MOTION_SEEN)).
+/// Gyros too noisy to see the turn (a block mean's noise is ~40 deg/h for
+/// the SCC1300, ~5 deg/h for the high-end MEMS grade, whose bias
+/// instability enters as rate noise) pass it, and their gyrocompass weighs
+/// it as little as the noise says.
+pub const EARTH_RATE_GATE: f64 = Z_STAY * Z_STAY;
 
 /// The snapshot slot (`kalman::CrossCovariances`) holding the state's
 /// covariance with the sums of the current block's x and z gyro noise
@@ -32,7 +66,7 @@ use crate::timing::SAMPLE_INTERVAL_S;
 /// compared against (the accelerometers, through the zero-velocity
 /// updates, see that turn as tilt). Uncounted, a station took the gyros'
 /// information about the heading twice (docs/filter-derivation.md 4k).
-pub(super) const BLOCK_NOISE: usize = 3;
+const BLOCK_NOISE: usize = 3;
 
 /// What a station's block did with the rate gyrocompass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -269,7 +303,7 @@ impl<T: FilterScalar> Navigator<T> {
     }
 
     /// The station survey at this cycle: the filter's attitude as drilling
-    /// angles, their covariance J P_phi J^T (`super::station`), the flags.
+    /// angles, their covariance J P_phi J^T (`crate::probe::station`), the flags.
     /// Everything but the station number, start and quality. With the rows
     /// of its link's z (`station_link`) where the covariance is valid.
     pub(super) fn station_survey(&self) -> (StationSurvey, Option<[SparseRow<T>; LINKED]>) {

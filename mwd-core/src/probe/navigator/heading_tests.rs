@@ -6,6 +6,14 @@
 //! until the next tie-in, flagged lost (a heading never found is not).
 
 use super::*;
+use crate::calibration::ProbeCalibration;
+use crate::earth::Position;
+use crate::probe::tie_in::TieIn;
+use crate::probe_sample::ProbeSample;
+use crate::protocol::frame::{nav_flags, nav_mode};
+use crate::protocol::NavSolution;
+use crate::sensor_noise::ImuNoise;
+use nalgebra::Vector3;
 extern crate std;
 use crate::conventions::Euler;
 use crate::protocol::frame::station_flags;
