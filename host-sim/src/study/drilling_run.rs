@@ -165,7 +165,7 @@ pub struct StationCheck {
     /// ([`AzimuthSigmaTrack::station_start`]).
     pub azimuth_sigma_before: Option<f64>,
     /// The azimuth error (rad, wrapped) of the same solution: with its
-    /// sigma, where the station starts from (`super::lateral_consistency`).
+    /// sigma, where the station starts from (`super::lateral::consistency`).
     pub azimuth_error_before: Option<f64>,
     /// The probe's link of this station's errors to the previous
     /// station's (`mwd_core::probe::station_link`), as the survey takes it.

@@ -1,22 +1,22 @@
 //! `host-sim study lateral` (issue 14 part A): which gyro meets the MGWD
-//! paper's requirement. N seeded runs of each well ([`super::drilling_run`]:
+//! paper's requirement. N seeded runs of each well ([`crate::study::drilling_run`]:
 //! simulator, navigator, stations, survey, TD check) for each gyro grade
-//! ([`super::grade`]), all grade x well x run jobs in one pool over the
+//! ([`crate::study::grade`]), all grade x well x run jobs in one pool over the
 //! cores; per grade and well the station azimuth errors, the error growth
 //! along MD against the predicted sigmas, the TD horizontal error against
 //! the predicted 1-sigma and 95 % ellipse, and whether the requirement is
-//! met. Summaries are in [`super::lateral_summary`], tables and CSV in
-//! [`super::lateral_table`].
+//! met. Summaries are in [`super::summary`], tables and CSV in
+//! [`super::table`].
 
-use super::drilling_run::{run, RunConfig, RunOutcome, Scalar};
-use super::grade::Grade;
-use super::lateral_covariance::{
+use super::covariance::{
     agreement, predict, Agreement, CovariancePrediction, SweepGrid, SweepResult,
 };
-use super::lateral_summary::{summarise, GradeWellSummary};
-use super::owsg::OwsgPrediction;
-use super::{run_jobs_until, Interruption};
+use super::summary::{summarise, GradeWellSummary};
 use crate::sim::{BuiltPlan, Plan};
+use crate::study::drilling_run::{run, RunConfig, RunOutcome, Scalar};
+use crate::study::grade::Grade;
+use crate::study::owsg::OwsgPrediction;
+use crate::study::{run_jobs_until, Interruption};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::path::Path;
@@ -25,8 +25,14 @@ use std::sync::atomic::AtomicBool;
 /// The repository's two laterals (docs/drilling-simulation.md), built in
 /// so the binary works from any directory.
 pub const BUILTIN_WELLS: [(&str, &str); 2] = [
-    ("100m", include_str!("../../data/plans/lateral-100m.json")),
-    ("1000m", include_str!("../../data/plans/lateral-1000m.json")),
+    (
+        "100m",
+        include_str!("../../../data/plans/lateral-100m.json"),
+    ),
+    (
+        "1000m",
+        include_str!("../../../data/plans/lateral-1000m.json"),
+    ),
 ];
 
 /// Drilling parameters given on the command line instead of the plan's
@@ -115,7 +121,7 @@ pub struct StudyConfig {
 #[derive(Clone, Debug, Serialize)]
 pub struct GradeInfo {
     #[serde(flatten)]
-    pub file: super::grade::GradeFile,
+    pub file: crate::study::grade::GradeFile,
 }
 
 /// A well as the output lists it.
@@ -305,8 +311,8 @@ pub fn study(
         .collect();
     let mut owsg = Vec::new();
     for well in &config.wells {
-        let site = super::owsg::study_site(well.plan.site.lat);
-        match super::owsg::predict_all(&well.plan, &site) {
+        let site = crate::study::owsg::study_site(well.plan.site.lat);
+        match crate::study::owsg::predict_all(&well.plan, &site) {
             Ok(models) => owsg.push(WellOwsg {
                 well: well.label.clone(),
                 models,

@@ -7,10 +7,10 @@
 //! the predicted station azimuth sigmas against the RMS azimuth error.
 //! Also the sweep over gyro bias instability and ARW.
 
-use super::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
-use super::grade::Grade;
-use super::lateral_summary::GradeWellSummary;
-use super::stats::rms;
+use super::summary::GradeWellSummary;
+use crate::study::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
+use crate::study::grade::Grade;
+use crate::study::stats::rms;
 use crate::survey::listing::drilling::station_valid;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -105,7 +105,7 @@ pub struct Agreement {
     /// RMS predicted station azimuth sigma / RMS station azimuth error.
     pub azimuth_ratio: Option<f64>,
     /// The same as `td_ratio` without the survey method on either side
-    /// ([`TdSummary::without_method`](super::lateral_summary::TdSummary)).
+    /// ([`TdSummary::without_method`](super::summary::TdSummary)).
     pub td_without_method_ratio: Option<f64>,
     pub within_10_percent: Option<bool>,
 }

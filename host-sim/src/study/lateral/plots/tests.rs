@@ -195,7 +195,7 @@ fn colour_map_and_levels() {
 }
 
 /// Example figures to look at (`cargo test --release -p host-sim --lib
-/// study::lateral_plots -- --ignored --nocapture`; the directory printed).
+/// study::lateral::plots -- --ignored --nocapture`; the directory printed).
 #[test]
 #[ignore = "writes example figures to look at"]
 fn write_example_figures() {
