@@ -18,12 +18,14 @@
 //!   [`correlation`] (the station azimuth errors' correlation along the
 //!   well) and [`consistency`] (the azimuth sigma through stations and
 //!   drilling);
-//! - [`table`]: the terminal tables and the CSV;
+//! - [`table`]: the terminal tables and the CSV, with `csv` (a CSV
+//!   cell's quoting, which the station list shares);
 //! - [`figures`]: the study's figures, drawn by [`plots`].
 
 pub mod consistency;
 pub mod correlation;
 pub mod covariance;
+mod csv;
 pub mod figures;
 pub mod plots;
 pub mod run;

@@ -3,6 +3,7 @@
 //! notes under them) and as empty fields in the CSV, never as a number.
 
 use super::correlation::LAGS;
+use super::csv::csv_field;
 use super::run::LateralStudy;
 use super::summary::{GradeWellSummary, ATTITUDE_LIMIT_DEG, POSITION_LIMIT_M_PER_1000_M};
 use crate::study::drilling_coverage::Fraction;
@@ -561,15 +562,6 @@ pub fn csv(study: &LateralStudy) -> String {
         out.push_str(&(fields.join(",") + "\n"));
     }
     out
-}
-
-/// A text field quoted when it holds a comma, quote or line break (RFC 4180).
-pub(crate) fn csv_field(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_string()
-    }
 }
 
 #[cfg(test)]
