@@ -7,8 +7,9 @@
 //! the probe and the survey predict (docs/lateral-study.md).
 //!
 //! The files, in the order the data meets them:
-//! - [`run`]: the study's wells (built-in laterals or plan files) and the
-//!   jobs (Monte Carlo runs, covariance analyses, sweep
+//! - [`wells`]: the study's wells (built-in laterals or plan files) and
+//!   the command line's drilling parameters;
+//! - [`run`]: the jobs (Monte Carlo runs, covariance analyses, sweep
 //!   points) in one pool over the cores, and the study's results;
 //! - [`covariance`]: the covariance analysis (one error-free run per grade
 //!   and well), its agreement with the Monte Carlo, and the sweep over gyro
@@ -32,8 +33,7 @@ pub mod run;
 pub mod stations;
 pub mod summary;
 pub mod table;
+pub mod wells;
 
-pub use run::{
-    study, DrillingOverrides, GradeInfo, LateralStudy, StudyConfig, Well, WellInfo, WellOwsg,
-    BUILTIN_WELLS,
-};
+pub use run::{study, GradeInfo, LateralStudy, StudyConfig, WellInfo, WellOwsg};
+pub use wells::{DrillingOverrides, Well, BUILTIN_WELLS};
