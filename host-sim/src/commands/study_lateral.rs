@@ -1,4 +1,4 @@
-//! `host-sim study lateral` (issue 14 part A): the command line of
+//! `host-sim study lateral`: the command line of
 //! [`host_sim::study::lateral`]: grades, wells, drilling parameters, a
 //! progress bar over every job, the tables, CSV and JSON.
 

@@ -316,8 +316,8 @@ fn exact_tie_in(truth: &DrillingAngles, sigma_azi: f64) -> Result<TieIn> {
     TieIn::new(*truth, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
 }
 
-/// Covariance analysis of `config`'s well and grade (issue 14's fast
-/// path): one run with error-free sensors ([`RunConfig::noise_free`]).
+/// Covariance analysis of `config`'s well and grade (the lateral study's
+/// fast path): one run with error-free sensors ([`RunConfig::noise_free`]).
 /// The filter is linear in its errors, so its covariance does not depend
 /// on the noise drawn, only on the trajectory and the probe's decisions
 /// (still or drilling, which the seed's vibration and orienter steps

@@ -1,6 +1,6 @@
-//! The lateral study's fast path (issue 14 item 3): covariance analysis.
-//! One run per grade and well with error-free sensors
-//! ([`drilling_run::covariance_analysis`]) gives the sigmas the probe and
+//! The lateral study's fast path: covariance analysis. One run per grade
+//! and well with error-free sensors
+//! ([`covariance_analysis`](crate::study::drilling_run::covariance_analysis)) gives the sigmas the probe and
 //! the survey would report; no noise is drawn, so one run answers what the
 //! Monte Carlo answers with hundreds, and the Monte Carlo checks it: the
 //! predicted TD horizontal 1-sigma against the RMS of the runs' TD errors,
@@ -94,8 +94,8 @@ impl CovariancePrediction {
 
 /// The covariance analysis against the Monte Carlo of the same grade and
 /// well: each ratio is predicted / observed, 1 for a filter that is
-/// neither optimistic nor pessimistic; the check (issue 14) asks for
-/// |ratio - 1| <= 10 %.
+/// neither optimistic nor pessimistic; the check asks for
+/// |ratio - 1| <= 10 % ([`AGREEMENT_TOLERANCE`]).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Agreement {
     pub grade: String,
@@ -110,7 +110,8 @@ pub struct Agreement {
     pub within_10_percent: Option<bool>,
 }
 
-/// Tolerance of the check (issue 14): covariance within 10 % of the spread.
+/// Tolerance of the agreement check: the predicted 1-sigma within 10 % of
+/// the Monte Carlo's RMS error.
 pub const AGREEMENT_TOLERANCE: f64 = 0.10;
 
 pub fn agreement(c: &CovariancePrediction, m: &GradeWellSummary) -> Agreement {

@@ -1,6 +1,6 @@
-//! Figures of the lateral study (issue 14): the error growth along MD with
-//! the predicted bounds, per sensor grade ([`along_md`]), and the sweep of
-//! the TD error over gyro bias and ARW as a contour map ([`sweep`], with
+//! Figures of the lateral study: the error growth along MD with the
+//! predicted bounds, per sensor grade ([`along_md`]), and the sweep of the
+//! TD error over gyro bias and ARW as a contour map ([`sweep`], with
 //! [`contour`]'s marching squares). Each is written as SVG and PNG of the
 //! same drawing through the survey figures' [`Figure`] and
 //! [`write_svg_png`] (embedded font, so PNG text needs no system fonts);
