@@ -274,7 +274,7 @@ pub fn table(s: &Summary) -> String {
             s.undetermined_azimuth_stations.to_string(),
         ),
         (
-            "azimuth within 2 sigma (issue: >= 93 %)",
+            "azimuth within 2 sigma (>= 93 %)",
             percent(&s.azimuth_within_2_sigma),
         ),
         (
