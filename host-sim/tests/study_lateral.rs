@@ -158,14 +158,14 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
         assert!(v.is_some_and(|v| v.is_finite() && v > 0.0), "{c:?}");
     }
     // the table and the CSV carry it, one field per column
-    let text = host_sim::study::lateral_table::table(&result);
+    let text = host_sim::study::lateral::table::table(&result);
     assert!(
         text.contains("scc1300")
             && text.contains("along MD")
             && text.contains("through stations and drilling"),
         "{text}"
     );
-    let csv = host_sim::study::lateral_table::csv(&result);
+    let csv = host_sim::study::lateral::table::csv(&result);
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 2);
     assert_eq!(lines[0].split(',').count(), lines[1].split(',').count());
@@ -173,7 +173,7 @@ fn a_tiny_study_gives_finite_statistics_with_the_right_counts() {
     // the along-MD rows carry the same per station
     assert!(s.along_md.iter().any(|a| a.start_error_ratio.is_some()));
     // --stations-csv: one row per station of every run
-    let rows = host_sim::study::lateral_stations::stations_csv(
+    let rows = host_sim::study::lateral::stations::stations_csv(
         [(s.grade.as_str(), s.well.as_str(), s.station_rows.as_slice())].into_iter(),
     );
     assert_eq!(rows.lines().count(), 1 + s.stations, "{rows}");
@@ -230,7 +230,7 @@ fn a_study_stopped_after_its_first_job_reports_that_job_and_says_it_was_interrup
     assert_eq!((s.runs, s.stations), (0, 0));
     assert_eq!(s.td.rms_horizontal_error_m, None);
     assert_eq!(s.rms_station_azimuth_deg, None);
-    let text = host_sim::study::lateral_table::table(&result);
+    let text = host_sim::study::lateral::table::table(&result);
     assert!(text.starts_with("INTERRUPTED after 1 of 4 jobs"), "{text}");
     let json = serde_json::to_value(&result).expect("serializable");
     assert_eq!(json["interrupted"]["jobs_done"], 1);

@@ -16,12 +16,14 @@ pub enum StudyCommand {
     /// and the survey's TD ellipse cover the errors?
     DrillingCoverage(CoverageArgs),
     /// A reference heading as the master for the first stations, the gyro
-    /// probe as the backup (issue 17 item 4): azimuth error at TD with and
-    /// without it, by gyro grade (docs/redundant-rins.md).
+    /// probe as the backup (the redundant rotational INS paper's
+    /// master/backup idea): azimuth error at TD with and without it, by gyro
+    /// grade (docs/redundant-rins.md).
     RinsProbe(RinsProbeArgs),
-    /// Which gyro meets the MGWD paper's requirement (issue 14): seeded
-    /// laterals by gyro grade, station azimuth and TD position errors
-    /// against the predicted sigmas (docs/lateral-study.md).
+    /// Which gyro meets the MGWD paper's requirement (attitude error under
+    /// 0.1 deg, position error under 1 m per 1000 m): seeded laterals by
+    /// gyro grade, station azimuth and TD position errors against the
+    /// predicted sigmas (docs/lateral-study.md).
     Lateral(LateralArgs),
 }
 

@@ -1,4 +1,4 @@
-//! `host-sim study lateral` (issue 14 part A): the command line of
+//! `host-sim study lateral`: the command line of
 //! [`host_sim::study::lateral`]: grades, wells, drilling parameters, a
 //! progress bar over every job, the tables, CSV and JSON.
 
@@ -6,11 +6,11 @@ use super::limits::number_in;
 use anyhow::{Context, Result};
 use host_sim::study::drilling_run::Scalar;
 use host_sim::study::grade;
+use host_sim::study::lateral::covariance::SweepGrid;
+use host_sim::study::lateral::figures::plots;
+use host_sim::study::lateral::stations::stations_csv;
+use host_sim::study::lateral::table::{csv, table};
 use host_sim::study::lateral::{study, DrillingOverrides, StudyConfig, Well};
-use host_sim::study::lateral_covariance::SweepGrid;
-use host_sim::study::lateral_figures::plots;
-use host_sim::study::lateral_stations::stations_csv;
-use host_sim::study::lateral_table::{csv, table};
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]

@@ -165,7 +165,7 @@ pub struct StationCheck {
     /// ([`AzimuthSigmaTrack::station_start`]).
     pub azimuth_sigma_before: Option<f64>,
     /// The azimuth error (rad, wrapped) of the same solution: with its
-    /// sigma, where the station starts from (`super::lateral_consistency`).
+    /// sigma, where the station starts from (`super::lateral::consistency`).
     pub azimuth_error_before: Option<f64>,
     /// The probe's link of this station's errors to the previous
     /// station's (`mwd_core::probe::station_link`), as the survey takes it.
@@ -316,8 +316,8 @@ fn exact_tie_in(truth: &DrillingAngles, sigma_azi: f64) -> Result<TieIn> {
     TieIn::new(*truth, sigma).map_err(|e| anyhow!("tie-in refused: {e:?}"))
 }
 
-/// Covariance analysis of `config`'s well and grade (issue 14's fast
-/// path): one run with error-free sensors ([`RunConfig::noise_free`]).
+/// Covariance analysis of `config`'s well and grade (the lateral study's
+/// fast path): one run with error-free sensors ([`RunConfig::noise_free`]).
 /// The filter is linear in its errors, so its covariance does not depend
 /// on the noise drawn, only on the trajectory and the probe's decisions
 /// (still or drilling, which the seed's vibration and orienter steps

@@ -1,4 +1,4 @@
-//! Gyro grades as data files (`host-sim/data/grades/*.json`, issue 14):
+//! Gyro grades as data files (`host-sim/data/grades/*.json`):
 //! a gyro's figures in datasheet units with the documents they come from
 //! (`sources`) and what those documents do not say (`assumptions`). The
 //! four files of the repository are built in, so the binary works from
@@ -436,7 +436,7 @@ mod tests {
                 assert_eq!(b.gyro[0].residual_bias, b.gyro[0].bias_instability);
             }
         }
-        // the GE figures as the issue quotes them
+        // the GE figures as Lin et al. (GE Research, 2020) report them
         let ge = &all[2].noise_budget().gyro[0];
         assert!((ge.white_density - arw_from_deg_per_sqrt_hour(0.003)).abs() < 1e-18);
         assert!((ge.bias_instability - rate_from_deg_per_hour(0.01)).abs() < 1e-18);

@@ -1,8 +1,8 @@
 //! The industry's generic gyro survey tool models, OWSG GYRO-MWD and
 //! GYRO-NS (SPE 90408 Tables 1 and 4, as transcribed in
 //! `host-sim/data/owsg_gyro_*_terms.csv`), run by the ISCWSA engine
-//! ([`crate::survey::iscwsa`]) on a study well, for the lateral study's
-//! "side by side with the industry's models" column (issue 14).
+//! ([`crate::survey::iscwsa`]) on a study well, so that the lateral study
+//! shows its figures side by side with the industry's models.
 //!
 //! Stations are those a drilling run surveys ([`study_stations`]): the
 //! plan's tie-on, one per stand from it (the drilling simulator's

@@ -1,5 +1,5 @@
-//! `host-sim study rins-probe`: issue 17 item 4, the [RINS] paper's
-//! master/backup idea for the probe (docs/redundant-rins.md, "The probe").
+//! `host-sim study rins-probe`: the [RINS] paper's master/backup idea for
+//! the probe (docs/redundant-rins.md, "The probe").
 //! A reference heading (magnetic-MWD-like station azimuths, sigma ~0.5 deg)
 //! is the master for the first K stations of a simulated lateral and is
 //! then lost; the gyro probe is the backup. Each seeded run drives two

@@ -3,11 +3,11 @@
 //! error along MD, per grade, against the predicted sigmas (the Monte
 //! Carlo's RMS and median sigma; covariance analysis alone: the predicted
 //! sigmas only), and per well the sweep's contour map
-//! ([`super::lateral_plots`] draws them).
+//! ([`super::plots`] draws them).
 
-use super::lateral::LateralStudy;
-use super::lateral_plots::{plot_error_along_md, plot_sweep_contour, AlongMdSeries, Sweep};
-use super::lateral_summary::POSITION_LIMIT_M_PER_1000_M;
+use super::plots::{plot_error_along_md, plot_sweep_contour, AlongMdSeries, Sweep};
+use super::run::LateralStudy;
+use super::summary::POSITION_LIMIT_M_PER_1000_M;
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 

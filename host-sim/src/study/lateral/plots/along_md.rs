@@ -1,17 +1,12 @@
-//! Figures of the lateral study (issue 14): the error growth along MD with
-//! the predicted bounds, per sensor grade, and the sweep of the TD error
-//! over gyro bias and ARW as a contour map. Each is written as SVG and PNG
-//! of the same drawing through the survey figures' [`Figure`] and
-//! [`write_svg_png`] (embedded font, so PNG text needs no system fonts).
-//!
-//! Undetermined values (NaN) are never drawn as numbers: a line is broken
-//! at them, and a sweep cell without a value is left blank.
+//! The error along MD ([`plot_error_along_md`]): per grade the RMS error
+//! over the runs at each station against the predicted 1- and 2-sigma, on
+//! a log y axis over MD; a line is broken where a value is undetermined.
 
-pub mod contour;
-
+use super::log_axis::{log_range, tick};
+use super::split_stem;
 use crate::formats::figure::{plot_error, write_svg_png, Figure, FONT};
 use crate::survey::listing::plot::SIZE;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -57,76 +52,9 @@ pub fn plot_error_along_md(
     write_svg_png(dir, name, SIZE, &figure)
 }
 
-/// The sweep: `value[b][a]` at bias `bias_deg_per_h[b]` and ARW
-/// `arw_deg_per_sqrt_h[a]` (e.g. TD horizontal 1-sigma, m per 1000 m;
-/// NaN where undetermined).
-pub struct Sweep<'a> {
-    pub title: &'a str,
-    pub bias_deg_per_h: &'a [f64],
-    pub arw_deg_per_sqrt_h: &'a [f64],
-    pub value: &'a [Vec<f64>],
-    /// The contour drawn bold (the paper's requirement).
-    pub requirement: f64,
-    /// What the value is, with its unit (colour bar and requirement).
-    pub label: &'a str,
-    /// Named grades marked on the map: (name, bias deg/h, ARW deg/sqrt(h)).
-    pub grades: &'a [(String, f64, f64)],
-}
-
-/// Writes `STEM.svg` and `STEM.png`: log-log axes, the value as a colour
-/// map (log colour scale, with a colour bar), contour lines at 1-3-10
-/// steps, the requirement's contour bold, and the grades as markers.
-pub fn plot_sweep_contour(stem: &Path, sweep: &Sweep) -> Result<[PathBuf; 2]> {
-    check_axis("bias", sweep.bias_deg_per_h)?;
-    check_axis("ARW", sweep.arw_deg_per_sqrt_h)?;
-    if sweep.value.len() != sweep.bias_deg_per_h.len()
-        || sweep
-            .value
-            .iter()
-            .any(|r| r.len() != sweep.arw_deg_per_sqrt_h.len())
-    {
-        bail!(
-            "sweep: the values must be {} rows (biases) of {} (ARWs)",
-            sweep.bias_deg_per_h.len(),
-            sweep.arw_deg_per_sqrt_h.len()
-        );
-    }
-    if !(sweep.requirement.is_finite() && sweep.requirement > 0.0) {
-        bail!(
-            "sweep: the requirement must be a positive number (got {})",
-            sweep.requirement
-        );
-    }
-    let (dir, name) = split_stem(stem)?;
-    write_svg_png(dir, name, SIZE, &SweepFigure::new(sweep)?)
-}
-
-/// `STEM` as (directory, file stem) for [`write_svg_png`].
-fn split_stem(stem: &Path) -> Result<(&Path, &str)> {
-    let name = stem
-        .file_name()
-        .and_then(|n| n.to_str())
-        .ok_or_else(|| anyhow!("{}: not a file name for the figures", stem.display()))?;
-    let dir = match stem.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    Ok((dir, name))
-}
-
-fn check_axis(name: &str, v: &[f64]) -> Result<()> {
-    if v.len() < 2 {
-        bail!("sweep: at least two {name} values are needed for a map");
-    }
-    if !v.iter().all(|x| x.is_finite() && *x > 0.0) || v.windows(2).any(|w| w[1] <= w[0]) {
-        bail!("sweep: the {name} values must be positive and increasing (a log axis)");
-    }
-    Ok(())
-}
-
 /// The runs of points with finite x and positive finite y (drawable on a
 /// log y axis): a line is broken where a value is undetermined.
-fn drawable_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
+pub(super) fn drawable_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
     let mut runs = vec![Vec::new()];
     for (&a, &b) in x.iter().zip(y) {
         if a.is_finite() && b.is_finite() && b > 0.0 {
@@ -139,36 +67,6 @@ fn drawable_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
     }
     runs.retain(|r| !r.is_empty());
     runs
-}
-
-/// A tick label: plain digits from 0.01 to 9999, else a power of ten.
-fn tick(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    if (0.01..10_000.0).contains(&v.abs()) {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        format!("{v:.0e}")
-    }
-}
-
-/// (low, high) of a log axis holding the positive finite values, with a
-/// factor `pad` of room; `None` if there are none.
-fn log_range(values: impl Iterator<Item = f64>, pad: f64) -> Option<(f64, f64)> {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
-    (lo <= hi).then(|| {
-        if lo == hi {
-            (lo / 10.0, hi * 10.0)
-        } else {
-            (lo / pad, hi * pad)
-        }
-    })
 }
 
 struct AlongMd<'a> {
@@ -278,9 +176,3 @@ impl Figure for AlongMd<'_> {
         Ok(())
     }
 }
-
-mod sweep;
-use sweep::SweepFigure;
-
-#[cfg(test)]
-mod tests;

@@ -1,11 +1,12 @@
-//! The lateral study's terminal tables and CSV ([`super::lateral`]).
+//! The lateral study's terminal tables and CSV ([`super`]).
 //! Undetermined figures print as "-" in tables (with the reason in the
 //! notes under them) and as empty fields in the CSV, never as a number.
 
-use super::drilling_coverage::Fraction;
-use super::lateral::LateralStudy;
-use super::lateral_correlation::LAGS;
-use super::lateral_summary::{GradeWellSummary, ATTITUDE_LIMIT_DEG, POSITION_LIMIT_M_PER_1000_M};
+use super::correlation::LAGS;
+use super::csv::csv_field;
+use super::run::LateralStudy;
+use super::summary::{GradeWellSummary, ATTITUDE_LIMIT_DEG, POSITION_LIMIT_M_PER_1000_M};
+use crate::study::drilling_coverage::Fraction;
 
 /// Columns aligned: the first `left` columns to the left, the rest (numbers)
 /// to the right; a rule under the header.
@@ -140,7 +141,7 @@ fn method_split_table(study: &LateralStudy) -> String {
 }
 
 /// The stations' azimuth errors' correlation by distance, Monte Carlo
-/// against the survey's chain (`super::lateral_correlation`).
+/// against the survey's chain (`super::correlation`).
 fn correlation_table(study: &LateralStudy) -> String {
     let mut out = String::from(
         "\nstation azimuth errors' correlation k stations apart: Monte Carlo / the survey's chain (which the TD covariance assumes)\n",
@@ -166,7 +167,7 @@ fn correlation_table(study: &LateralStudy) -> String {
 }
 
 /// The azimuth sigma's consistency through the stations and the drilling
-/// between them (`super::lateral_consistency`).
+/// between them (`super::consistency`).
 fn consistency_table(study: &LateralStudy) -> String {
     let mut out = String::from(
         "\nazimuth sigma through stations and drilling (RMS of the normalised change: 1 when the sigma holds; above 1: over-confident)\n",
@@ -563,20 +564,11 @@ pub fn csv(study: &LateralStudy) -> String {
     out
 }
 
-/// A text field quoted when it holds a comma, quote or line break (RFC 4180).
-pub(crate) fn csv_field(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::study::drilling_run::Scalar;
-    use crate::study::lateral_summary::summarise;
+    use crate::study::lateral::summary::summarise;
 
     fn study() -> LateralStudy {
         LateralStudy {

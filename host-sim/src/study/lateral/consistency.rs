@@ -1,5 +1,5 @@
 //! Where the azimuth's printed sigma stops holding its error: at the
-//! stations or in the drilling between them ([`super::lateral`]).
+//! stations or in the drilling between them ([`super`]).
 //!
 //! Each determined station gives its azimuth error and sigma at its start
 //! (the last solution before its first still sample,
@@ -30,8 +30,8 @@
 //! The mean fraction of the azimuth variance a station removes,
 //! `1 - s_end^2 / s_start^2`, says how much the station weighs.
 
-use super::drilling_run::{RunOutcome, StationCheck};
-use super::stats::rms;
+use crate::study::drilling_run::{RunOutcome, StationCheck};
+use crate::study::stats::rms;
 use crate::survey::listing::drilling::azimuth_usable;
 use serde::Serialize;
 use std::collections::BTreeMap;

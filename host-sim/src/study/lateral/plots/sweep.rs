@@ -1,4 +1,4 @@
-//! The sweep's contour map ([`super::plot_sweep_contour`]): a colour map
+//! The sweep's contour map ([`plot_sweep_contour`]): a colour map
 //! of the value on log-log axes (each grid point's cell reaching halfway,
 //! in log, to its neighbours), contour lines by marching squares on the
 //! log grid (log10 of bias, ARW and value: the TD error is close to a
@@ -7,11 +7,69 @@
 //! bar.
 
 use super::contour::{contour_segments, Segment};
-use super::{log_range, tick, Sweep};
-use crate::formats::figure::{plot_error, Figure, FONT};
+use super::log_axis::{log_range, tick};
+use super::split_stem;
+use crate::formats::figure::{plot_error, write_svg_png, Figure, FONT};
+use crate::survey::listing::plot::SIZE;
 use anyhow::{bail, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// The sweep: `value[b][a]` at bias `bias_deg_per_h[b]` and ARW
+/// `arw_deg_per_sqrt_h[a]` (e.g. TD horizontal 1-sigma, m per 1000 m;
+/// NaN where undetermined).
+pub struct Sweep<'a> {
+    pub title: &'a str,
+    pub bias_deg_per_h: &'a [f64],
+    pub arw_deg_per_sqrt_h: &'a [f64],
+    pub value: &'a [Vec<f64>],
+    /// The contour drawn bold (the paper's requirement).
+    pub requirement: f64,
+    /// What the value is, with its unit (colour bar and requirement).
+    pub label: &'a str,
+    /// Named grades marked on the map: (name, bias deg/h, ARW deg/sqrt(h)).
+    pub grades: &'a [(String, f64, f64)],
+}
+
+/// Writes `STEM.svg` and `STEM.png`: log-log axes, the value as a colour
+/// map (log colour scale, with a colour bar), contour lines at 1-3-10
+/// steps, the requirement's contour bold, and the grades as markers.
+pub fn plot_sweep_contour(stem: &Path, sweep: &Sweep) -> Result<[PathBuf; 2]> {
+    check_axis("bias", sweep.bias_deg_per_h)?;
+    check_axis("ARW", sweep.arw_deg_per_sqrt_h)?;
+    if sweep.value.len() != sweep.bias_deg_per_h.len()
+        || sweep
+            .value
+            .iter()
+            .any(|r| r.len() != sweep.arw_deg_per_sqrt_h.len())
+    {
+        bail!(
+            "sweep: the values must be {} rows (biases) of {} (ARWs)",
+            sweep.bias_deg_per_h.len(),
+            sweep.arw_deg_per_sqrt_h.len()
+        );
+    }
+    if !(sweep.requirement.is_finite() && sweep.requirement > 0.0) {
+        bail!(
+            "sweep: the requirement must be a positive number (got {})",
+            sweep.requirement
+        );
+    }
+    let (dir, name) = split_stem(stem)?;
+    write_svg_png(dir, name, SIZE, &SweepFigure::new(sweep)?)
+}
+
+/// A sweep axis: at least two values, positive and increasing (a log axis).
+fn check_axis(name: &str, v: &[f64]) -> Result<()> {
+    if v.len() < 2 {
+        bail!("sweep: at least two {name} values are needed for a map");
+    }
+    if !v.iter().all(|x| x.is_finite() && *x > 0.0) || v.windows(2).any(|w| w[1] <= w[0]) {
+        bail!("sweep: the {name} values must be positive and increasing (a log axis)");
+    }
+    Ok(())
+}
 
 /// Contour levels (1-3-10 steps), drawn where the value spans them.
 pub const LEVELS: [f64; 13] = [

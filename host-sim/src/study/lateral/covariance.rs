@@ -1,16 +1,16 @@
-//! The lateral study's fast path (issue 14 item 3): covariance analysis.
-//! One run per grade and well with error-free sensors
-//! ([`drilling_run::covariance_analysis`]) gives the sigmas the probe and
+//! The lateral study's fast path: covariance analysis. One run per grade
+//! and well with error-free sensors
+//! ([`covariance_analysis`](crate::study::drilling_run::covariance_analysis)) gives the sigmas the probe and
 //! the survey would report; no noise is drawn, so one run answers what the
 //! Monte Carlo answers with hundreds, and the Monte Carlo checks it: the
 //! predicted TD horizontal 1-sigma against the RMS of the runs' TD errors,
 //! the predicted station azimuth sigmas against the RMS azimuth error.
 //! Also the sweep over gyro bias instability and ARW.
 
-use super::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
-use super::grade::Grade;
-use super::lateral_summary::GradeWellSummary;
-use super::stats::rms;
+use super::summary::GradeWellSummary;
+use crate::study::drilling_run::{covariance_analysis, RunConfig, RunOutcome};
+use crate::study::grade::Grade;
+use crate::study::stats::rms;
 use crate::survey::listing::drilling::station_valid;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -94,8 +94,8 @@ impl CovariancePrediction {
 
 /// The covariance analysis against the Monte Carlo of the same grade and
 /// well: each ratio is predicted / observed, 1 for a filter that is
-/// neither optimistic nor pessimistic; the check (issue 14) asks for
-/// |ratio - 1| <= 10 %.
+/// neither optimistic nor pessimistic; the check asks for
+/// |ratio - 1| <= 10 % ([`AGREEMENT_TOLERANCE`]).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Agreement {
     pub grade: String,
@@ -105,12 +105,13 @@ pub struct Agreement {
     /// RMS predicted station azimuth sigma / RMS station azimuth error.
     pub azimuth_ratio: Option<f64>,
     /// The same as `td_ratio` without the survey method on either side
-    /// ([`TdSummary::without_method`](super::lateral_summary::TdSummary)).
+    /// ([`TdSummary::without_method`](super::summary::TdSummary)).
     pub td_without_method_ratio: Option<f64>,
     pub within_10_percent: Option<bool>,
 }
 
-/// Tolerance of the check (issue 14): covariance within 10 % of the spread.
+/// Tolerance of the agreement check: the predicted 1-sigma within 10 % of
+/// the Monte Carlo's RMS error.
 pub const AGREEMENT_TOLERANCE: f64 = 0.10;
 
 pub fn agreement(c: &CovariancePrediction, m: &GradeWellSummary) -> Agreement {

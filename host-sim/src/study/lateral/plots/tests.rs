@@ -1,7 +1,11 @@
 //! Tests of the lateral study's figures (`super`).
 
+use super::along_md::drawable_runs;
+use super::log_axis::tick;
 use super::sweep::{viridis, LEVELS};
 use super::*;
+use plotters::style::RGBColor;
+use std::path::PathBuf;
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0D, 0x0A, 0x1A, 0x0A];
 
@@ -195,7 +199,7 @@ fn colour_map_and_levels() {
 }
 
 /// Example figures to look at (`cargo test --release -p host-sim --lib
-/// study::lateral_plots -- --ignored --nocapture`; the directory printed).
+/// study::lateral::plots -- --ignored --nocapture`; the directory printed).
 #[test]
 #[ignore = "writes example figures to look at"]
 fn write_example_figures() {

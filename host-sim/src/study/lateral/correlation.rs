@@ -1,5 +1,5 @@
 //! How the stations' azimuth errors are correlated along a run, measured
-//! against what the survey assumes ([`super::lateral`]).
+//! against what the survey assumes ([`super`]).
 //!
 //! The survey's TD covariance correlates the stations' azimuth errors as
 //! a Markov chain (`survey_error::probe_station`, docs/drilling-survey.md):
@@ -18,7 +18,7 @@
 //! Were the errors distributed as the chain says, the two would agree
 //! within the Monte Carlo's spread.
 
-use super::drilling_run::RunOutcome;
+use crate::study::drilling_run::RunOutcome;
 use crate::survey::iscwsa::probe_station::{
     azimuth_chain_correlations, links_in_order, AngleSigma,
 };

@@ -3,8 +3,8 @@
 //! runs and stations make a figure (a signed error, where a sigma stops
 //! holding, a run that went astray).
 
-use super::drilling_run::RunOutcome;
-use super::lateral_table::csv_field;
+use super::csv::csv_field;
+use crate::study::drilling_run::RunOutcome;
 use crate::survey::listing::drilling::{azimuth_determined, station_valid};
 
 /// One station of one run; angles in degrees, errors signed (estimate

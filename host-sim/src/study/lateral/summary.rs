@@ -1,5 +1,5 @@
 //! The lateral study's statistics per grade and well
-//! ([`super::lateral`]): named fields, serialised as they are, so other
+//! ([`super`]): named fields, serialised as they are, so other
 //! columns (covariance analysis) and plots can be added beside them.
 //!
 //! Conventions: an RMS, percentile or median over no cases is `None`
@@ -10,12 +10,12 @@
 //! errors; the 95 % ellipse holds a TD when its squared Mahalanobis
 //! distance is <= -2 ln 0.05 = 5.991 (chi-square, 2 degrees of freedom).
 
-use super::drilling_coverage::Fraction;
-use super::drilling_run::RunOutcome;
-use super::lateral_consistency::{azimuth_consistency, AzimuthConsistency};
-use super::lateral_correlation::{azimuth_lag_correlations, LagCorrelation};
-use super::lateral_stations::{station_rows, StationRow};
-use super::stats::{median, percentile, rms};
+use super::consistency::{azimuth_consistency, AzimuthConsistency};
+use super::correlation::{azimuth_lag_correlations, LagCorrelation};
+use super::stations::{station_rows, StationRow};
+use crate::study::drilling_coverage::Fraction;
+use crate::study::drilling_run::RunOutcome;
+use crate::study::stats::{median, percentile, rms};
 use crate::survey::listing::drilling::station_valid;
 use crate::survey::listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
@@ -100,7 +100,7 @@ pub struct AlongMd {
     pub median_horizontal_sigma_m: Option<f64>,
     /// This station's azimuth correction against the variance it removed,
     /// and the drilling stretch that ended at it against its growth, RMS
-    /// over the runs (`super::lateral_consistency`; 1 when consistent).
+    /// over the runs (`super::consistency`; 1 when consistent).
     pub station_correction_ratio: Option<f64>,
     pub drilling_growth_ratio: Option<f64>,
     /// The azimuth error over its sigma at this station's start (after
@@ -134,10 +134,10 @@ pub struct GradeWellSummary {
     pub inclination_within_2_sigma: Fraction,
     pub td: TdSummary,
     /// The stations' azimuth errors' correlation by distance, Monte Carlo
-    /// against the survey's chain (`super::lateral_correlation`).
+    /// against the survey's chain (`super::correlation`).
     pub azimuth_correlation: Vec<LagCorrelation>,
     /// The azimuth sigma's consistency through the stations and the
-    /// drilling between them (`super::lateral_consistency`).
+    /// drilling between them (`super::consistency`).
     pub azimuth_consistency: AzimuthConsistency,
     /// Runs without a TD check, by reason.
     pub td_unchecked: Vec<(String, usize)>,
