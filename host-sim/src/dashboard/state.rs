@@ -132,7 +132,7 @@ pub struct DashboardState {
 impl DashboardState {
     pub fn new(source: SourceInfo, session: u64, limits: Limits) -> Self {
         let stations = StationCollector::default();
-        let stations_view = stations_json(&stations, 0, &source);
+        let stations_view = stations_json(&stations, 0, source.depth.as_ref(), &source.survey);
         Self {
             limits,
             session,
@@ -216,8 +216,12 @@ impl DashboardState {
                     self.stations_dropped += 1;
                 }
                 self.stations.push_station(station);
-                self.stations_view =
-                    stations_json(&self.stations, self.stations_dropped, &self.source);
+                self.stations_view = stations_json(
+                    &self.stations,
+                    self.stations_dropped,
+                    self.source.depth.as_ref(),
+                    &self.source.survey,
+                );
                 self.stations_update = update;
             }
         }

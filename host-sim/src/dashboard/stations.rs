@@ -7,11 +7,11 @@
 use mwd_core::protocol::StationSurvey;
 use serde_json::{json, Value};
 
-use super::state::SourceInfo;
+use crate::formats::depth_log::DepthLog;
 use crate::formats::display;
 use crate::survey::listing::drilling::{self, DrillingRow};
 use crate::survey::listing::TieOnInput;
-use crate::survey::stations::StationCollector;
+use crate::survey::stations::{StationCollector, SurveySetup};
 
 /// "12.34 +- 0.56 m" from a value and a variance; "n/a" when the variance
 /// is not a valid one (never a sigma of 0 for it).
@@ -63,12 +63,17 @@ fn positioned(row: &mut Value, d: &DrillingRow) {
 /// The stations for the page: the list, the note on positions, and the
 /// plan view (east, north) and vertical section (section, TVD) of the
 /// stations whose position is determined.
-pub fn stations_json(collected: &StationCollector, dropped: u64, source: &SourceInfo) -> Value {
+pub fn stations_json(
+    collected: &StationCollector,
+    dropped: u64,
+    depth: Option<&DepthLog>,
+    setup: &SurveySetup,
+) -> Value {
     let stations = collected.stations();
     let mut rows: Vec<Value> = stations.iter().map(station_row).collect();
     let mut plan = Vec::new();
     let mut section = Vec::new();
-    let note = match (&source.depth, stations.is_empty()) {
+    let note = match (depth, stations.is_empty()) {
         (None, _) => "No depth log: positions by minimum curvature need MD, so the stations \
                       are listed only (start with --depth DEPTH.csv)."
             .to_string(),
@@ -76,7 +81,7 @@ pub fn stations_json(collected: &StationCollector, dropped: u64, source: &Source
         (Some(depth), false) => {
             // No station links: the page has the frames only, not their
             // replay (the survey then chains the stations' azimuths alone).
-            match collected.survey(&[], &source.survey, depth) {
+            match collected.survey(&[], setup, depth) {
                 Ok(survey) => {
                     for d in &survey.rows {
                         // By number and time: a station's NaN correlations
@@ -97,7 +102,7 @@ pub fn stations_json(collected: &StationCollector, dropped: u64, source: &Source
                         .iter()
                         .map(|s| format!("station {}: {}", s.survey.station, s.reason))
                         .collect();
-                    let mut note = tie_on_note(&source.survey.tie);
+                    let mut note = tie_on_note(&setup.tie);
                     if !skipped.is_empty() {
                         note += &format!(" Left out: {}.", skipped.join("; "));
                     }
