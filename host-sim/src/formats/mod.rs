@@ -9,6 +9,7 @@
 //!   as a stream, summarised, and as CSV.
 //! - [`samples_csv`]: the probe-sample CSV (a sample and its truth a row).
 //! - [`depth_log`]: the surface's depth log (time to measured depth).
+//! - [`station_csv`]: the survey station file (MD, inclination, azimuth).
 //! - [`text_records`], [`ranges`]: text tables read record by record with
 //!   bounded lines, and the physical range of each number in them.
 //! - [`display`]: angles and their uncertainty as people read them.
@@ -20,4 +21,5 @@ pub mod display;
 pub mod figure;
 pub mod ranges;
 pub mod samples_csv;
+pub mod station_csv;
 pub mod text_records;

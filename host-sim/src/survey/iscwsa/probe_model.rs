@@ -47,6 +47,8 @@ pub fn sensor_term_magnitudes() -> Vec<(&'static str, f64)> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::stations::{SiteTerms, StationTrig};
+    use super::super::weighting::{horizontal_earth_rate, weighting};
     use super::super::*;
     use super::*;
     use nalgebra::{Matrix3, SymmetricEigen};

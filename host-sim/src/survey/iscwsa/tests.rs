@@ -1,4 +1,6 @@
+use super::term_table::to_model_units;
 use super::*;
+use std::path::Path;
 
 fn site() -> Site {
     Site {
@@ -233,9 +235,12 @@ fn bad_surveys_are_rejected_with_the_station_named() {
 /// as described in the module documentation), kept only as a test oracle;
 /// it shares the engine's weighting table.
 mod slow {
+    use super::super::propagation::outer;
+    use super::super::stations::{SiteTerms, StationTrig};
+    use super::super::weighting::Weight;
     use super::super::{
-        outer, Cov6, ErrorTerm, ModelResult, Options, Propagation, Site, SiteTerms, Station,
-        StationTrig, TieOn, Weight, XclAzimuth, XCL_TORTUOSITY,
+        Cov6, ErrorTerm, ModelResult, Options, Propagation, Site, Station, TieOn, XclAzimuth,
+        XCL_TORTUOSITY,
     };
     use std::collections::BTreeMap;
 
@@ -244,7 +249,7 @@ mod slow {
     /// what this oracle checks is the propagation around them, so it only
     /// recomputes the station's trigonometry and the site terms per call.
     fn weighting(name: &str, s: &Station, course: f64, site: &Site) -> Option<Weight> {
-        super::super::weighting(
+        super::super::weighting::weighting(
             name,
             s,
             &StationTrig::of(s, site),

@@ -1,0 +1,171 @@
+//! The listing's rows: each station of a station file positioned by
+//! minimum curvature from the tie-on (`mwd_core::survey`, true north; grid
+//! azimuths turned by the convergence), with its dogleg severity and
+//! vertical section, and a place for its NEV covariance.
+
+use super::ellipse::Ellipse;
+use crate::formats::station_csv::{InputStation, StationFile};
+use crate::survey::iscwsa::Cov6;
+use anyhow::{anyhow, bail, Context, Result};
+use mwd_core::survey::{positions, GridConvergence, Station, TieOn, TrueNorth};
+use nalgebra::Matrix3;
+
+/// North reference of the file's azimuths.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AzimuthReference {
+    True,
+    /// Grid azimuths with this convergence (rad): true = grid + convergence.
+    Grid(f64),
+}
+
+/// The tie-on, in the file's unit (north and east along true north).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TieOnInput {
+    pub md: Option<f64>,
+    pub tvd: f64,
+    pub north: f64,
+    pub east: f64,
+}
+
+/// A station with its position (metres, true north) and, with a model, its
+/// covariance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    pub input: InputStation,
+    pub md_m: f64,
+    pub inc_deg: f64,
+    /// True azimuth, deg.
+    pub azi_deg: f64,
+    pub tvd_m: f64,
+    pub north_m: f64,
+    pub east_m: f64,
+    pub dls_deg_per_30m: f64,
+    pub vsec_m: f64,
+    /// NEV covariance (m^2) when an error model was run and is valid here.
+    pub cov: Option<Cov6>,
+}
+
+impl Row {
+    pub fn ellipse(&self) -> Option<Ellipse> {
+        self.cov.as_ref().map(Ellipse::from_cov)
+    }
+}
+
+/// Positions by minimum curvature from the tie-on (true north), with the
+/// vertical section (from the origin of north and east) along
+/// `vsec_azimuth` (rad; `None`: the closure azimuth of the last station
+/// from that origin).
+pub fn compute(
+    file: &StationFile,
+    reference: AzimuthReference,
+    tie: TieOnInput,
+    vsec_azimuth: Option<f64>,
+) -> Result<(Vec<Row>, f64)> {
+    let k = file.unit.to_m();
+    let first = file.stations[0].md;
+    if let Some(md) = tie.md {
+        if md != first {
+            bail!(
+                "the tie-on MD {md} is not the first station's MD {first}: the first station is the tie-on"
+            );
+        }
+    }
+    let tie_on = TieOn::<TrueNorth>::new(
+        first * k,
+        tie.tvd * k,
+        tie.north * k,
+        tie.east * k,
+        Matrix3::zeros(),
+    )
+    .map_err(|e| anyhow!("tie-on: {e:?}"))?;
+    let stations = file
+        .stations
+        .iter()
+        .map(|s| {
+            let azi = s.azi_deg.to_radians();
+            let azi = match reference {
+                AzimuthReference::True => azi,
+                AzimuthReference::Grid(c) => GridConvergence::new(c)
+                    .map_err(|e| anyhow!("convergence: {e:?}"))?
+                    .true_azimuth(azi),
+            };
+            Station::<TrueNorth>::new(s.md * k, s.inc_deg.to_radians(), azi)
+                .map_err(|e| anyhow!("station at MD {}: {e:?}", s.md))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let points = positions(&tie_on, &stations)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| anyhow!("minimum curvature: {e:?}"))?;
+    let last = points.last().context("no stations")?;
+    let direction = vsec_azimuth.unwrap_or_else(|| {
+        let (n, e) = (last.north(), last.east());
+        if n == 0.0 && e == 0.0 {
+            0.0
+        } else {
+            e.atan2(n).rem_euclid(std::f64::consts::TAU)
+        }
+    });
+    let rows = points
+        .iter()
+        .zip(&file.stations)
+        .map(|(p, input)| Row {
+            input: *input,
+            md_m: p.station.md(),
+            inc_deg: p.station.inclination().to_degrees(),
+            azi_deg: p.station.azimuth().to_degrees(),
+            tvd_m: p.tvd(),
+            north_m: p.north(),
+            east_m: p.east(),
+            dls_deg_per_30m: p.dls_deg_per_30m,
+            vsec_m: p.vertical_section(direction),
+            cov: None,
+        })
+        .collect();
+    Ok((rows, direction))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::station_csv::read_stations;
+
+    fn file(text: &str) -> StationFile {
+        read_stations(text.as_bytes()).unwrap()
+    }
+
+    #[test]
+    fn grid_azimuths_and_tie_on() {
+        let f = file("md_m,inc_deg,azi_deg,toolface_deg,time_s\n100,90,0,10,1\n200,90,0,,2\n");
+        assert_eq!(f.stations[0].toolface_deg, Some(10.0));
+        assert_eq!(f.stations[1].toolface_deg, None);
+        let tie = TieOnInput {
+            md: Some(100.0),
+            tvd: 50.0,
+            north: 10.0,
+            east: -5.0,
+        };
+        let grid = AzimuthReference::Grid(2f64.to_radians());
+        let (rows, vsec) = compute(&f, grid, tie, None).unwrap();
+        assert!((rows[0].north_m - 10.0).abs() < 1e-12);
+        assert!((rows[0].tvd_m - 50.0).abs() < 1e-12);
+        // grid north + 2 deg convergence = true azimuth 2 deg
+        assert!((rows[1].azi_deg - 2.0).abs() < 1e-9);
+        let c = 2f64.to_radians();
+        assert!((rows[1].north_m - (10.0 + 100.0 * c.cos())).abs() < 1e-9);
+        assert!((rows[1].east_m - (-5.0 + 100.0 * c.sin())).abs() < 1e-9);
+        assert!((rows[1].tvd_m - 50.0).abs() < 1e-9);
+        // default vertical section: closure of the last station
+        let closure = rows[1]
+            .east_m
+            .atan2(rows[1].north_m)
+            .rem_euclid(std::f64::consts::TAU);
+        assert!((vsec - closure).abs() < 1e-12);
+        assert!((rows[1].vsec_m - rows[1].north_m.hypot(rows[1].east_m)).abs() < 1e-9);
+        // the tie-on MD must be the first station's
+        let bad = TieOnInput {
+            md: Some(0.0),
+            ..tie
+        };
+        assert!(compute(&f, AzimuthReference::True, bad, None).is_err());
+    }
+}
