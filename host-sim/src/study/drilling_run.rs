@@ -12,10 +12,11 @@ use crate::formats::capture::{raw_sample_from_si, SiSample};
 use crate::formats::depth_log::DepthLog;
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey::iscwsa::{ErrorTerm, Site};
-use crate::survey::listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
+use crate::survey::listing::drilling::{self, DrillingSurvey, StationStart};
 use crate::survey::listing::{
     compute, AzimuthReference, InputStation, LengthUnit, StationFile, TieOnInput,
 };
+use crate::survey::stations::{StationCollector, SurveySetup};
 use anyhow::{anyhow, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{wrap_pi, wrap_two_pi, DrillingAngles};
@@ -162,7 +163,7 @@ pub struct StationCheck {
     pub truth_md: f64,
     /// The azimuth sigma (rad) just before the station's first
     /// zero-velocity update, as the survey's azimuth chain takes it
-    /// ([`AzimuthSigmaTrack::station_start`]).
+    /// ([`StationCollector::push_station`]).
     pub azimuth_sigma_before: Option<f64>,
     /// The azimuth error (rad, wrapped) of the same solution: with its
     /// sigma, where the station starts from (`super::lateral::consistency`).
@@ -429,10 +430,8 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     // the survey's chain in the links' states (`survey_error::link_chain`)
     navigator.track_station_links(true);
     let mut tied = false;
-    let mut stations = Vec::new();
     // each station's azimuth sigma at its start, for the survey's chain
-    let mut track = AzimuthSigmaTrack::default();
-    let mut azi_before = Vec::new();
+    let mut collected = StationCollector::default();
     // and the error of that solution's azimuth
     let mut err_before = Vec::new();
     let mut links = Vec::new();
@@ -442,7 +441,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let mut last: Option<(Vector3<f64>, Vector3<f64>, bool)> = None;
     for (index, d) in sim.enumerate() {
         let s = &d.sample;
-        track.push(&feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?);
+        collected.push_solution(&feed(&mut navigator, raw_frames, index, &s.gyro, &s.accel)?);
         samples += 1;
         last = Some((
             s.true_rate,
@@ -463,11 +462,9 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
             continue;
         }
         if let Some(station) = navigator.take_station() {
-            let (sigma, error) = start_of(track.station_start_solution(&station), &drilling);
-            azi_before.push(sigma);
-            err_before.push(error);
+            let start = collected.push_station(&station);
+            err_before.push(start_error(start, &drilling));
             links.push(link_of(&navigator, &station));
-            stations.push(station);
         }
     }
     // The run ends still at TD, where the probe sends its station when the
@@ -481,7 +478,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         });
         for k in 0..MAX_STATION_SAMPLES as usize {
             let (gyro, force) = tail.measure(SAMPLE_INTERVAL_S, &rate, &accel);
-            track.push(&feed(
+            collected.push_solution(&feed(
                 &mut navigator,
                 raw_frames,
                 run_samples + k,
@@ -490,18 +487,17 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
             )?);
             samples += 1;
             if let Some(station) = navigator.take_station() {
-                let (sigma, error) = start_of(track.station_start_solution(&station), &drilling);
-                azi_before.push(sigma);
-                err_before.push(error);
+                let start = collected.push_station(&station);
+                err_before.push(start_error(start, &drilling));
                 links.push(link_of(&navigator, &station));
-                stations.push(station);
                 break;
             }
         }
     }
-    let mut checks: Vec<StationCheck> = stations
+    let mut checks: Vec<StationCheck> = collected
+        .stations()
         .iter()
-        .zip(&azi_before)
+        .zip(&collected.azimuth_sigma_before())
         .zip(&err_before)
         .zip(&links)
         .map(|(((st, before), err_before), link)| {
@@ -536,15 +532,12 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         north: tie_on.nev().x,
         east: tie_on.nev().y,
     };
-    let survey = drilling::survey(
-        &stations,
-        &azi_before,
-        &links,
-        &depth,
+    let setup = SurveySetup {
         tie,
-        &config.terms,
-        &config.site,
-    );
+        terms: config.terms.clone(),
+        site: config.site,
+    };
+    let survey = collected.survey(&links, &setup, &depth);
     let (td, td_note, method_td_error_ne) = match survey {
         Ok(survey) => {
             attach_positions(&mut checks, &survey, &drilling);
@@ -566,16 +559,14 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     })
 }
 
-/// A station's start (`AzimuthSigmaTrack::station_start_solution`): its
+/// The azimuth error of a station's start (`StationCollector::push_station`):
 /// azimuth sigma and the error of the same solution's azimuth against the
 /// truth at that solution's time (rad, wrapped; `None` if not finite).
-fn start_of(start: Option<StationStart>, drilling: &Drilling) -> (Option<f64>, Option<f64>) {
-    let Some(start) = start else {
-        return (None, None);
-    };
+fn start_error(start: Option<StationStart>, drilling: &Drilling) -> Option<f64> {
+    let start = start?;
     let truth = drilling.truth((f64::from(start.sample_counter) + 1.0) * SAMPLE_INTERVAL_S);
     let error = wrap_pi(start.azimuth - truth.point.azimuth);
-    (Some(start.sigma), error.is_finite().then_some(error))
+    error.is_finite().then_some(error)
 }
 
 /// Minimum curvature through the true MD and angles at the survey's
