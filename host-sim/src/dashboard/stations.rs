@@ -103,6 +103,10 @@ pub fn stations_json(
                         .map(|s| format!("station {}: {}", s.survey.station, s.reason))
                         .collect();
                     let mut note = tie_on_note(&setup.tie);
+                    note += " The position sigmas chain the stations' azimuths alone: the page \
+                             has no replay of the capture for the stations' links, which \
+                             `host-sim survey CAPTURE --job` adds, so they can be smaller than \
+                             the survey's.";
                     if !skipped.is_empty() {
                         note += &format!(" Left out: {}.", skipped.join("; "));
                     }
