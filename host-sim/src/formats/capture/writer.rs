@@ -160,7 +160,7 @@ const SIMULATED_FIRMWARE_VERSION: u16 = 0;
 /// navigation code (the same `Navigator` the firmware runs) makes of that
 /// raw frame. A configured `tie_in` is taken as the probe's main loop
 /// takes it, after the first navigating cycle
-/// (`firmware/src/bin/probe_qemu/main.rs`).
+/// (`firmware/src/app/main_loop.rs`).
 pub fn write_simulated_probe<W: Write>(
     capture: &mut CaptureWriter<W>,
     samples: impl IntoIterator<Item = SimSample>,

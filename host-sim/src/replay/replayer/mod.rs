@@ -154,7 +154,7 @@ impl Replayer {
     /// The probe's configured tie-in (a job's, as `probe configure` sent
     /// it): the replay's navigator starts from it where the probe's does,
     /// after the first cycle that navigates (its main loop,
-    /// `firmware/src/bin/probe_qemu/main.rs`), after each boot and
+    /// `firmware/src/app/main_loop.rs`), after each boot and
     /// re-align. A probe that stepped several samples in that pass took it
     /// later: its solutions then differ from there, and say so.
     pub fn with_tie_in(mut self, tie_in: Option<TieIn>) -> Self {
