@@ -4,7 +4,7 @@
 //! `host_sim::analysis::allan_analysis`'s; this module reads the options
 //! and reports.
 
-use super::print_out;
+use super::output::print_out;
 use anyhow::{bail, Result};
 use host_sim::analysis::allan::TauSet;
 use host_sim::analysis::allan_analysis::{analyse_columns, work, AllanReport, SensorAllan};

@@ -4,7 +4,7 @@
 //! `host_sim::analysis::ar_analysis`'s; this module reads the options and
 //! reports.
 
-use super::print_out;
+use super::output::print_out;
 use anyhow::Result;
 use host_sim::analysis::ar_analysis::{analyse_columns, model_file, ArOptions, ColumnAr};
 use host_sim::analysis::arfit::{ArFit, ArMethod};

@@ -4,7 +4,7 @@
 //! The calibration is `host_sim::analysis::six_position`'s; this module
 //! reads the options and reports.
 
-use super::print_out;
+use super::output::print_out;
 use anyhow::{ensure, Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use host_sim::analysis::calibration::TriadResult;

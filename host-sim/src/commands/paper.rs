@@ -1,7 +1,7 @@
 //! `host-sim paper ...`: reproductions of the papers' experiments, each a
 //! subcommand of [`PaperCommand`] with its own arguments.
 
-use super::print_out;
+use super::output::print_out;
 use anyhow::Result;
 use host_sim::paper::tls::{error_percent, tables, Experiment, TableRow, PAPER_TABLES};
 use std::fmt::Write;

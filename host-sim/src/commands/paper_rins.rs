@@ -79,9 +79,9 @@ pub fn run(args: RinsArgs) -> Result<()> {
         }
     }
     if args.json {
-        super::print_out(&(serde_json::to_string_pretty(&results)? + "\n"))
+        super::output::print_out(&(serde_json::to_string_pretty(&results)? + "\n"))
     } else {
-        super::print_out(&report(&scenario, &results, wall))
+        super::output::print_out(&report(&scenario, &results, wall))
     }
 }
 
@@ -236,7 +236,7 @@ fn strapdown_check(s: &Scenario, hours: f64, rate: f64, json: bool) -> Result<()
     let wall = started.elapsed().as_secs_f64();
     if json {
         let all = serde_json::json!({ "with_sensor_errors": runs, "error_free_master": floor });
-        return super::print_out(&(serde_json::to_string_pretty(&all)? + "\n"));
+        return super::output::print_out(&(serde_json::to_string_pretty(&all)? + "\n"));
     }
     let cell = |a: &Agreement, decimals: usize| {
         format!(
@@ -272,5 +272,5 @@ fn strapdown_check(s: &Scenario, hours: f64, rate: f64, json: bool) -> Result<()
         num(floor.velocity.max_difference, 7),
         num(floor.position_m.max_difference, 4)
     ));
-    super::print_out(&(lines.join("\n") + "\n"))
+    super::output::print_out(&(lines.join("\n") + "\n"))
 }

@@ -13,11 +13,14 @@
 //!   bounded lines, and the physical range of each number in them.
 //! - [`display`]: angles and their uncertainty as people read them.
 //! - [`figure`]: a drawing written as SVG and PNG (the embedded font).
+//! - [`files`]: output files written and the depth log read with the path
+//!   in every error.
 
 pub mod capture;
 pub mod depth_log;
 pub mod display;
 pub mod figure;
+pub mod files;
 pub mod ranges;
 pub mod samples_csv;
 pub mod text_records;
