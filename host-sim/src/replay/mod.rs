@@ -36,7 +36,9 @@
 //! stops it too and says so.
 
 pub mod commands;
+pub mod file_replay;
 pub mod live;
+pub mod report;
 
 use std::collections::{HashMap, VecDeque};
 use std::io::{self, Write};

@@ -1,8 +1,10 @@
 //! Trajectory and sensor simulation of the probe: scripted motions at one
 //! place (`trajectory`) and the drilling of a lateral along a well plan
-//! (`plan`, `drilling`).
+//! (`plan`, `drilling`), and what a simulation writes (`outputs`: the
+//! samples as a capture or CSV, a lateral's truth and depth log).
 pub mod drilling;
 pub mod model_file;
+pub mod outputs;
 pub mod plan;
 pub mod sensor;
 pub mod stream;
