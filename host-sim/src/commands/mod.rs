@@ -13,7 +13,6 @@ mod calibrate;
 mod dashboard;
 mod decode;
 mod demo;
-mod interrupt;
 mod limits;
 mod observability;
 mod paper;
@@ -21,16 +20,13 @@ mod paper_mgwd;
 mod paper_rins;
 mod probe;
 mod replay;
+mod runs;
 mod simulate;
 mod site;
 mod study;
 mod study_lateral;
 mod survey;
 mod survey_capture;
-
-// TEMPORARY: the study commands' helpers, until they name their leaves.
-use host_sim::formats::files::write_json;
-use interrupt::stop_on_ctrl_c;
 
 #[derive(Parser, Debug)]
 #[command(name = "host-sim", version, about = "Host tool of the gyro MWD probe")]

@@ -1,6 +1,24 @@
-//! Ctrl-C (and SIGTERM) during a study: the first one lets the runs under
-//! way finish and the study write what it has, a second one quits at once.
-//! A leaf of `commands/`, used by the study commands.
+//! The studies' runs on the command line: worker threads, a progress bar,
+//! and Ctrl-C (or SIGTERM): the first one lets the runs under way finish
+//! and the study write what it has, a second one quits at once. A leaf of
+//! `commands/`, used by the study commands.
+
+use anyhow::Context;
+
+/// Worker threads: `--threads`, else all cores.
+pub fn threads(given: Option<u64>) -> usize {
+    given.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    )
+}
+
+/// A progress bar over `len` runs drawn with `template`.
+pub fn progress_bar(len: u64, template: &str) -> anyhow::Result<indicatif::ProgressBar> {
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(indicatif::ProgressStyle::with_template(template).context("progress bar")?);
+    Ok(bar)
+}
 
 /// A flag the first Ctrl-C (or SIGTERM) sets: a study then finishes the
 /// runs under way and writes what it has. A second one quits at once. The
@@ -9,7 +27,6 @@
 pub fn stop_on_ctrl_c(
     bar: Option<&indicatif::ProgressBar>,
 ) -> anyhow::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    use anyhow::Context;
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
     let stop = Arc::new(AtomicBool::new(false));
