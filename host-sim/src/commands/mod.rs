@@ -1,4 +1,10 @@
-//! The CLI: one module per subcommand, each with its clap `Args` and a `run`.
+//! The CLI: one module per subcommand, each with its clap `Args` and a
+//! `run` that checks the arguments, calls the library (`host_sim`) and
+//! prints; the computing, the tables and the files are the library's.
+//! Leaves the commands share: [`output`] (`outln!`, `out!`: standard
+//! output that a closed pipe does not turn into a panic), [`limits`] and
+//! [`site`] (the numbers checked when parsed), [`runs`] (the studies'
+//! threads, progress bar and Ctrl-C).
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 

@@ -41,3 +41,29 @@ pub fn read_depth_log(path: &Path) -> Result<DepthLog> {
     let file = File::open(path).with_context(|| format!("reading {}", path.display()))?;
     DepthLog::read(file).with_context(|| format!("{}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn errors_name_the_path() {
+        let dir = std::env::temp_dir().join("host-sim-files-test-no-such-dir");
+        let path = dir.join("out.txt");
+        let e = write_text(&path, "x").unwrap_err();
+        assert_eq!(e.to_string(), format!("writing {}", path.display()));
+        let e = create_buffered(&path).unwrap_err();
+        assert_eq!(e.to_string(), format!("creating {}", path.display()));
+        let e = read_depth_log(&path).unwrap_err();
+        assert_eq!(e.to_string(), format!("reading {}", path.display()));
+    }
+
+    #[test]
+    fn a_closed_pipe_is_told_through_the_context() {
+        let pipe = std::io::Error::from(std::io::ErrorKind::BrokenPipe);
+        assert!(is_broken_pipe(&anyhow::Error::new(pipe).context("writing")));
+        let other = std::io::Error::from(std::io::ErrorKind::Other);
+        assert!(!is_broken_pipe(&anyhow::Error::new(other)));
+        assert!(!is_broken_pipe(&anyhow::anyhow!("not an io error")));
+    }
+}

@@ -202,3 +202,75 @@ impl Replayed {
         (s.mismatched, s.unchecked)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn replayed(summary: ReplaySummary, stations: Option<StationSummary>) -> Replayed {
+        Replayed {
+            source: "run.bin".into(),
+            capture: CaptureSummary::default(),
+            rows: 0,
+            last_row: None,
+            summary,
+            step_losses: Vec::new(),
+            commands: Vec::new(),
+            stations: stations.map(|s| (Vec::new(), s)),
+        }
+    }
+
+    #[test]
+    fn identical_and_complete_is_parity() {
+        let r = replayed(ReplaySummary::default(), Some(StationSummary::default()));
+        let report = r.report(None, false);
+        assert_eq!(report.verdict, Verdict::Parity);
+        assert!(report.note.is_none());
+        assert!(report.text.starts_with("capture          run.bin\n"));
+        assert!(report.text.contains("station parity   0 replayed"));
+    }
+
+    #[test]
+    fn differences_come_before_what_was_not_compared() {
+        let summary = ReplaySummary {
+            mismatched: 2,
+            unchecked: 5,
+            ..ReplaySummary::default()
+        };
+        let report = replayed(summary, None).report(Some(Path::new("out.csv")), false);
+        assert_eq!(report.verdict, Verdict::Different);
+        assert!(report
+            .note
+            .is_some_and(|n| n.starts_with("2 replayed solutions")));
+        assert!(report.text.contains("not replayed live"));
+        assert!(report.text.ends_with("csv              out.csv (0 rows)\n"));
+    }
+
+    #[test]
+    fn stations_not_compared_are_incomplete() {
+        let stations = StationSummary {
+            unchecked: 1,
+            ..StationSummary::default()
+        };
+        let report = replayed(ReplaySummary::default(), Some(stations)).report(None, false);
+        assert_eq!(report.verdict, Verdict::Incomplete);
+        assert_eq!(
+            report.note.as_deref(),
+            Some("1 probe station surveys could not be compared")
+        );
+    }
+
+    #[test]
+    fn post_processing_is_never_a_parity_failure() {
+        let summary = ReplaySummary {
+            mismatched: 1,
+            ..ReplaySummary::default()
+        };
+        let report = replayed(summary, None).report(None, true);
+        assert_eq!(report.verdict, Verdict::Parity);
+        assert!(report.note.is_none());
+        assert!(report
+            .text
+            .contains("post-processed   with another calibration"));
+    }
+}
