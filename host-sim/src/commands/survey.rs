@@ -1,6 +1,10 @@
 //! `host-sim survey`: positions of a survey's stations by minimum curvature
 //! and, with `--error-model`, their ISCWSA position uncertainty and error
-//! ellipse; a listing on the terminal and CSV, JSON, WITSML exports.
+//! ellipse; a listing on the terminal and CSV, JSON, WITSML exports. The
+//! survey is `host_sim::survey::well_survey`'s, its outputs
+//! `host_sim::survey::outputs`'; this module reads the options (and the
+//! job file they may name) and prints. With `--depth`, the capture survey
+//! (`survey_capture`).
 use super::limits::number_in;
 use super::site::SiteArgs;
 use anyhow::{bail, Result};

@@ -2,6 +2,8 @@
 //! surveys of a drilling capture, paired with MD from the surface depth
 //! log, listed with their position uncertainty; `--trajectory OUT.csv`: the
 //! continuous trajectory from the 20 Hz solutions. docs/drilling-survey.md.
+//! The survey is `host_sim::survey::capture`'s; `survey` checks the
+//! options and gives the inputs.
 
 use super::limits::number_in;
 use anyhow::Result;
