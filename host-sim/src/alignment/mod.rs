@@ -8,7 +8,12 @@
 //! - [`coarse`]: calibration, static segments (toolface positions) and the
 //!   core's coarse alignment with its bounds.
 //! - [`observability`]: the observability of the navigation errors with and
-//!   without sensor biases, under toolface indexing.
+//!   without sensor biases, under toolface indexing;
+//!   [`observability_report`]: its ranks and per-state report as text.
+//! - [`demo`]: the paper's static test simulated and coarse-aligned, with
+//!   toolface indexing (`host-sim demo`).
 
 pub mod coarse;
+pub mod demo;
 pub mod observability;
+pub mod observability_report;

@@ -35,6 +35,12 @@ pub fn duration_s(text: &str) -> Result<f64, String> {
     Ok(value)
 }
 
+/// `--tie-in-azimuth-sigma-deg` (the studies): 1-sigma of the parent
+/// well's azimuth at the tie-in, 0.001 to 30 deg.
+pub fn azimuth_sigma_deg(text: &str) -> Result<f64, String> {
+    number_in(text, "the tie-in azimuth sigma", (0.001, 30.0), "deg")
+}
+
 /// A body rate `x,y,z` in deg/s, each within the SCC1300's measurement
 /// range (+-300 deg/s: beyond it the simulated gyros would saturate).
 #[derive(Clone, Copy, Debug, PartialEq)]

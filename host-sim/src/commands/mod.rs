@@ -1,18 +1,15 @@
-//! The CLI: one module per subcommand, each with its clap `Args` and a `run`.
+//! The CLI: one module per subcommand, each with its clap `Args` and a
+//! `run` that checks the arguments, calls the library (`host_sim`) and
+//! prints; the computing, the tables and the files are the library's.
+//! Leaves the commands share: [`output`] (`outln!`, `out!`: standard
+//! output that a closed pipe does not turn into a panic), [`limits`] and
+//! [`site`] (the numbers checked when parsed), [`runs`] (the studies'
+//! threads, progress bar and Ctrl-C).
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
-/// `println!` for command output that a closed pipe (`| head -1`) does not
-/// turn into a panic: see [`print_out`].
-macro_rules! outln {
-    () => { $crate::commands::print_line(format_args!("")) };
-    ($($arg:tt)*) => { $crate::commands::print_line(format_args!($($arg)*)) };
-}
-
-/// `print!` through [`print_out`], as [`outln!`].
-macro_rules! out {
-    ($($arg:tt)*) => { $crate::commands::print_text(format_args!($($arg)*)) };
-}
+#[macro_use]
+mod output;
 
 mod align;
 mod allan;
@@ -29,6 +26,7 @@ mod paper_mgwd;
 mod paper_rins;
 mod probe;
 mod replay;
+mod runs;
 mod simulate;
 mod site;
 mod study;
@@ -81,72 +79,6 @@ pub enum Command {
     /// Reproductions of the papers' experiments.
     #[command(subcommand)]
     Paper(paper::PaperCommand),
-}
-
-/// Prints to stdout; a closed pipe (`| head`) ends the output quietly: the
-/// command goes on (files it writes are still written, its exit status
-/// still tells), only what nobody reads is dropped.
-fn print_out(text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => Ok(other?),
-    }
-}
-
-/// What [`outln!`] calls: one line through [`print_out`]. Another write
-/// error than a closed pipe (a full disk behind a redirection) is said on
-/// stderr rather than panicking as `println!` would.
-pub fn print_line(args: std::fmt::Arguments<'_>) {
-    print_text(format_args!("{args}\n"));
-}
-
-/// What [`out!`] calls.
-pub fn print_text(args: std::fmt::Arguments<'_>) {
-    if let Err(e) = print_out(&args.to_string()) {
-        eprintln!("error: writing to standard output: {e:#}");
-    }
-}
-
-/// Writes `value` as pretty JSON (with a final newline) to `path`, the
-/// path named in the error: the studies' `--json` outputs.
-fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
-    use anyhow::Context;
-    let text = serde_json::to_string_pretty(value)? + "\n";
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
-}
-
-/// A flag the first Ctrl-C (or SIGTERM) sets: a study then finishes the
-/// runs under way and writes what it has. A second one quits at once. The
-/// note goes above `bar` when it is drawn (one bar for the whole study),
-/// else to standard error.
-fn stop_on_ctrl_c(
-    bar: Option<&indicatif::ProgressBar>,
-) -> anyhow::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    use anyhow::Context;
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    let bar = bar.filter(|b| !b.is_hidden()).cloned();
-    ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::Relaxed) {
-            std::process::exit(130);
-        }
-        let note = "interrupted: finishing the runs under way, then writing the results so \
-                    far (Ctrl-C again to quit at once, writing nothing)";
-        // A bar that is not drawn (no terminal) prints nothing either.
-        match &bar {
-            Some(bar) => bar.println(note),
-            None => eprintln!("{note}"),
-        }
-    })
-    .context("installing the SIGINT/SIGTERM handler")?;
-    Ok(stop)
 }
 
 /// Runs a command; its exit status (only `replay` has others than 0: see

@@ -1,8 +1,10 @@
 //! `host-sim observability`: which errors a static probe's zero-velocity and
 //! zero-position updates can determine, at one toolface or over toolface
-//! indexing, with a per-state report from the SVD.
+//! indexing, with a per-state report from the SVD
+//! (`host_sim::alignment::observability_report`).
 use anyhow::{ensure, Result};
-use host_sim::alignment::observability::{analyse, Analysis, Measurements, STATE_NAMES};
+use host_sim::alignment::observability::{analyse, Measurements};
+use host_sim::alignment::observability_report::report;
 use host_sim::paper::mgwd::PUBLISHED;
 use mwd_core::conventions::{Euler, DEG};
 
@@ -52,47 +54,6 @@ pub fn run(args: Args) -> Result<()> {
         !args.no_biases,
         measurements,
     );
-    report(&args, &a);
+    out!("{}", report(&args.toolfaces, &args.measurements, &a));
     Ok(())
-}
-
-/// Ranks, each state's unobservable share and the unobservable directions.
-fn report(args: &Args, a: &Analysis) {
-    outln!(
-        "{} states, {} toolface segment(s) {:?} deg, measurements: {}",
-        a.states,
-        args.toolfaces.len(),
-        args.toolfaces,
-        args.measurements
-    );
-    outln!("rank of each segment's obsv(F, H): {:?}", a.segment_ranks);
-    outln!(
-        "rank of the stripped observability matrix: {} of {} (stripping condition {})",
-        a.stripped_rank,
-        a.states,
-        if a.stripping_condition {
-            "holds: this is the total rank"
-        } else {
-            "does not hold: a lower bound"
-        }
-    );
-    // Shares are of each state's unit vector (states scaled to 1 mrad,
-    // 1 cm/s, 1 cm, 1 mg, 2 deg/h) lying in the unobservable subspace.
-    outln!("\n{:<28} {:>13}", "state", "unobservable");
-    for (i, name) in STATE_NAMES.iter().enumerate().take(a.states) {
-        outln!(
-            "{:<28} {:>12.0}%",
-            name,
-            100.0 * a.report.unobservable_share[i]
-        );
-    }
-    for (k, v) in a.report.unobservable_directions.iter().enumerate() {
-        let parts: Vec<String> = v
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| c.abs() > 0.1)
-            .map(|(i, c)| format!("{c:+.2} {}", STATE_NAMES[i]))
-            .collect();
-        outln!("unobservable direction {}: {}", k + 1, parts.join(", "));
-    }
 }

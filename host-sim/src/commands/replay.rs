@@ -9,9 +9,8 @@
 //! probe's sample (`host_sim::replay::commands`); `--uplink LOG` gives what
 //! the replies do not carry (toolface indexing's parameters).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -19,19 +18,15 @@ use std::time::Duration;
 
 use anyhow::Context;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::formats::capture::{CaptureSummary, ProbeCaptureFile};
-use host_sim::formats::display;
-use host_sim::replay::commands::{decode_uplink_log, CommandRow};
+use host_sim::formats::files::create_buffered;
+use host_sim::replay::commands::decode_uplink_log;
+use host_sim::replay::file_replay::{replay_file, ReplayedProbe};
 use host_sim::replay::live::{self, LiveOptions, LiveSinks};
-use host_sim::replay::{
-    self, ReplayRow, ReplaySummary, Replayer, StationRow, StationSummary, StepLoss,
-};
+use host_sim::replay::report::{Replayed, Verdict};
 use host_sim::survey::job::Job;
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;
-use mwd_core::probe::TieIn;
-use mwd_core::protocol::uplink::{Command as UplinkCommand, StillSettings};
 
 use super::site::SiteArgs;
 
@@ -121,46 +116,11 @@ pub struct Args {
     pub uplink: Option<PathBuf>,
 }
 
-/// A replayed capture: where it came from, the capture, the replayed
-/// solutions and their summary.
-/// What a replay reports: the rows themselves went to `--csv` as they
-/// settled, so a capture of any length keeps only this.
-struct Replayed {
-    source: String,
-    capture: CaptureSummary,
-    /// How many rows the replay made, and the newest.
-    rows: usize,
-    last_row: Option<ReplayRow>,
-    summary: ReplaySummary,
-    step_losses: Vec<StepLoss>,
-    /// The replies to uplink commands and what the replay did with each.
-    commands: Vec<CommandRow>,
-    /// Live: the CSV was written while streaming.
-    /// Replayed station surveys and their comparison; `None` for a live
-    /// session (its stations are listed from the probe's frames only).
-    stations: Option<(Vec<StationRow>, StationSummary)>,
-}
-
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let job = args.job.as_deref().map(Job::load).transpose()?;
-    let site = match (args.site_numbers.as_deref(), &job) {
-        (Some(&[lat, lon, height]), _) => super::site::checked_position(lat, lon, height)?,
-        (_, Some(job)) => job.site,
-        _ => args.site.position(),
-    };
-    let job_calibration = job.as_ref().and_then(|j| j.calibration.as_ref());
-    let calibration = match (&args.calibration_file, job_calibration) {
-        (Some(path), _) => CalibrationFile::load(path)?.to_probe(),
-        (None, Some((_, calibration))) => *calibration,
-        (None, None) => ProbeCalibration::default(),
-    };
-    // A configured probe's navigator uses the job's still settings after
-    // its next boot or re-align (docs/protocol.md): so does the replay.
-    let job_still = job.as_ref().and_then(|j| j.still);
-    let still = job_still.unwrap_or_else(default_still_settings);
-    let tie_in = job.as_ref().and_then(|j| j.tie_in);
+    let probe = replayed_probe(&args, job.as_ref())?;
     let replayed = match (&args.port, &args.file) {
-        (Some(port), _) => replay_live(&args, port, site, calibration, still, tie_in)?,
+        (Some(port), _) => replay_live(&args, port, probe)?,
         (None, Some(file)) => {
             let sent = match &args.uplink {
                 Some(log) => {
@@ -169,12 +129,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     decode_uplink_log(&bytes)
                 }
                 None => Vec::new(),
-            };
-            let probe = ReplayedProbe {
-                site,
-                calibration,
-                still,
-                tie_in,
             };
             replay_file(file, probe, &sent, args.csv.as_deref())?
         }
@@ -187,78 +141,48 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // have had it.
     // Still settings other than the defaults: as another calibration.
     let post_processed = args.calibration_file.is_some()
-        || job_calibration.is_some()
-        || still != default_still_settings()
-        || site != Position::paper_site()
+        || job.as_ref().is_some_and(|j| j.calibration.is_some())
+        || probe.still != default_still_settings()
+        || probe.site != Position::paper_site()
         || job.as_ref().is_some_and(|j| j.tie_in.is_some());
-    report(&replayed, args.csv.as_ref(), post_processed)
-}
-
-/// The probe the replay stands for: its site, calibration, still settings
-/// and tie-in.
-struct ReplayedProbe {
-    site: Position,
-    calibration: ProbeCalibration,
-    still: StillSettings,
-    tie_in: Option<TieIn>,
-}
-
-/// Replays a capture file as it is read, writing `--csv` as the rows
-/// settle.
-fn replay_file(
-    file: &Path,
-    probe: ReplayedProbe,
-    sent: &[(u16, UplinkCommand)],
-    csv: Option<&Path>,
-) -> anyhow::Result<Replayed> {
-    let mut capture = ProbeCaptureFile::open(file)?;
-    let mut out = csv.map(create).transpose()?;
-    let csv_error = |e: std::io::Error| {
-        let path = csv.map(|p| p.display().to_string()).unwrap_or_default();
-        anyhow::Error::new(e).context(format!("writing {path}"))
+    let report = replayed.report(args.csv.as_deref(), post_processed);
+    out!("{}", report.text);
+    let (prefix, status) = match report.verdict {
+        Verdict::Parity => ("", status::PARITY),
+        Verdict::Different => ("error: ", status::DIFFERENT),
+        Verdict::Incomplete => ("warning: ", status::INCOMPLETE),
     };
-    if let Some(w) = out.as_mut() {
-        writeln!(w, "{}", replay::CSV_HEADER).map_err(csv_error)?;
+    if let Some(note) = report.note {
+        eprintln!("{prefix}{note}");
     }
-    let mut replayer = Replayer::with_settings(probe.site, probe.calibration, probe.still)
-        .with_tie_in(probe.tie_in);
-    for (seq, command) in sent {
-        replayer.knows_sent_command(*seq, command);
-    }
-    let mut summary = CaptureSummary::default();
-    let mut items = 0usize;
-    while let Some(item) = capture.next_item()? {
-        summary.note(item.received());
-        replayer.push_received(item.received());
-        items += 1;
-        if items % replay::FILE_BATCH_ITEMS == 0 {
-            let sink = out.as_mut().map(|w| w as &mut dyn Write);
-            replayer.write_settled(sink, false).map_err(csv_error)?;
-        }
-    }
-    summary.stats = *capture.stats();
-    let (station_rows, station_summary) = replayer.stations();
-    let stations = Some((station_rows.to_vec(), station_summary));
-    let sink = out.as_mut().map(|w| w as &mut dyn Write);
-    replayer.write_settled(sink, true).map_err(csv_error)?;
-    // The header alone (no raw frame) was never flushed with rows.
-    if let Some(w) = out.as_mut() {
-        w.flush().map_err(csv_error)?;
-    }
-    let step_losses = replayer.step_losses().to_vec();
-    let commands = replayer.commands().to_vec();
-    let rows = replayer.rows_replayed();
-    let last_row = replayer.last_row().copied();
-    let (_, replay_summary) = replayer.finish();
-    Ok(Replayed {
-        source: file.display().to_string(),
-        capture: summary,
-        rows,
-        last_row,
-        summary: replay_summary,
-        step_losses,
-        commands,
-        stations,
+    Ok(ExitCode::from(status))
+}
+
+/// The probe the replay stands for: `--site` or the job's site (else
+/// `--lat`, `--lon`, `--height`), `--calibration-file` or the job's
+/// calibration; the job's still settings and tie-in.
+fn replayed_probe(args: &Args, job: Option<&Job>) -> anyhow::Result<ReplayedProbe> {
+    let site = match (args.site_numbers.as_deref(), job) {
+        (Some(&[lat, lon, height]), _) => super::site::checked_position(lat, lon, height)?,
+        (_, Some(job)) => job.site,
+        _ => args.site.position(),
+    };
+    let job_calibration = job.and_then(|j| j.calibration.as_ref());
+    let calibration = match (&args.calibration_file, job_calibration) {
+        (Some(path), _) => CalibrationFile::load(path)?.to_probe(),
+        (None, Some((_, calibration))) => *calibration,
+        (None, None) => ProbeCalibration::default(),
+    };
+    // A configured probe's navigator uses the job's still settings after
+    // its next boot or re-align (docs/protocol.md): so does the replay.
+    let still = job
+        .and_then(|j| j.still)
+        .unwrap_or_else(default_still_settings);
+    Ok(ReplayedProbe {
+        site,
+        calibration,
+        still,
+        tie_in: job.and_then(|j| j.tie_in),
     })
 }
 
@@ -270,27 +194,14 @@ fn seconds(name: &str, value: f64) -> anyhow::Result<Duration> {
     Ok(Duration::from_secs_f64(value))
 }
 
-/// Creates an output file for a live session.
-fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
-    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    Ok(BufWriter::new(file))
-}
-
 /// Replays the live stream of a serial port until it ends (or
 /// `--duration`, `--silence`, SIGINT/SIGTERM), with a status line a few
 /// times a second, writing `--save` and `--csv` as it goes.
-fn replay_live(
-    args: &Args,
-    port: &str,
-    site: Position,
-    calibration: ProbeCalibration,
-    still: StillSettings,
-    tie_in: Option<TieIn>,
-) -> anyhow::Result<Replayed> {
+fn replay_live(args: &Args, port: &str, probe: ReplayedProbe) -> anyhow::Result<Replayed> {
     let duration = args.duration.map(|s| seconds("duration", s)).transpose()?;
     let silence = seconds("silence", args.silence)?;
-    let mut save = args.save.as_deref().map(create).transpose()?;
-    let mut csv = args.csv.as_deref().map(create).transpose()?;
+    let mut save = args.save.as_deref().map(create_buffered).transpose()?;
+    let mut csv = args.csv.as_deref().map(create_buffered).transpose()?;
     // Ctrl-C or SIGTERM ends the session like the end of the stream.
     let stop = Arc::new(AtomicBool::new(false));
     let handler_stop = Arc::clone(&stop);
@@ -307,9 +218,9 @@ fn replay_live(
     let options = LiveOptions {
         duration,
         silence: Some(silence),
-        calibration,
-        still,
-        tie_in,
+        calibration: probe.calibration,
+        still: probe.still,
+        tie_in: probe.tie_in,
         ..LiveOptions::default()
     };
     let sinks = LiveSinks {
@@ -317,143 +228,16 @@ fn replay_live(
         csv: csv.as_mut().map(|w| w as &mut dyn Write),
         stop: Some(&stop),
     };
-    let outcome = live::run(serial, site, options, sinks, |status| outln!("{status}"));
+    let outcome = live::run(serial, probe.site, options, sinks, |status| {
+        outln!("{status}")
+    });
     outln!("end of stream    {}", outcome.end);
     if let Some(path) = &args.save {
-        outln!(
-            "saved            {} ({} bytes)",
-            path.display(),
-            outcome.capture.stats.bytes
-        );
+        let bytes = outcome.capture.stats.bytes;
+        outln!("saved            {} ({bytes} bytes)", path.display());
     }
     if let live::StreamEnd::OutputFailed(e) = &outcome.end {
         anyhow::bail!("writing the live session's output: {e}");
     }
-    Ok(Replayed {
-        source: port.to_string(),
-        capture: outcome.capture,
-        rows: outcome.rows,
-        last_row: outcome.last_row,
-        summary: outcome.summary,
-        step_losses: outcome.step_losses,
-        commands: outcome.commands,
-        stations: None,
-    })
-}
-
-/// The summary both modes end with, the CSV, and the exit status.
-fn report(
-    replayed: &Replayed,
-    csv: Option<&PathBuf>,
-    post_processed: bool,
-) -> anyhow::Result<ExitCode> {
-    let Replayed {
-        source,
-        capture: cap,
-        rows,
-        last_row,
-        summary,
-        step_losses,
-        commands,
-        stations,
-    } = replayed;
-    outln!("capture          {source}");
-    outln!("{cap}");
-    outln!("raw frames       {}", summary.raw_frames);
-    outln!("degraded samples {}", summary.degraded);
-    outln!("probe solutions  {}", summary.probe_solutions);
-    outln!(
-        "probe restarts   {} (the replay restarted with it)",
-        summary.restarts
-    );
-    outln!(
-        "replay parity    {} identical, {} different, {} not compared",
-        summary.matched,
-        summary.mismatched,
-        summary.unchecked
-    );
-    for command in commands {
-        outln!("uplink           {command}");
-    }
-    for loss in step_losses {
-        outln!("out of step      {loss}");
-    }
-    let mut stations_differ = 0;
-    let mut stations_unchecked = 0;
-    match stations {
-        Some((rows, s)) => {
-            outln!(
-                "station parity   {} replayed, {} from the probe: {} identical, {} different, \
-                 {} not compared",
-                s.replayed,
-                s.probe,
-                s.matched,
-                s.mismatched,
-                s.unchecked
-            );
-            for row in rows {
-                let parity = match (row.in_step, row.matches_probe) {
-                    (false, _) => "not compared",
-                    (true, Some(true)) => "identical to the probe's",
-                    (true, Some(false)) => "DIFFERENT from the probe's",
-                    (true, None) => "no probe frame",
-                };
-                outln!(
-                    "replayed {} [{parity}]",
-                    display::station_text(&row.station)
-                );
-            }
-            stations_differ = s.mismatched;
-            stations_unchecked = s.unchecked;
-        }
-        None => {
-            outln!("station parity   not replayed live (the probe's stations are listed above)")
-        }
-    }
-    if let Some(last) = last_row {
-        let s = &last.solution;
-        let [r, p, h] = s.attitude.map(f64::from);
-        outln!(
-            "last attitude    roll {:.3} pitch {:.3} deg, azimuth {}",
-            r.to_degrees(),
-            p.to_degrees(),
-            display::azimuth_text(h, f64::from(s.attitude_std[2]), 2)
-        );
-    }
-    if let Some(out) = csv {
-        outln!("csv              {} ({rows} rows)", out.display());
-    }
-    if post_processed {
-        if summary.mismatched > 0 || stations_differ > 0 {
-            outln!(
-                "post-processed   with another calibration or site than the probe's defaults: \
-                 differences from the probe's solutions are expected, not a parity failure"
-            );
-        }
-        return Ok(ExitCode::from(status::PARITY));
-    }
-    let differences = step_losses
-        .iter()
-        .filter(|l| l.reason.is_a_difference())
-        .count();
-    if summary.mismatched > 0 || stations_differ > 0 || differences > 0 {
-        eprintln!(
-            "error: {} replayed solutions and {stations_differ} station surveys differ from the \
-             probe's; {differences} commands or navigation modes differ (see \"out of step\")",
-            summary.mismatched
-        );
-        return Ok(ExitCode::from(status::DIFFERENT));
-    }
-    if stations_unchecked > 0 {
-        eprintln!("warning: {stations_unchecked} probe station surveys could not be compared");
-        return Ok(ExitCode::from(status::INCOMPLETE));
-    }
-    if summary.unchecked > 0 || !step_losses.is_empty() {
-        eprintln!(
-            "warning: {} probe solutions could not be compared (see \"out of step\")",
-            summary.unchecked
-        );
-        return Ok(ExitCode::from(status::INCOMPLETE));
-    }
-    Ok(ExitCode::from(status::PARITY))
+    Ok(Replayed::from_live(port, outcome))
 }

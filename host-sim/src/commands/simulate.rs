@@ -3,13 +3,12 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::formats::{capture, samples_csv};
 use host_sim::paper::mgwd::PUBLISHED;
+use host_sim::sim::outputs::{drill, write_samples, LateralOutputs, SampleSink};
 use host_sim::sim::plan::Vibration;
-use host_sim::sim::stream::SensorStreamWriter;
 use host_sim::sim::{
-    DeterministicErrors, Drilling, DrillingSimulator, Motion, Plan, SensorModel, SensorModelFile,
-    SensorSimulator, SimSample, Trajectory, Truth,
+    DeterministicErrors, Drilling, Motion, Plan, SensorModel, SensorModelFile, SensorSimulator,
+    Trajectory,
 };
 use host_sim::survey::job::Job;
 use mwd_core::conventions::{Euler, DEG};
@@ -17,8 +16,7 @@ use mwd_core::earth::Position;
 use mwd_core::probe::TieIn;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::limits::{self, BodyRate};
 use super::site::SiteArgs;
@@ -217,45 +215,19 @@ pub fn run(args: Args) -> Result<()> {
     let model = sensor_model(&args)?;
     let n = (duration / SAMPLE_INTERVAL_S).round() as usize;
     let samples = SensorSimulator::new(trajectory, model, SAMPLE_INTERVAL_S).take(n);
-    let output = &args.output;
-    let to_stdout = output.as_os_str() == "-";
-    match output_format(&args) {
-        OutputFormat::Bin => {
-            anyhow::ensure!(
-                !to_stdout,
-                "binary captures go to a file, not standard output"
-            );
-            let bytes = write_capture(output, samples, site, tie_in(&args)?)?;
-            eprintln!(
-                "wrote a boot event and {n} raw-sample and navigation frames ({bytes} bytes) to {}",
-                output.display()
-            );
+    let sink = sample_sink(&args, site)?;
+    let bytes = write_samples(sink, samples)?;
+    let output = args.output.display();
+    match sink {
+        SampleSink::Capture { .. } => eprintln!(
+            "wrote a boot event and {n} raw-sample and navigation frames ({bytes} bytes) to {output}"
+        ),
+        SampleSink::Csv(_) => {
+            eprintln!("wrote {n} samples ({duration} s at 20 Hz) to {output}")
         }
-        OutputFormat::Csv if to_stdout => {
-            // A reader that stopped (`| head`) ends the run quietly.
-            match samples_csv::write(std::io::stdout().lock(), samples) {
-                Err(e) if is_broken_pipe(&e) => {}
-                other => other?,
-            }
-        }
-        OutputFormat::Csv => {
-            write_csv(output, samples)?;
-            eprintln!(
-                "wrote {n} samples ({duration} s at 20 Hz) to {}",
-                output.display()
-            );
-        }
+        SampleSink::Stdout => {}
     }
     Ok(())
-}
-
-/// Whether `error` is standard output's reader having gone.
-fn is_broken_pipe(error: &anyhow::Error) -> bool {
-    error.chain().any(|cause| {
-        cause
-            .downcast_ref::<std::io::Error>()
-            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
-    })
 }
 
 /// The simulated probe: `--sensor` or `--sensor-model`, with the
@@ -278,14 +250,35 @@ fn sensor_model(args: &Args) -> Result<SensorModel> {
     Ok(model)
 }
 
-/// `--format`, or by default `bin` for a `.bin` output and `csv` otherwise.
-fn output_format(args: &Args) -> OutputFormat {
-    args.format
-        .unwrap_or(if args.output.extension().is_some_and(|e| e == "bin") {
+/// Where the samples go: `--output` in `--format` (by default `bin` for a
+/// `.bin` output and `csv` otherwise), a capture of a probe at `site` with
+/// `--tie-in-job`'s tie-in.
+fn sample_sink(args: &Args, site: Position) -> Result<SampleSink<'_>> {
+    let output = args.output.as_path();
+    let to_stdout = output.as_os_str() == "-";
+    let format = args
+        .format
+        .unwrap_or(if output.extension().is_some_and(|e| e == "bin") {
             OutputFormat::Bin
         } else {
             OutputFormat::Csv
-        })
+        });
+    Ok(match format {
+        OutputFormat::Bin => {
+            anyhow::ensure!(
+                !to_stdout,
+                "binary captures go to a file, not standard output"
+            );
+            let tie_in = tie_in(args)?;
+            SampleSink::Capture {
+                path: output,
+                site,
+                tie_in,
+            }
+        }
+        OutputFormat::Csv if to_stdout => SampleSink::Stdout,
+        OutputFormat::Csv => SampleSink::Csv(output),
+    })
 }
 
 /// `--tie-in-job`'s tie-in.
@@ -299,32 +292,6 @@ fn tie_in(args: &Args) -> Result<Option<TieIn>> {
     }
 }
 
-/// Writes the capture of a probe at `site` (tied in to `tie_in`) of
-/// `samples`; returns its size in bytes.
-fn write_capture(
-    path: &Path,
-    samples: impl Iterator<Item = SimSample>,
-    site: Position,
-    tie_in: Option<TieIn>,
-) -> Result<u64> {
-    let mut capture =
-        capture::create_capture(path).with_context(|| format!("creating {}", path.display()))?;
-    capture::write_simulated_probe(&mut capture, samples, site, tie_in)?;
-    let bytes = capture.bytes_written();
-    capture.finish()?;
-    Ok(bytes)
-}
-
-/// Writes `samples` as a sample CSV file.
-fn write_csv(path: &Path, samples: impl Iterator<Item = SimSample>) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut out = std::io::BufWriter::new(file);
-    samples_csv::write(&mut out, samples)?;
-    out.flush()?;
-    Ok(())
-}
-
 /// `--motion lateral`: the drilling simulator along `--plan`.
 fn run_lateral(args: &Args) -> Result<()> {
     let path = args
@@ -333,179 +300,50 @@ fn run_lateral(args: &Args) -> Result<()> {
         .context("--motion lateral needs --plan FILE (a well plan, docs/drilling-simulation.md)")?;
     let mut plan = Plan::load(path)?;
     if let Some(level) = args.vibration {
-        plan.drilling.vibration = match level {
-            VibrationLevel::None => Vibration::NONE,
-            VibrationLevel::Moderate => Vibration::MODERATE,
-            VibrationLevel::Harsh => Vibration::HARSH,
-        };
+        plan.drilling.vibration = level.vibration();
     }
     let model = sensor_model(args)?;
     let started = std::time::Instant::now();
     let drilling = Drilling::new(plan, args.seed);
-    anyhow::ensure!(
-        drilling.duration() <= MAX_LATERAL_S,
-        "the plan takes {:.1} h to drill; at most {:.0} h are simulated",
-        drilling.duration() / 3600.0,
-        MAX_LATERAL_S / 3600.0
-    );
-    let n = drilling.sample_count(SAMPLE_INTERVAL_S);
     // The site the probe's navigator is configured with: the plan's (the
     // wellhead; the QEMU probe's default is the same paper site), not the
     // probe's position down hole, so `replay` of the capture (which knows
     // only the configured site) is bit for bit the probe's.
     let site = drilling.plan().site;
-    let output = &args.output;
-    let to_stdout = output.as_os_str() == "-";
-    let mut truth_out = match &args.truth {
-        Some(p) => {
-            let mut w = TruthWriter::create(p)?;
-            w.row(&drilling.truth(0.0))?;
-            Some(w)
-        }
-        None => None,
+    let outputs = LateralOutputs {
+        truth: args.truth.as_deref(),
+        truth_every: args.truth_every as usize,
+        sensor_stream: args.sensor_stream.as_deref(),
+        depth_log: args.depth_log.as_deref(),
     };
-    let mut stream = match &args.sensor_stream {
-        Some(p) => Some(SensorStreamWriter::create(p, n)?),
-        None => None,
-    };
-    let mut counts = Counts::default();
-    let mut failure: Option<anyhow::Error> = None;
-    let every = args.truth_every as usize;
-    let samples = DrillingSimulator::new(&drilling, model, SAMPLE_INTERVAL_S)
-        .enumerate()
-        .map(|(i, d)| {
-            counts.accel_over_range += usize::from(d.accel_over_range);
-            counts.gyro_over_range += usize::from(d.gyro_over_range);
-            if let Some(w) = truth_out.as_mut() {
-                if (i + 1) % every == 0 {
-                    if let Err(e) = w.row(&d.truth) {
-                        failure.get_or_insert(e);
-                    }
-                }
-            }
-            if let Some(w) = stream.as_mut() {
-                if let Err(e) = w.push(&d.sample) {
-                    failure.get_or_insert(e);
-                }
-            }
-            d.sample
-        });
-    match output_format(args) {
-        OutputFormat::Bin => {
-            anyhow::ensure!(
-                !to_stdout,
-                "binary captures go to a file, not standard output"
-            );
-            write_capture(output, samples, site, tie_in(args)?)?;
-        }
-        OutputFormat::Csv if to_stdout => {
-            match samples_csv::write(std::io::stdout().lock(), samples) {
-                Err(e) if is_broken_pipe(&e) => {}
-                other => other?,
-            }
-        }
-        OutputFormat::Csv => write_csv(output, samples)?,
-    }
-    if let Some(e) = failure {
-        return Err(e);
-    }
-    if let Some(w) = truth_out {
-        w.finish()?;
-    }
-    if let Some(w) = stream {
-        w.finish()?;
-    }
-    if let Some(p) = &args.depth_log {
-        write_depth_log(p, &drilling)?;
-    }
+    let over_range = drill(&drilling, model, &outputs, |samples| {
+        write_samples(sample_sink(args, site)?, samples).map(drop)
+    })?;
     let plan = drilling.plan();
     eprintln!(
-        "drilled MD {:.2} -> {:.2} m in {:.2} h ({} connections, {} shocks): {n} samples to {} in {:.1} s; \
+        "drilled MD {:.2} -> {:.2} m in {:.2} h ({} connections, {} shocks): {} samples to {} in {:.1} s; \
          {} samples with an accelerometer axis beyond 6 g, {} with a gyro beyond 300 deg/s",
         plan.start_md(),
         plan.end_md(),
         drilling.duration() / 3600.0,
         drilling.connections().len(),
         drilling.shocks().len(),
-        output.display(),
+        drilling.sample_count(SAMPLE_INTERVAL_S),
+        args.output.display(),
         started.elapsed().as_secs_f64(),
-        counts.accel_over_range,
-        counts.gyro_over_range,
+        over_range.accel,
+        over_range.gyro,
     );
     Ok(())
 }
 
-/// Longest drilling run simulated: 7 days (a 1000 m lateral at 30 m/h
-/// takes ~37 h).
-const MAX_LATERAL_S: f64 = 7.0 * 86_400.0;
-
-#[derive(Default)]
-struct Counts {
-    accel_over_range: usize,
-    gyro_over_range: usize,
-}
-
-/// The truth trajectory CSV.
-struct TruthWriter {
-    out: std::io::BufWriter<std::fs::File>,
-    path: PathBuf,
-}
-
-impl TruthWriter {
-    fn create(path: &Path) -> Result<Self> {
-        let file =
-            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut out = std::io::BufWriter::new(file);
-        writeln!(
-            out,
-            "time_s,md_m,tvd_m,north_m,east_m,inclination_deg,azimuth_deg,toolface_deg,\
-             roll_deg,pitch_deg,heading_deg,state"
-        )?;
-        Ok(Self {
-            out,
-            path: path.to_owned(),
-        })
+impl VibrationLevel {
+    /// The plan's vibration at this level.
+    pub fn vibration(self) -> Vibration {
+        match self {
+            Self::None => Vibration::NONE,
+            Self::Moderate => Vibration::MODERATE,
+            Self::Harsh => Vibration::HARSH,
+        }
     }
-
-    fn row(&mut self, t: &Truth) -> Result<()> {
-        let e = t.euler();
-        let p = &t.point;
-        writeln!(
-            self.out,
-            "{:.3},{:.6},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{}",
-            t.time,
-            t.md,
-            p.nev.z,
-            p.nev.x,
-            p.nev.y,
-            p.inclination / DEG,
-            p.azimuth / DEG,
-            mwd_core::conventions::wrap_two_pi(t.toolface) / DEG,
-            e.roll / DEG,
-            e.pitch / DEG,
-            e.heading / DEG,
-            t.state.name()
-        )
-        .with_context(|| format!("writing {}", self.path.display()))
-    }
-
-    fn finish(mut self) -> Result<()> {
-        self.out
-            .flush()
-            .with_context(|| format!("writing {}", self.path.display()))
-    }
-}
-
-/// The surface depth log: time_s, md_m (with the plan's depth errors).
-fn write_depth_log(path: &Path, drilling: &Drilling) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut out = std::io::BufWriter::new(file);
-    writeln!(out, "time_s,md_m")?;
-    for (t, md) in drilling.depth_log() {
-        writeln!(out, "{t:.3},{md:.4}")?;
-    }
-    out.flush()
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
 }

@@ -1,9 +1,10 @@
 //! `host-sim study drilling-coverage`: the coverage study of the probe's
 //! station sigmas over seeded simulated laterals (docs/drilling-survey.md).
 
-use super::limits::number_in;
-use anyhow::{Context, Result};
-use host_sim::sim::plan::Vibration;
+use super::limits::{azimuth_sigma_deg, number_in};
+use super::runs::{progress_bar, stop_on_ctrl_c, threads};
+use anyhow::Result;
+use host_sim::formats::files::write_json;
 use host_sim::sim::Plan;
 use host_sim::study::drilling_coverage::{study, table};
 use host_sim::study::drilling_run::{RunConfig, Scalar};
@@ -25,10 +26,6 @@ pub enum StudyCommand {
     /// gyro grade, station azimuth and TD position errors against the
     /// predicted sigmas (docs/lateral-study.md).
     Lateral(LateralArgs),
-}
-
-pub(super) fn azimuth_sigma_deg(text: &str) -> Result<f64, String> {
-    number_in(text, "the tie-in azimuth sigma", (0.001, 30.0), "deg")
 }
 
 pub use super::study_lateral::LateralArgs;
@@ -66,19 +63,17 @@ pub struct CoverageArgs {
 }
 
 pub fn run(cmd: StudyCommand) -> Result<()> {
-    let args = match cmd {
-        StudyCommand::DrillingCoverage(args) => args,
-        StudyCommand::RinsProbe(args) => return rins_probe(args),
-        StudyCommand::Lateral(args) => return super::study_lateral::run(args),
-    };
+    match cmd {
+        StudyCommand::DrillingCoverage(args) => drilling_coverage(args),
+        StudyCommand::RinsProbe(args) => rins_probe(args),
+        StudyCommand::Lateral(args) => super::study_lateral::run(args),
+    }
+}
+
+fn drilling_coverage(args: CoverageArgs) -> Result<()> {
     let mut plan = Plan::load(&args.plan)?;
     if let Some(level) = args.vibration {
-        use super::simulate::VibrationLevel as V;
-        plan.drilling.vibration = match level {
-            V::None => Vibration::NONE,
-            V::Moderate => Vibration::MODERATE,
-            V::Harsh => Vibration::HARSH,
-        };
+        plan.drilling.vibration = level.vibration();
     }
     let mut config = RunConfig::new(
         plan,
@@ -87,16 +82,12 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     )?;
     config.uncalibrated = args.uncalibrated;
     config.scalar = args.scalar;
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    );
-    let bar = indicatif::ProgressBar::new(args.runs);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})")
-            .context("progress bar")?,
-    );
-    let stop = super::stop_on_ctrl_c(Some(&bar))?;
+    let threads = threads(args.threads);
+    let bar = progress_bar(
+        args.runs,
+        "{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
+    )?;
+    let stop = stop_on_ctrl_c(Some(&bar))?;
     let summary = study(
         &config,
         args.runs as usize,
@@ -122,7 +113,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     );
     out!("{}", table(&summary));
     if let Some(path) = &args.json {
-        super::write_json(path, &summary)?;
+        write_json(path, &summary)?;
     }
     if let Some(i) = summary.interrupted {
         anyhow::bail!(
@@ -182,55 +173,14 @@ pub struct RinsProbeArgs {
 }
 
 fn rins_probe(args: RinsProbeArgs) -> Result<()> {
-    use host_sim::study::rins_probe::{study, table, ProbeConfig, GRADES};
+    use host_sim::study::rins_probe::table;
     let plan = Plan::load(&args.plan)?;
-    let names = if args.grades.is_empty() {
-        vec![
-            GradeName::Scc1300,
-            GradeName::Tactical,
-            GradeName::Navigation,
-        ]
-    } else {
-        args.grades.clone()
-    };
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    );
+    let threads = threads(args.threads);
     let mut summaries = Vec::new();
     // One bar per grade: the note goes to standard error.
-    let stop = super::stop_on_ctrl_c(None)?;
-    for name in names {
-        let grade = GRADES[match name {
-            GradeName::Scc1300 => 0,
-            GradeName::Tactical => 1,
-            GradeName::Navigation => 2,
-        }];
-        let config = ProbeConfig {
-            plan: plan.clone(),
-            tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
-            reference_sigma: args.reference_sigma_deg.to_radians(),
-            reference_stations: args.reference_stations as usize,
-            grade,
-            white_noise_kept: args.white_noise_kept,
-        };
-        let bar = indicatif::ProgressBar::new(args.runs);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} {bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
-            )
-            .context("progress bar")?,
-        );
-        bar.set_message(grade.name);
-        summaries.push(study(
-            &config,
-            args.runs as usize,
-            args.first_seed,
-            threads,
-            &|| bar.inc(1),
-            &stop,
-        ));
-        bar.finish_and_clear();
+    let stop = stop_on_ctrl_c(None)?;
+    for name in grade_names(&args) {
+        summaries.push(rins_probe_grade(&args, &plan, name, threads, &stop)?);
     }
     outln!(
         "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads{})",
@@ -249,10 +199,62 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     );
     out!("{}", table(&summaries));
     if let Some(path) = &args.json {
-        super::write_json(path, &summaries)?;
+        write_json(path, &summaries)?;
     }
     if stop.load(std::sync::atomic::Ordering::Relaxed) {
         anyhow::bail!("interrupted: the outputs above hold the runs done");
     }
     Ok(())
+}
+
+/// `--grades`, by default all three.
+fn grade_names(args: &RinsProbeArgs) -> Vec<GradeName> {
+    if args.grades.is_empty() {
+        vec![
+            GradeName::Scc1300,
+            GradeName::Tactical,
+            GradeName::Navigation,
+        ]
+    } else {
+        args.grades.clone()
+    }
+}
+
+/// The rins-probe study of one grade, with its progress bar.
+fn rins_probe_grade(
+    args: &RinsProbeArgs,
+    plan: &host_sim::sim::BuiltPlan,
+    name: GradeName,
+    threads: usize,
+    stop: &std::sync::atomic::AtomicBool,
+) -> Result<host_sim::study::rins_probe::GradeSummary> {
+    use host_sim::study::rins_probe::{study, ProbeConfig, GRADES};
+    let grade = GRADES[match name {
+        GradeName::Scc1300 => 0,
+        GradeName::Tactical => 1,
+        GradeName::Navigation => 2,
+    }];
+    let config = ProbeConfig {
+        plan: plan.clone(),
+        tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
+        reference_sigma: args.reference_sigma_deg.to_radians(),
+        reference_stations: args.reference_stations as usize,
+        grade,
+        white_noise_kept: args.white_noise_kept,
+    };
+    let bar = progress_bar(
+        args.runs,
+        "{msg} {bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
+    )?;
+    bar.set_message(grade.name);
+    let summary = study(
+        &config,
+        args.runs as usize,
+        args.first_seed,
+        threads,
+        &|| bar.inc(1),
+        stop,
+    );
+    bar.finish_and_clear();
+    Ok(summary)
 }

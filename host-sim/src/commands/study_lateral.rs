@@ -2,15 +2,17 @@
 //! [`host_sim::study::lateral`]: grades, wells, drilling parameters, a
 //! progress bar over every job, the tables, CSV and JSON.
 
-use super::limits::number_in;
+use super::limits::{azimuth_sigma_deg, number_in};
+use super::runs::{progress_bar, stop_on_ctrl_c, threads};
 use anyhow::{Context, Result};
+use host_sim::formats::files::{write_json, write_text};
 use host_sim::study::drilling_run::Scalar;
 use host_sim::study::grade;
 use host_sim::study::lateral::covariance::SweepGrid;
 use host_sim::study::lateral::figures::plots;
 use host_sim::study::lateral::stations::stations_csv;
 use host_sim::study::lateral::table::{csv, table};
-use host_sim::study::lateral::{study, DrillingOverrides, StudyConfig, Well};
+use host_sim::study::lateral::{study, DrillingOverrides, LateralStudy, StudyConfig, Well};
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]
@@ -70,7 +72,7 @@ pub struct LateralArgs {
     #[arg(long = "connection-still", value_parser = connection_still)]
     pub connection_still_s: Option<f64>,
     /// 1-sigma of the parent well's azimuth at the tie-in, deg.
-    #[arg(long = "tie-in-azimuth-sigma", alias = "tie-in-azimuth-sigma-deg", default_value_t = 0.5, value_parser = super::study::azimuth_sigma_deg)]
+    #[arg(long = "tie-in-azimuth-sigma", alias = "tie-in-azimuth-sigma-deg", default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
     pub tie_in_azimuth_sigma_deg: f64,
     /// Write the results here (JSON: summaries and the along-MD arrays).
     #[arg(long)]
@@ -109,26 +111,8 @@ pub fn run(args: LateralArgs) -> Result<()> {
         stand_length_m: args.stand_length_m,
         connection_still_s: args.connection_still_s,
     };
-    let wells: Vec<Well> = if args.plans.is_empty() {
-        let names: &[&str] = match args.well {
-            WellChoice::Short => &["100m"],
-            WellChoice::Long => &["1000m"],
-            WellChoice::Both => &["100m", "1000m"],
-        };
-        names
-            .iter()
-            .map(|n| Well::builtin(n, &overrides))
-            .collect::<Result<_>>()?
-    } else {
-        args.plans
-            .iter()
-            .map(|p| Well::load(p, &overrides))
-            .collect::<Result<_>>()?
-    };
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    );
+    let wells = wells(&args, &overrides)?;
+    let threads = threads(args.threads);
     let config = StudyConfig {
         grades,
         wells,
@@ -144,14 +128,11 @@ pub fn run(args: LateralArgs) -> Result<()> {
     let sweep_points = args.sweep.map_or(0, |n| n * n) * config.wells.len() as u64;
     let runs = if args.covariance_only { 0 } else { args.runs };
     let jobs = pairs * (runs + 1) + sweep_points;
-    let bar = indicatif::ProgressBar::new(jobs);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} runs (Monte Carlo, covariance analysis, sweep), {elapsed} (eta {eta})",
-        )
-        .context("progress bar")?,
-    );
-    let stop = super::stop_on_ctrl_c(Some(&bar))?;
+    let bar = progress_bar(
+        jobs,
+        "{bar:40} {pos}/{len} runs (Monte Carlo, covariance analysis, sweep), {elapsed} (eta {eta})",
+    )?;
+    let stop = stop_on_ctrl_c(Some(&bar))?;
     let result = study(&config, &|| bar.inc(1), &stop)?;
     bar.finish_and_clear();
     let names: Vec<&str> = config.grades.iter().map(|g| g.name()).collect();
@@ -168,27 +149,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
         result.wall_s
     );
     out!("{}", table(&result));
-    if let Some(path) = &args.json {
-        super::write_json(path, &result)?;
-    }
-    if let Some(path) = &args.csv {
-        std::fs::write(path, csv(&result))
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
-    if let Some(path) = &args.stations_csv {
-        let tables = result
-            .summaries
-            .iter()
-            .map(|s| (s.grade.as_str(), s.well.as_str(), s.station_rows.as_slice()));
-        std::fs::write(path, stations_csv(tables))
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
-    if let Some(dir) = &args.plots {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        for path in plots(&result, dir)? {
-            outln!("wrote {}", path.display());
-        }
-    }
+    write_outputs(&args, &result)?;
     for e in &result.errors {
         eprintln!("error: {e}");
     }
@@ -198,6 +159,51 @@ pub fn run(args: LateralArgs) -> Result<()> {
             i.jobs_done,
             i.jobs
         );
+    }
+    Ok(())
+}
+
+/// The wells: `--plan`s, else the built-in laterals of `--well`.
+fn wells(args: &LateralArgs, overrides: &DrillingOverrides) -> Result<Vec<Well>> {
+    if args.plans.is_empty() {
+        let names: &[&str] = match args.well {
+            WellChoice::Short => &["100m"],
+            WellChoice::Long => &["1000m"],
+            WellChoice::Both => &["100m", "1000m"],
+        };
+        names
+            .iter()
+            .map(|n| Well::builtin(n, overrides))
+            .collect::<Result<_>>()
+    } else {
+        args.plans
+            .iter()
+            .map(|p| Well::load(p, overrides))
+            .collect::<Result<_>>()
+    }
+}
+
+/// `--json`, `--csv`, `--stations-csv` and `--plots` (each file said as
+/// written).
+fn write_outputs(args: &LateralArgs, result: &LateralStudy) -> Result<()> {
+    if let Some(path) = &args.json {
+        write_json(path, result)?;
+    }
+    if let Some(path) = &args.csv {
+        write_text(path, &csv(result))?;
+    }
+    if let Some(path) = &args.stations_csv {
+        let tables = result
+            .summaries
+            .iter()
+            .map(|s| (s.grade.as_str(), s.well.as_str(), s.station_rows.as_slice()));
+        write_text(path, &stations_csv(tables))?;
+    }
+    if let Some(dir) = &args.plots {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for path in plots(result, dir)? {
+            outln!("wrote {}", path.display());
+        }
     }
     Ok(())
 }

@@ -12,7 +12,10 @@
 //! - [`state`]: what the page shows, in bounded buffers, and its updates.
 //! - [`view`], [`stations`]: frames and stations as people read them.
 //! - [`server`]: the page (uPlot embedded) and server-sent events.
+//! - [`launch`]: a dashboard started from its source, with the calibration
+//!   in use as the page shows it.
 
+pub mod launch;
 pub mod ring;
 pub mod server;
 pub mod source;

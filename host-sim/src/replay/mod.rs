@@ -52,8 +52,10 @@
 //! - [`live`]: the probe's stream replayed as it arrives.
 
 pub mod commands;
+pub mod file_replay;
 pub mod live;
 mod replayer;
+pub mod report;
 mod rows;
 mod rows_csv;
 mod step_loss;

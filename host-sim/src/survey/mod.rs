@@ -11,11 +11,18 @@
 //!   NEV covariance and ellipses, a drilling capture's stations paired with
 //!   depth, the listing, its figures, anti-collision.
 //! - [`job`]: the job file (site, tie-in, calibration, tool model).
+//! - [`well_survey`]: a station file's survey as `host-sim survey` makes
+//!   it (positions, the model's covariance, an offset well's separation).
+//! - [`outputs`]: that survey's listing, CSV, JSON, WITSML and figures.
+//! - [`capture`]: the survey of a drilling capture with its depth log.
 //! - [`stations`]: the probe's downlink to the survey's stations (each
 //!   station's start sigma, stations sent again), positioned from the tie-on:
 //!   the one collector the capture survey, the dashboard and the studies use.
 
+pub mod capture;
 pub mod iscwsa;
 pub mod job;
 pub mod listing;
+pub mod outputs;
 pub mod stations;
+pub mod well_survey;

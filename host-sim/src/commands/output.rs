@@ -1,0 +1,45 @@
+//! Standard output for the commands: `outln!` and `out!`, `println!` and
+//! `print!` that a closed pipe (`| head -1`) does not turn into a panic.
+//! A leaf of `commands/`: every command prints through it, it uses none
+//! of them.
+
+/// `println!` for command output that a closed pipe (`| head -1`) does not
+/// turn into a panic: see [`print_out`].
+macro_rules! outln {
+    () => { $crate::commands::output::print_line(format_args!("")) };
+    ($($arg:tt)*) => { $crate::commands::output::print_line(format_args!($($arg)*)) };
+}
+
+/// `print!` through [`print_out`], as [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => { $crate::commands::output::print_text(format_args!($($arg)*)) };
+}
+
+/// Prints to stdout; a closed pipe (`| head`) ends the output quietly: the
+/// command goes on (files it writes are still written, its exit status
+/// still tells), only what nobody reads is dropped.
+pub fn print_out(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
+}
+
+/// What [`outln!`] calls: one line through [`print_out`]. Another write
+/// error than a closed pipe (a full disk behind a redirection) is said on
+/// stderr rather than panicking as `println!` would.
+pub fn print_line(args: std::fmt::Arguments<'_>) {
+    print_text(format_args!("{args}\n"));
+}
+
+/// What [`out!`] calls.
+pub fn print_text(args: std::fmt::Arguments<'_>) {
+    if let Err(e) = print_out(&args.to_string()) {
+        eprintln!("error: writing to standard output: {e:#}");
+    }
+}

@@ -1,0 +1,49 @@
+//! The studies' runs on the command line: worker threads, a progress bar,
+//! and Ctrl-C (or SIGTERM): the first one lets the runs under way finish
+//! and the study write what it has, a second one quits at once. A leaf of
+//! `commands/`, used by the study commands.
+
+use anyhow::Context;
+
+/// Worker threads: `--threads`, else all cores.
+pub fn threads(given: Option<u64>) -> usize {
+    given.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    )
+}
+
+/// A progress bar over `len` runs drawn with `template`.
+pub fn progress_bar(len: u64, template: &str) -> anyhow::Result<indicatif::ProgressBar> {
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(indicatif::ProgressStyle::with_template(template).context("progress bar")?);
+    Ok(bar)
+}
+
+/// A flag the first Ctrl-C (or SIGTERM) sets: a study then finishes the
+/// runs under way and writes what it has. A second one quits at once. The
+/// note goes above `bar` when it is drawn (one bar for the whole study),
+/// else to standard error.
+pub fn stop_on_ctrl_c(
+    bar: Option<&indicatif::ProgressBar>,
+) -> anyhow::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let bar = bar.filter(|b| !b.is_hidden()).cloned();
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        let note = "interrupted: finishing the runs under way, then writing the results so \
+                    far (Ctrl-C again to quit at once, writing nothing)";
+        // A bar that is not drawn (no terminal) prints nothing either.
+        match &bar {
+            Some(bar) => bar.println(note),
+            None => eprintln!("{note}"),
+        }
+    })
+    .context("installing the SIGINT/SIGTERM handler")?;
+    Ok(stop)
+}

@@ -1,0 +1,306 @@
+//! The outputs of a station file's survey ([`WellSurvey`]): the listing
+//! on the terminal, one CSV row per station, the survey as JSON, a WITSML
+//! 1.4.1.1 trajectory, and the plan and section figures. Lengths in
+//! metres, azimuths along true north, whatever the input.
+
+use crate::survey::listing::ellipse::scale_2d;
+use crate::survey::listing::plot;
+use crate::survey::listing::separation as sep;
+use crate::survey::well_survey::{sf_status, WellSurvey};
+use anyhow::Result;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Where the outputs go (each one only when given).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OutputPaths<'a> {
+    pub csv: Option<&'a Path>,
+    pub json: Option<&'a Path>,
+    pub witsml: Option<&'a Path>,
+    /// Directory of the figures (prepared beforehand:
+    /// [`crate::formats::figure::prepare_dir`]).
+    pub plot: Option<&'a Path>,
+}
+
+/// Writes the outputs asked for, in the order CSV, JSON, WITSML, figures;
+/// `well` names the well in the figures. Returns the figures' files.
+pub fn write_outputs(s: &WellSurvey, paths: &OutputPaths, well: &str) -> Result<Vec<PathBuf>> {
+    use crate::formats::files::write_text;
+    if let Some(p) = paths.csv {
+        write_text(p, &csv_text(s))?;
+    }
+    if let Some(p) = paths.json {
+        write_text(p, &json_text(s)?)?;
+    }
+    if let Some(p) = paths.witsml {
+        write_text(p, &witsml_text(s))?;
+    }
+    let Some(dir) = paths.plot else {
+        return Ok(Vec::new());
+    };
+    let figures = plot::SurveyPlot {
+        rows: &s.rows,
+        unit: s.unit,
+        vsec_azimuth: s.vsec_azimuth_deg.to_radians(),
+        well,
+        model: s.model.map(|m| m.name),
+        offset: s
+            .offset
+            .as_ref()
+            .map(|o| (o.short_name.as_str(), o.rows.as_slice())),
+    };
+    figures.write(dir)
+}
+
+/// The listing: a header line, the model's and the ellipse's, a table of
+/// the stations (with their sigmas and ellipse with a model, their
+/// separation with an offset well), the model's validity note and the
+/// separation summary.
+pub fn listing_text(s: &WellSurvey) -> String {
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "{} stations; N/E along true north, m; vertical section along {:.2} deg",
+        s.rows.len(),
+        s.vsec_azimuth_deg
+    );
+    if let Some(m) = s.model {
+        let _ = writeln!(
+            text,
+            "error model {}; ellipse at {:.1} % (2-D normal, k = {:.4} x 1-sigma)",
+            m.name,
+            100.0 * s.confidence,
+            scale_2d(s.confidence)
+        );
+    }
+    let mut head = format!(
+        "{:>9} {:>7} {:>7} {:>9} {:>9} {:>9} {:>6} {:>9}",
+        "MD m", "inc", "azi", "TVD m", "N m", "E m", "DLS", "VS m"
+    );
+    if s.model.is_some() {
+        head += &format!(
+            " {:>7} {:>7} {:>7} {:>8} {:>8} {:>6}",
+            "sN m", "sE m", "sV m", "major m", "minor m", "az"
+        );
+    }
+    if s.offset.is_some() {
+        head += &format!(" {:>9} {:>7} {:>8}", "ctc m", "sS m", "SF");
+    }
+    let _ = writeln!(text, "{head}");
+    for (k, r) in s.rows.iter().enumerate() {
+        let mut line = format!(
+            "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
+            r.md_m, r.inc_deg, r.azi_deg, r.tvd_m, r.north_m, r.east_m, r.dls_deg_per_30m, r.vsec_m
+        );
+        if s.model.is_some() {
+            match (r.cov, r.ellipse()) {
+                (Some(c), Some(e)) => {
+                    let (a, b) = e.scaled(s.confidence);
+                    let _ = write!(
+                        line,
+                        " {:>7.2} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>6.1}",
+                        c[0].max(0.0).sqrt(),
+                        c[1].max(0.0).sqrt(),
+                        e.sigma_vert,
+                        a,
+                        b,
+                        e.azimuth_deg
+                    );
+                }
+                _ => line += "  (outside the model's validity)",
+            }
+        }
+        if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
+            let _ = write!(line, " {:>9.2}", x.ctc_m);
+            match (x.sigma_s_m, x.sf) {
+                (Some(sig), Some(f)) => {
+                    let flag = if f < 1.0 { " SF<1" } else { "" };
+                    let _ = write!(line, " {sig:>7.2} {f:>8.3}{flag}");
+                }
+                _ => line += "  SF undetermined",
+            }
+        }
+        let _ = writeln!(text, "{line}");
+    }
+    if let Some(note) = s.validity_note() {
+        let _ = writeln!(text, "note: {note}");
+    }
+    for l in s.separation_summary() {
+        let _ = writeln!(text, "{l}");
+    }
+    text
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |v| v.to_string())
+}
+
+pub fn csv_text(s: &WellSurvey) -> String {
+    let mut out = String::from(
+        "md_m,inc_deg,azi_deg,tvd_m,north_m,east_m,dls_deg_per_30m,vsec_m,toolface_deg,time_s",
+    );
+    if s.model.is_some() {
+        out += ",sigma_north_m,sigma_east_m,sigma_vert_m,ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg,confidence,error_model_valid";
+    }
+    if s.offset.is_some() {
+        out += ",offset_md_m,ctc_m,sigma_s_m,sf,sf_status";
+    }
+    out += "\n";
+    for (k, r) in s.rows.iter().enumerate() {
+        let _ = write!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{}",
+            r.md_m,
+            r.inc_deg,
+            r.azi_deg,
+            r.tvd_m,
+            r.north_m,
+            r.east_m,
+            r.dls_deg_per_30m,
+            r.vsec_m,
+            opt(r.input.toolface_deg),
+            opt(r.input.time_s)
+        );
+        if s.model.is_some() {
+            match (r.cov, r.ellipse()) {
+                (Some(c), Some(e)) => {
+                    let (a, b) = e.scaled(s.confidence);
+                    let _ = write!(
+                        out,
+                        ",{},{},{},{a},{b},{},{},true",
+                        c[0].max(0.0).sqrt(),
+                        c[1].max(0.0).sqrt(),
+                        e.sigma_vert,
+                        e.azimuth_deg,
+                        s.confidence
+                    );
+                }
+                _ => {
+                    let _ = write!(out, ",,,,,,,{},false", s.confidence);
+                }
+            }
+        }
+        if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
+            let _ = write!(
+                out,
+                ",{},{},{},{},{}",
+                x.closest.md_m,
+                x.ctc_m,
+                opt(x.sigma_s_m),
+                opt(x.sf),
+                sf_status(x)
+            );
+        }
+        out += "\n";
+    }
+    out
+}
+
+pub fn json_text(s: &WellSurvey) -> Result<String> {
+    let stations: Vec<serde_json::Value> = s
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let mut v = serde_json::json!({
+                "md_m": r.md_m, "inc_deg": r.inc_deg, "azi_deg": r.azi_deg,
+                "tvd_m": r.tvd_m, "north_m": r.north_m, "east_m": r.east_m,
+                "dls_deg_per_30m": r.dls_deg_per_30m, "vsec_m": r.vsec_m,
+                "toolface_deg": r.input.toolface_deg, "time_s": r.input.time_s,
+            });
+            if s.model.is_some() {
+                let e = r.ellipse();
+                let scaled = e.map(|e| e.scaled(s.confidence));
+                v["nev_covariance_m2"] = serde_json::json!(r.cov);
+                v["sigma_north_m"] = serde_json::json!(r.cov.map(|c| c[0].max(0.0).sqrt()));
+                v["sigma_east_m"] = serde_json::json!(r.cov.map(|c| c[1].max(0.0).sqrt()));
+                v["sigma_vert_m"] = serde_json::json!(e.map(|e| e.sigma_vert));
+                v["ellipse_semi_major_m"] = serde_json::json!(scaled.map(|x| x.0));
+                v["ellipse_semi_minor_m"] = serde_json::json!(scaled.map(|x| x.1));
+                v["ellipse_azimuth_deg"] = serde_json::json!(e.map(|e| e.azimuth_deg));
+                v["error_model_valid"] = serde_json::json!(r.cov.is_some());
+            }
+            if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
+                let c = &x.closest;
+                v["offset_md_m"] = serde_json::json!(c.md_m);
+                v["offset_nev_m"] = serde_json::json!([c.nev.x, c.nev.y, c.nev.z]);
+                v["offset_nev_covariance_m2"] = serde_json::json!(c.cov);
+                v["ctc_m"] = serde_json::json!(x.ctc_m);
+                v["sigma_s_m"] = serde_json::json!(x.sigma_s_m);
+                v["sf"] = serde_json::json!(x.sf);
+                v["sf_status"] = serde_json::json!(sf_status(x));
+            }
+            v
+        })
+        .collect();
+    let doc = serde_json::json!({
+        "north_reference": "true",
+        "length_unit": "m",
+        "vsec_azimuth_deg": s.vsec_azimuth_deg,
+        "error_model": s.model.map(|m| m.name),
+        "confidence": s.model.map(|_| s.confidence),
+        "ellipse_convention": s.model.map(|_| "semi-axes: 1-sigma of the NE covariance times sqrt(-2 ln(1 - confidence)); azimuth of the major axis in [0, 180) deg; covariance [nn, ee, vv, ne, nv, ev] m^2"),
+        "note": s.validity_note(),
+        "stations": stations,
+    });
+    let mut doc = doc;
+    if let Some(o) = &s.offset {
+        let min = sep::minimum(&o.seps);
+        doc["separation"] = serde_json::json!({
+            "offset": o.name,
+            "offset_error_model": o.model.map(|m| m.name),
+            "rule": "ISCWSA separation rule, Sawaryn et al. 2019 (SPE-187073-PA): SF = (D - R_ref - R_off - S_m) / (k sqrt(sigma_S^2 + sigma_pa^2)); offset covariance interpolated linearly in MD at the closest point",
+            "k": o.rule.k,
+            "surface_margin_m": o.rule.surface_margin_m,
+            "sigma_pa_m": o.rule.sigma_pa_m,
+            "hole_radius_m": o.rule.ref_radius_m,
+            "offset_hole_radius_m": o.rule.offset_radius_m,
+            "min_sf": min.map(|m| m.1),
+            "min_sf_md_m": min.map(|m| s.rows[m.0].md_m),
+            "violation": o.seps.iter().any(|x| x.sf.is_some_and(|f| f < 1.0)),
+            "summary": s.separation_summary(),
+        });
+    }
+    Ok(serde_json::to_string_pretty(&doc)? + "\n")
+}
+
+pub fn witsml_text(s: &WellSurvey) -> String {
+    let mut x = String::from(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n\
+         <trajectorys xmlns=\"http://www.witsml.org/schemas/1series\" version=\"1.4.1.1\">\n\
+         \x20 <trajectory uidWell=\"well\" uidWellbore=\"wellbore\" uid=\"survey\">\n\
+         \x20   <nameWell>well</nameWell>\n\
+         \x20   <nameWellbore>wellbore</nameWellbore>\n\
+         \x20   <name>host-sim survey</name>\n",
+    );
+    if let (Some(first), Some(last)) = (s.rows.first(), s.rows.last()) {
+        let _ = writeln!(x, "    <mdMn uom=\"m\">{}</mdMn>", first.md_m);
+        let _ = writeln!(x, "    <mdMx uom=\"m\">{}</mdMx>", last.md_m);
+    }
+    let _ = writeln!(
+        x,
+        "    <aziVertSect uom=\"dega\">{}</aziVertSect>",
+        s.vsec_azimuth_deg
+    );
+    x += "    <aziRef>true north</aziRef>\n";
+    for (k, r) in s.rows.iter().enumerate() {
+        let kind = if k == 0 { "tie in point" } else { "unknown" };
+        let _ = write!(
+            x,
+            "    <trajectoryStation uid=\"st{k}\">\n\
+             \x20     <typeTrajStation>{kind}</typeTrajStation>\n\
+             \x20     <md uom=\"m\">{}</md>\n\
+             \x20     <tvd uom=\"m\">{}</tvd>\n\
+             \x20     <incl uom=\"dega\">{}</incl>\n\
+             \x20     <azi uom=\"dega\">{}</azi>\n\
+             \x20     <dispNs uom=\"m\">{}</dispNs>\n\
+             \x20     <dispEw uom=\"m\">{}</dispEw>\n\
+             \x20     <vertSect uom=\"m\">{}</vertSect>\n\
+             \x20     <dls uom=\"dega/30m\">{}</dls>\n\
+             \x20   </trajectoryStation>\n",
+            r.md_m, r.tvd_m, r.inc_deg, r.azi_deg, r.north_m, r.east_m, r.vsec_m, r.dls_deg_per_30m
+        );
+    }
+    x += "  </trajectory>\n</trajectorys>\n";
+    x
+}

@@ -1,0 +1,225 @@
+//! A station file's survey as `host-sim survey` makes it: the stations
+//! positioned by minimum curvature ([`listing::compute`]), given their
+//! NEV covariance by an error model ([`listing::apply_model`]), and, with
+//! an offset well, each station's separation from it (the ISCWSA
+//! separation rule, Sawaryn et al. 2019, SPE-187073-PA). What the outputs
+//! ([`crate::survey::outputs`]) need besides the rows is kept here too.
+//!
+//! The site an error model runs at comes from the caller, once the model
+//! is known: a magnetic model needs the field, which the command line
+//! gives (and refuses to go without).
+
+use crate::survey::iscwsa::Site;
+use crate::survey::listing::separation as sep;
+use crate::survey::listing::{
+    self as listing, AzimuthReference, Invalid, KnownModel, LengthUnit, Row, StationFile,
+    TieOnInput,
+};
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// The site a model runs at, given the model (see the module's doc).
+pub type SiteFor<'a> = &'a dyn Fn(&KnownModel) -> Result<Site>;
+
+/// Reads a station file (CSV), its path in the errors.
+pub fn read_station_file(path: &Path) -> Result<StationFile> {
+    let input = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    listing::read_stations(input).with_context(|| format!("{}", path.display()))
+}
+
+/// Which error model gives the stations their covariance.
+#[derive(Clone, Copy, Debug)]
+pub enum ModelChoice<'a> {
+    /// None: positions only.
+    None,
+    /// A model the tool knows, by name ([`listing::model`]).
+    Named(&'a str),
+    /// A term table read from a file ([`listing::model_from_file`]).
+    File(&'a Path),
+}
+
+/// How the reference well's stations are positioned.
+#[derive(Clone, Copy, Debug)]
+pub struct SurveyInputs<'a> {
+    /// North reference of the file's azimuths.
+    pub reference: AzimuthReference,
+    /// The tie-on, in the file's unit.
+    pub tie: TieOnInput,
+    /// Vertical-section azimuth, rad (`None`: closure of the last station).
+    pub vsec_azimuth: Option<f64>,
+    pub model: ModelChoice<'a>,
+    /// Probability held by the scaled horizontal ellipse (2-D normal).
+    pub confidence: f64,
+}
+
+/// The offset well's inputs besides the separation rule's radii and
+/// margins.
+#[derive(Clone, Copy, Debug)]
+pub struct OffsetInputs<'a> {
+    /// The offset well's station file (same format and length unit).
+    pub path: &'a Path,
+    /// North reference of its azimuths (the reference well's).
+    pub reference: AzimuthReference,
+    /// Its tie-on, in the file's unit.
+    pub tie: TieOnInput,
+    /// Its error model by name; `None`: the reference well's.
+    pub model_name: Option<&'a str>,
+    pub rule: sep::Rule,
+}
+
+/// The offset well's separation from the reference stations.
+pub struct Offset {
+    pub name: String,
+    pub model: Option<&'static KnownModel>,
+    pub rule: sep::Rule,
+    pub seps: Vec<sep::Separation>,
+    /// The offset's file name (figures' legend) and its rows.
+    pub short_name: String,
+    pub rows: Vec<Row>,
+}
+
+/// A survey: its rows and what the outputs need besides them.
+pub struct WellSurvey {
+    pub rows: Vec<Row>,
+    pub vsec_azimuth_deg: f64,
+    pub model: Option<&'static KnownModel>,
+    /// First station the model is not valid at.
+    pub invalid_from: Option<Invalid>,
+    pub confidence: f64,
+    /// Length unit of the station file (the figures use it).
+    pub unit: LengthUnit,
+    pub offset: Option<Offset>,
+}
+
+impl WellSurvey {
+    /// The stations of `file` positioned and, with a model, given their
+    /// covariance at the site `site_for` gives for it.
+    pub fn compute(file: &StationFile, inputs: &SurveyInputs, site_for: SiteFor) -> Result<Self> {
+        let (mut rows, direction) =
+            listing::compute(file, inputs.reference, inputs.tie, inputs.vsec_azimuth)?;
+        let model = match inputs.model {
+            ModelChoice::File(path) => Some(listing::model_from_file(path)?),
+            ModelChoice::Named(name) => Some(listing::model(name)?),
+            ModelChoice::None => None,
+        };
+        let mut invalid_from = None;
+        if let Some(m) = model {
+            let terms = listing::terms(m)?;
+            let site = site_for(m)?;
+            invalid_from = listing::apply_model(&mut rows, m, &terms, &site)?;
+        }
+        Ok(Self {
+            rows,
+            vsec_azimuth_deg: direction.to_degrees(),
+            model,
+            invalid_from,
+            confidence: inputs.confidence,
+            unit: file.unit,
+            offset: None,
+        })
+    }
+
+    /// The offset well positioned and given its covariance, and its
+    /// separation from every station of this survey.
+    pub fn add_offset(&mut self, inputs: &OffsetInputs, site_for: SiteFor) -> Result<()> {
+        let path = inputs.path;
+        let file = read_station_file(path).context("the offset well")?;
+        if file.unit != self.unit {
+            bail!(
+                "{}: the offset well's length unit differs from the reference well's (give both in m or both in ft)",
+                path.display()
+            );
+        }
+        let (mut rows, _) = listing::compute(&file, inputs.reference, inputs.tie, None)
+            .with_context(|| format!("offset well {}", path.display()))?;
+        // default: the reference well's model (named or from a file)
+        let model = match inputs.model_name {
+            Some(name) => Some(listing::model(name)?),
+            None => self.model,
+        };
+        if let Some(m) = model {
+            let terms = listing::terms(m)?;
+            listing::apply_model(&mut rows, m, &terms, &site_for(m)?)
+                .with_context(|| format!("offset well {}", path.display()))?;
+        }
+        let seps = sep::separations(&self.rows, &rows, &inputs.rule)?;
+        self.offset = Some(Offset {
+            name: path.display().to_string(),
+            model,
+            rule: inputs.rule,
+            seps,
+            short_name: path
+                .file_name()
+                .map_or_else(|| "offset".into(), |n| n.to_string_lossy().into_owned()),
+            rows,
+        });
+        Ok(())
+    }
+
+    /// Where the model stops being valid, as a sentence.
+    pub fn validity_note(&self) -> Option<String> {
+        let (m, inv) = (self.model?, self.invalid_from.as_ref()?);
+        Some(format!(
+            "{} {}: no uncertainty from MD {:.2} m (station {}) on, not extrapolated",
+            m.name, inv.reason, self.rows[inv.station].md_m, inv.station
+        ))
+    }
+
+    /// The minimum SF and the violations, as lines of text.
+    pub fn separation_summary(&self) -> Vec<String> {
+        let Some(o) = &self.offset else {
+            return Vec::new();
+        };
+        let mut out = vec![format!(
+            "offset {}: model {}; ISCWSA separation rule (Sawaryn et al. 2019, SPE-187073-PA): k {}, S_m {} m, sigma_pa {} m, hole radii {} m / {} m",
+            o.name,
+            o.model.map_or("none", |m| m.name),
+            o.rule.k,
+            o.rule.surface_margin_m,
+            o.rule.sigma_pa_m,
+            o.rule.ref_radius_m,
+            o.rule.offset_radius_m
+        )];
+        match sep::minimum(&o.seps) {
+            Some((i, f)) => out.push(format!(
+                "minimum SF {:.3} at MD {:.2} m (offset MD {:.2} m, centre to centre {:.2} m +- {:.2} m 1-sigma)",
+                f,
+                self.rows[i].md_m,
+                o.seps[i].closest.md_m,
+                o.seps[i].ctc_m,
+                o.seps[i].sigma_s_m.unwrap_or(f64::NAN)
+            )),
+            None => {
+                out.push("minimum SF undetermined: no station has both wells' covariance".into())
+            }
+        }
+        let bad: Vec<usize> = (0..o.seps.len())
+            .filter(|&i| sf_status(&o.seps[i]) == "violation")
+            .collect();
+        if let (Some(&a), Some(&b)) = (bad.first(), bad.last()) {
+            out.push(format!(
+                "VIOLATION of the separation rule (SF < 1) at {} stations, MD {:.2} to {:.2} m",
+                bad.len(),
+                self.rows[a].md_m,
+                self.rows[b].md_m
+            ));
+        }
+        let undetermined = o.seps.iter().filter(|x| x.sf.is_none()).count();
+        if undetermined > 0 {
+            out.push(format!(
+                "SF undetermined at {undetermined} stations (a covariance missing: no model, or beyond its validity)"
+            ));
+        }
+        out
+    }
+}
+
+/// A station's separation as one word: ok, violation (SF < 1) or
+/// undetermined (no SF).
+pub fn sf_status(x: &sep::Separation) -> &'static str {
+    match x.sf {
+        None => "undetermined",
+        Some(f) if f < 1.0 => "violation",
+        Some(_) => "ok",
+    }
+}
