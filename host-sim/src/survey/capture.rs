@@ -11,15 +11,15 @@ use crate::formats::depth_log::DepthLog;
 use crate::formats::files::read_depth_log;
 use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
-use crate::survey::listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, TrajectoryPoint};
+use crate::survey::listing::drilling::{self, DrillingSurvey, TrajectoryPoint};
 use crate::survey::listing::{drilling_text, TieOnInput};
+use crate::survey::stations::{StationCollector, SurveySetup};
 use anyhow::{Context, Result};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::earth::Position;
 use mwd_core::probe::{StationLink, TieIn};
 use mwd_core::protocol::uplink::StillSettings;
-use mwd_core::protocol::{DecoderStats, Frame, Payload, StationSurvey};
-use std::collections::HashMap;
+use mwd_core::protocol::{DecoderStats, Frame, Payload};
 use std::path::{Path, PathBuf};
 
 /// What a capture's replay needs of the probe's configuration: the site,
@@ -66,34 +66,20 @@ impl CaptureSurvey {
     pub fn run(inputs: &CaptureSurveyInputs) -> Result<Self> {
         let read = read_stations(&inputs.capture, &inputs.probe)?;
         let depth = read_depth_log(&inputs.depth)?;
-        let site = Site {
-            gravity: 9.806_65,
-            b_total: 0.0,
-            dip: 0.0,
-            declination: 0.0,
-            vertical_limit: 0.0001_f64.to_radians(),
-            latitude: inputs.latitude,
-            gyro_noise_reduction: 1.0,
-        };
-        let terms = drilling::survey_terms()?;
+        let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?;
         let links = read.links;
-        let survey = drilling::survey(
-            &read.stations,
-            &read.azimuth_sigma_before,
-            links.as_deref().unwrap_or(&[]),
-            &depth,
-            inputs.tie,
-            &terms,
-            &site,
-        )
-        .with_context(|| format!("{}", inputs.capture.display()))?;
+        let survey = read
+            .collected
+            .survey(links.as_deref().unwrap_or(&[]), &setup, &depth)
+            .with_context(|| format!("{}", inputs.capture.display()))?;
+        let SurveySetup { tie, terms, site } = setup;
         Ok(Self {
             survey,
             stats: read.stats,
             links_missing: links.err(),
             capture: inputs.capture.clone(),
             depth,
-            tie: inputs.tie,
+            tie,
             terms,
             site,
         })
@@ -174,10 +160,9 @@ pub fn trajectory_csv(points: &[TrajectoryPoint], confidence: f64) -> String {
 /// What the survey takes from a capture, read in one pass as a stream (a
 /// day and a half of drilling is 5 M frames: none of them is kept).
 struct CaptureStations {
-    /// The probe's station surveys, in order.
-    stations: Vec<StationSurvey>,
-    /// Each one's azimuth sigma just before its still period began.
-    azimuth_sigma_before: Vec<Option<f64>>,
+    /// The probe's station surveys in order, each with the azimuth sigma
+    /// just before its still period began.
+    collected: StationCollector,
     /// The stations' links from the capture's replay
     /// (`replay::replayed_station_links`), or why there are none.
     links: Result<Vec<Option<StationLink>>, String>,
@@ -188,25 +173,11 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
     let mut capture = ProbeCaptureFile::open(path)?;
     let mut replayer = Replayer::with_settings(probe.site, probe.calibration, probe.still)
         .with_tie_in(probe.tie_in);
-    let mut track = AzimuthSigmaTrack::default();
-    let mut stations = Vec::new();
-    let mut azimuth_sigma_before = Vec::new();
-    // A station frame sent again (on request) starts where the first did.
-    let mut starts: HashMap<(u16, u32), Option<f64>> = HashMap::new();
+    let mut collected = StationCollector::default();
     let mut items = 0usize;
     while let Some(item) = capture.next_item()? {
         if let Item::Frame(frame) = &item {
-            match &frame.payload {
-                Payload::Nav(n) => track.push(n),
-                Payload::Station(st) => {
-                    let sigma = *starts
-                        .entry((st.station, st.start_sample))
-                        .or_insert_with(|| track.station_start(st));
-                    stations.push(*st);
-                    azimuth_sigma_before.push(sigma);
-                }
-                _ => {}
-            }
+            collected.push_frame(frame);
         }
         replayer.push_received(item.received());
         items += 1;
@@ -215,10 +186,9 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
             replayer.write_settled(None, false)?;
         }
     }
-    let links = replayed_station_links(&mut replayer, &stations);
+    let links = replayed_station_links(&mut replayer, collected.stations());
     Ok(CaptureStations {
-        stations,
-        azimuth_sigma_before,
+        collected,
         links,
         stats: *capture.stats(),
     })
