@@ -85,7 +85,7 @@ fn empty_file_and_header_only() {
 fn missing_column() {
     refused_file("col", "md_m,inc_deg\n0,0\n30,1\n", &[], "no column azi_deg");
     refused_file(
-        "md",
+        "no-md",
         "inc_deg,azi_deg\n0,0\n",
         &[],
         "no column md_m or md_ft",
