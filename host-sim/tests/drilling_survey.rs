@@ -5,7 +5,7 @@
 //! coverage study's harness.
 mod common;
 
-use common::{run, s, scratch};
+use common::{plan, run, s, scratch, simulate_tied_in};
 use host_sim::formats::depth_log::DepthLog;
 use host_sim::survey::iscwsa::Site;
 use host_sim::survey::listing::drilling::{survey, survey_terms};
@@ -13,7 +13,6 @@ use host_sim::survey::listing::drilling_text::listing;
 use host_sim::survey::listing::TieOnInput;
 use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::StationSurvey;
-use std::path::{Path, PathBuf};
 
 fn site() -> Site {
     Site {
@@ -171,12 +170,6 @@ fn a_station_outside_the_log_or_a_log_that_is_not_one_is_refused() {
     ] {
         assert!(DepthLog::read(bad.as_bytes()).is_err(), "{bad:?}");
     }
-}
-
-fn plan(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("data/plans")
-        .join(name)
 }
 
 /// CSV text as rows of named cells.
@@ -346,36 +339,7 @@ fn a_simulated_short_lateral_is_surveyed_against_its_truth() {
 #[test]
 fn a_tied_in_capture_is_surveyed_with_the_links_of_its_replay() {
     let dir = scratch("drilling-survey", "tied-in");
-    let (bin, depth, job) = (
-        dir.join("run.bin"),
-        dir.join("depth.csv"),
-        dir.join("job.json"),
-    );
-    std::fs::write(
-        &job,
-        r#"{ "format": "mwd-job", "version": 1,
-  "site": { "latitude_deg": 45.77755, "longitude_deg": 126.687898, "height_m": 124.0 },
-  "tie_in": { "inclination_deg": 90.0, "azimuth_deg": 120.0, "toolface_deg": 0.0,
-              "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 0.5, "toolface_sigma_deg": 0.3 },
-  "survey": { "tie_on": { "md": 3000.0, "tvd": 2450.0, "north": 420.0, "east": 310.0 } } }"#,
-    )
-    .unwrap();
-    let sim = run(&[
-        "simulate",
-        "--motion",
-        "lateral",
-        "--plan",
-        s(&plan("qemu-short.json")),
-        "--seed",
-        "3",
-        "-o",
-        s(&bin),
-        "--depth-log",
-        s(&depth),
-        "--tie-in-job",
-        s(&job),
-    ]);
-    assert_eq!(sim.code, Some(0), "{}", sim.stderr);
+    let (bin, depth, job) = simulate_tied_in(&dir);
     let replay = run(&["replay", s(&bin), "--job", s(&job)]);
     assert_eq!(replay.code, Some(0), "{}{}", replay.stdout, replay.stderr);
     assert!(replay.stdout.contains(" 0 different"), "{}", replay.stdout);

@@ -9,21 +9,14 @@
 mod common;
 
 use std::collections::HashMap;
-use std::path::PathBuf;
 
-use common::{run, s, scratch};
+use common::{run, s, scratch, simulate_tied_in};
 use host_sim::dashboard::state::{DashboardState, SourceInfo, LIMITS};
 use host_sim::formats::capture::read_capture;
 use host_sim::formats::depth_log::DepthLog;
 use host_sim::survey::job::Job;
 use host_sim::survey::stations::{job_tie_on, SurveySetup};
 use serde_json::Value;
-
-fn plan(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("data/plans")
-        .join(name)
-}
 
 /// The rows of a CSV, by column name.
 fn table(text: &str) -> Vec<HashMap<String, String>> {
@@ -65,36 +58,7 @@ fn without_sigmas(text: &str) -> String {
 #[test]
 fn the_capture_survey_and_the_dashboard_place_the_same_stations_from_the_job_tie_on() {
     let dir = scratch("station-collector", "tied-in");
-    let (bin, depth, job) = (
-        dir.join("run.bin"),
-        dir.join("depth.csv"),
-        dir.join("job.json"),
-    );
-    std::fs::write(
-        &job,
-        r#"{ "format": "mwd-job", "version": 1,
-  "site": { "latitude_deg": 45.77755, "longitude_deg": 126.687898, "height_m": 124.0 },
-  "tie_in": { "inclination_deg": 90.0, "azimuth_deg": 120.0, "toolface_deg": 0.0,
-              "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 0.5, "toolface_sigma_deg": 0.3 },
-  "survey": { "tie_on": { "md": 3000.0, "tvd": 2450.0, "north": 420.0, "east": 310.0 } } }"#,
-    )
-    .unwrap();
-    let sim = run(&[
-        "simulate",
-        "--motion",
-        "lateral",
-        "--plan",
-        s(&plan("qemu-short.json")),
-        "--seed",
-        "3",
-        "-o",
-        s(&bin),
-        "--depth-log",
-        s(&depth),
-        "--tie-in-job",
-        s(&job),
-    ]);
-    assert_eq!(sim.code, Some(0), "{}", sim.stderr);
+    let (bin, depth, job) = simulate_tied_in(&dir);
 
     // The capture survey: with the job (the replay's links), and with the
     // same tie-on given by flags (no tie-in, so no links).

@@ -53,3 +53,47 @@ pub fn refused(run: &Run, needle: &str) {
     );
     assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
 }
+
+/// The job of the tied-in lateral: the parent well's survey at the window
+/// (the probe's tie-in attitude) and the survey's tie-on there.
+pub const TIED_IN_JOB: &str = r#"{ "format": "mwd-job", "version": 1,
+  "site": { "latitude_deg": 45.77755, "longitude_deg": 126.687898, "height_m": 124.0 },
+  "tie_in": { "inclination_deg": 90.0, "azimuth_deg": 120.0, "toolface_deg": 0.0,
+              "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 0.5, "toolface_sigma_deg": 0.3 },
+  "survey": { "tie_on": { "md": 3000.0, "tvd": 2450.0, "north": 420.0, "east": 310.0 } } }"#;
+
+/// A built-in plan of the simulator (`host-sim/data/plans/`).
+pub fn plan(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/plans")
+        .join(name)
+}
+
+/// The short lateral (`qemu-short.json`, seed 3) simulated by a probe
+/// configured with [`TIED_IN_JOB`], in `dir`: the capture, its depth log
+/// and the job file.
+pub fn simulate_tied_in(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
+    let (bin, depth, job) = (
+        dir.join("run.bin"),
+        dir.join("depth.csv"),
+        dir.join("job.json"),
+    );
+    std::fs::write(&job, TIED_IN_JOB).unwrap();
+    let sim = run(&[
+        "simulate",
+        "--motion",
+        "lateral",
+        "--plan",
+        s(&plan("qemu-short.json")),
+        "--seed",
+        "3",
+        "-o",
+        s(&bin),
+        "--depth-log",
+        s(&depth),
+        "--tie-in-job",
+        s(&job),
+    ]);
+    assert_eq!(sim.code, Some(0), "{}", sim.stderr);
+    (bin, depth, job)
+}
