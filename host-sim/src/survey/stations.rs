@@ -75,11 +75,6 @@ impl StationCollector {
         &self.stations
     }
 
-    /// Each station's start, in the same order.
-    pub fn starts(&self) -> &[Option<StationStart>] {
-        &self.starts
-    }
-
     /// Each station's azimuth sigma at its start (rad), in the same order.
     pub fn azimuth_sigma_before(&self) -> Vec<Option<f64>> {
         self.starts.iter().map(|s| s.map(|s| s.sigma)).collect()
@@ -201,7 +196,7 @@ mod tests {
         // A station whose still period began long after the last solution.
         assert_eq!(c.push_station(&station(2, 500, 600)), None);
         assert_eq!(c.stations().len(), 3);
-        assert_eq!(c.starts()[2], None);
+        assert_eq!(c.azimuth_sigma_before()[2], None);
     }
 
     #[test]

@@ -116,15 +116,10 @@ impl AzimuthSigmaTrack {
             .push((s.sample_counter, s.attitude[2], s.attitude_std[2]));
     }
 
-    /// A station just taken from the stream: its start's sigma
-    /// ([`before`](Self::before) its `start_sample`), and the solutions
-    /// before its end forgotten, so that a live stream or a long run keeps
-    /// only what a station still to come can start from.
-    pub fn station_start(&mut self, station: &StationSurvey) -> Option<f64> {
-        self.station_start_solution(station).map(|s| s.sigma)
-    }
-
-    /// The same, with the start's azimuth and sample counter.
+    /// A station just taken from the stream: the solution it starts from
+    /// ([`start_before`](Self::start_before) its `start_sample`), and the
+    /// solutions before its end forgotten, so that a live stream or a long
+    /// run keeps only what a station still to come can start from.
     pub fn station_start_solution(&mut self, station: &StationSurvey) -> Option<StationStart> {
         let start = self.start_before(station.start_sample);
         self.forget_before(station.end_sample);
@@ -573,7 +568,10 @@ mod tests {
             end_sample: 40,
             ..StationSurvey::default()
         };
-        assert_eq!(track.station_start(&station), Some(0.5));
+        assert_eq!(
+            track.station_start_solution(&station).map(|s| s.sigma),
+            Some(0.5)
+        );
         assert_eq!(track.points.len(), 10);
         assert_eq!(track.before(45), Some(0.5));
         assert_eq!(track.before(40), None);
