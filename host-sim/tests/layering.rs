@@ -154,7 +154,7 @@ fn item_end(t: &[String], mut i: usize) -> usize {
 
 /// `tokens` without the items marked `#[cfg(test)]`, and the names of the
 /// `mod x;` declarations that are not test-only.
-fn without_tests(t: Vec<String>) -> (Vec<String>, Vec<(String, Option<String>)>) {
+fn without_tests(t: Vec<String>) -> (Vec<String>, Vec<String>) {
     let mut keep = Vec::new();
     let mut mods = Vec::new();
     let mut i = 0;
@@ -174,7 +174,7 @@ fn without_tests(t: Vec<String>) -> (Vec<String>, Vec<(String, Option<String>)>)
             // `#[path = "x"]` just before: the attribute's string was
             // dropped with the other strings, so such a module is reported
             // by name and its file found by the caller.
-            mods.push((t[i + 1].clone(), None));
+            mods.push(t[i + 1].clone());
         }
         keep.push(t[i].clone());
         i += 1;
@@ -214,7 +214,7 @@ fn module_tree(root: &Path) -> Vec<SourceFile> {
             dir.join(path.file_stem().unwrap())
         };
         let mut children = BTreeSet::new();
-        for (name, _) in mods {
+        for name in mods {
             let (file, owns) = match path_attribute(&src, &name) {
                 Some(p) => (dir.join(p), false),
                 None if child_dir.join(format!("{name}.rs")).exists() => {
