@@ -7,8 +7,12 @@ cd "$(dirname "$0")/.."
 # no debug info in the optimised builds (release, the probe's profiles and
 # the release tests), which only a debugger or a profiler reads; the
 # probe's flash and RAM figures count code and data, not debug sections.
+# The debug test builds keep line tables only (file and line in a
+# panic's backtrace): full debug info made the test binaries, each of
+# which links the navigation core and the host tool, fill a CI disk.
 export CARGO_INCREMENTAL=0
 export CARGO_PROFILE_RELEASE_DEBUG=false
+export CARGO_PROFILE_DEV_DEBUG=line-tables-only
 
 rustup target add thumbv7em-none-eabihf
 rustup component add rustfmt clippy
@@ -60,3 +64,5 @@ bash scripts/bad-input-matrix.sh target/debug/host-sim
 # The dashboard in headless Chromium (installs Debian's chromium if absent):
 # DOM checks against `host-sim decode` of the same capture, and a screenshot.
 bash scripts/dashboard-browser-test.sh target/debug/host-sim
+# What the builds took on disk (CI machines have had little to spare).
+du -sh target
