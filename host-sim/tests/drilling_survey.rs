@@ -8,7 +8,7 @@ mod common;
 use common::{plan, run, s, scratch, simulate_tied_in};
 use host_sim::formats::depth_log::DepthLog;
 use host_sim::survey::iscwsa::Site;
-use host_sim::survey::listing::drilling::{survey, survey_terms};
+use host_sim::survey::listing::drilling::{survey, survey_terms, SurveySetup};
 use host_sim::survey::listing::drilling_text::listing;
 use host_sim::survey::listing::TieOnInput;
 use mwd_core::protocol::frame::station_flags;
@@ -68,14 +68,24 @@ const TIE: TieOnInput = TieOnInput {
     east: 0.0,
 };
 
+/// The probe's survey tied on at `TIE`, the bit `sensor_to_bit` m ahead.
+fn setup(sensor_to_bit: Option<f64>) -> SurveySetup {
+    SurveySetup {
+        tie: TIE,
+        terms: survey_terms().unwrap(),
+        site: site(),
+        sensor_to_bit_m: None,
+    }
+    .with_sensor_to_bit(sensor_to_bit)
+}
+
 #[test]
 fn synthetic_stations_are_positioned_with_the_random_walk_depth_and_method_uncertainty() {
     let sig = [0.1, 0.2, 0.3, 0.4];
     let stations: Vec<StationSurvey> = (0..4)
         .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, sig[k]))
         .collect();
-    let terms = survey_terms().unwrap();
-    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
     assert_eq!(out.rows.len(), 4);
     for (k, r) in out.rows.iter().enumerate() {
         assert!((r.row.md_m - (1000.0 + 10.0 * k as f64)).abs() < 1e-9);
@@ -120,14 +130,54 @@ fn synthetic_stations_are_positioned_with_the_random_walk_depth_and_method_uncer
 }
 
 #[test]
+fn the_bit_is_projected_straight_ahead_with_the_last_stations_errors_over_the_lever() {
+    let sig = [0.1, 0.2, 0.3, 0.4];
+    let stations: Vec<StationSurvey> = (0..4)
+        .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, sig[k]))
+        .collect();
+    let plain = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
+    assert!(plain.bit.is_none());
+    let out = survey(&stations, &[], &[], &log(), &setup(Some(10.0))).unwrap();
+    let bit = out.bit.expect("a projection with a sensor-to-bit distance");
+    assert_eq!(bit.sensor_to_bit_m, 10.0);
+    assert!((bit.row.md_m - 1040.0).abs() < 1e-9);
+    assert!((bit.row.east_m - 40.0).abs() < 1e-5 && bit.row.north_m.abs() < 1e-5);
+    // the stations themselves are untouched by the projection
+    for (a, b) in out.rows.iter().zip(&plain.rows) {
+        assert_eq!(a.row, b.row);
+    }
+    // north (across the hole): the azimuth random walk as at the stations,
+    // with the last station's error acting over its half leg and the 10 m
+    // to the bit; the method's terms on four 10 m legs
+    let h = [5.0, 10.0, 10.0, 15.0];
+    let s2 = sig.map(|s: f64| s.to_radians().powi(2));
+    let mut var_n = 0.0;
+    for j in 0..4 {
+        for k in 0..4 {
+            var_n += h[j] * h[k] * s2[j].min(s2[k]);
+        }
+    }
+    let xcl_leg = 0.167 * 10.0 * (1.0f64.to_radians() / 30.48) * 10.0;
+    var_n += 4.0 * xcl_leg * xcl_leg;
+    let c = bit.row.cov.expect("the bit's position is determined");
+    assert!((c[0] - var_n).abs() < 1e-6 * var_n, "{} vs {var_n}", c[0]);
+    assert!(c[0] > plain.rows[3].row.cov.unwrap()[0]);
+    // an undetermined last station leaves the bit undetermined too
+    let mut lost = stations.clone();
+    lost[3].flags |= station_flags::AZIMUTH_UNDETERMINED;
+    lost[3].angles_std[1] = f32::INFINITY;
+    let out = survey(&lost, &[], &[], &log(), &setup(Some(10.0))).unwrap();
+    assert!(out.bit.is_some_and(|b| b.row.cov.is_none()));
+}
+
+#[test]
 fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     let mut stations: Vec<StationSurvey> = (0..4)
         .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, 0.2))
         .collect();
     stations[2].flags |= station_flags::AZIMUTH_UNDETERMINED;
     stations[2].angles_std[1] = f32::INFINITY;
-    let terms = survey_terms().unwrap();
-    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
     let determined: Vec<bool> = out.rows.iter().map(|r| r.position_determined).collect();
     assert_eq!(determined, [true, true, false, false]);
     assert!(out.rows[3].azimuth_determined && out.rows[3].row.cov.is_none());
@@ -139,7 +189,7 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     assert!(!text.contains("lost its heading"), "{text}");
     // a heading lost since the tie-in (not merely never found) says so
     stations[2].flags |= station_flags::HEADING_LOST;
-    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
     let text = listing(&out, 0.95);
     assert!(
         text.contains(
@@ -149,16 +199,15 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     );
     // an invalid station is skipped, with its reason
     stations[1].flags |= station_flags::SOLUTION_INVALID;
-    let out = survey(&stations, &[], &[], &log(), TIE, &terms, &site()).unwrap();
+    let out = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
     assert_eq!(out.rows.len(), 3);
     assert!(out.skipped[0].reason.contains("invalid"));
 }
 
 #[test]
 fn a_station_outside_the_log_or_a_log_that_is_not_one_is_refused() {
-    let terms = survey_terms().unwrap();
     let late = [station(1, 100.0, 0.1), station(2, 500.0, 0.1)];
-    let err = survey(&late, &[], &[], &log(), TIE, &terms, &site()).unwrap_err();
+    let err = survey(&late, &[], &[], &log(), &setup(None)).unwrap_err();
     assert!(
         format!("{err:#}").contains("outside the depth log"),
         "{err:#}"

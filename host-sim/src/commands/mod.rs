@@ -19,6 +19,7 @@ mod calibrate;
 mod dashboard;
 mod decode;
 mod demo;
+mod drill;
 mod limits;
 mod observability;
 mod paper;
@@ -43,6 +44,10 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// A survey while drilling on a simulated run, end to end: drill the
+    /// job's plan, survey the probe's capture (positions, ellipses, the
+    /// bit) and check it against the simulation's truth.
+    Drill(drill::Args),
     /// Simulate the paper's 60 s static test (and 2 x 10 min of toolface
     /// indexing) and print the coarse alignment next to the truth.
     Demo(demo::Args),
@@ -86,6 +91,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     let done = |result: anyhow::Result<()>| result.map(|()| ExitCode::SUCCESS);
     match cli.command {
+        Command::Drill(args) => done(drill::run(args)),
         Command::Demo(args) => done(demo::run(args)),
         Command::Simulate(args) => done(simulate::run(args)),
         Command::Decode(args) => done(decode::run(args)),

@@ -249,14 +249,27 @@ impl Resolved {
 pub fn run(args: Args) -> Result<()> {
     let resolved = Resolved::new(&args)?;
     check_offset_flags(&args.sep)?;
-    if args.capture.depth.is_some() {
-        let inputs = capture_inputs(&args, &resolved)?;
-        let csv = args.csv.as_deref();
-        return super::survey_capture::run(&args.capture, &inputs, csv, args.confidence);
-    }
     if let Some(dir) = &args.plot {
         // refused before any work: a file in the way is the user's mistake
         host_sim::formats::figure::prepare_dir(dir)?;
+    }
+    let site_for = |model: &KnownModel| model_site(&args, &resolved, model);
+    let paths = OutputPaths {
+        csv: args.csv.as_deref(),
+        json: args.json.as_deref(),
+        witsml: args.witsml.as_deref(),
+        plot: args.plot.as_deref(),
+    };
+    if args.capture.depth.is_some() {
+        let inputs = capture_inputs(&args, &resolved)?;
+        let offset = args.sep.offset.as_deref();
+        let outputs = super::survey_capture::CaptureOutputs {
+            paths,
+            confidence: args.confidence,
+            vsec_azimuth: args.vsec_azimuth_deg.map(f64::to_radians),
+            offset: offset.map(|p| offset_inputs(&args, p)).transpose()?,
+        };
+        return super::survey_capture::run(&args.capture, &inputs, &outputs, &site_for);
     }
     let file = read_station_file(&args.stations)?;
     let inputs = SurveyInputs {
@@ -266,18 +279,11 @@ pub fn run(args: Args) -> Result<()> {
         model: model_choice(&args, &resolved),
         confidence: args.confidence,
     };
-    let site_for = |model: &KnownModel| model_site(&args, &resolved, model);
     let mut survey = WellSurvey::compute(&file, &inputs, &site_for)?;
     if let Some(path) = &args.sep.offset {
         survey.add_offset(&offset_inputs(&args, path)?, &site_for)?;
     }
     out!("{}", listing_text(&survey));
-    let paths = OutputPaths {
-        csv: args.csv.as_deref(),
-        json: args.json.as_deref(),
-        witsml: args.witsml.as_deref(),
-        plot: args.plot.as_deref(),
-    };
     let well = args
         .stations
         .file_stem()
@@ -307,19 +313,20 @@ fn check_offset_flags(o: &OffsetArgs) -> Result<()> {
 /// A capture survey's inputs (`--depth`), once the options it does not
 /// take are refused.
 fn capture_inputs(args: &Args, resolved: &Resolved) -> Result<CaptureSurveyInputs> {
-    let unsupported = [
-        ("--json", args.json.is_some()),
-        ("--witsml", args.witsml.is_some()),
-        ("--plot", args.plot.is_some()),
-        ("--offset", args.sep.offset.is_some()),
+    let own_model = [
         ("--error-model", args.error_model.is_some()),
-        ("--vsec-azimuth-deg", args.vsec_azimuth_deg.is_some()),
-        ("--convergence-deg", args.convergence_deg.is_some()),
+        ("--error-model-file", args.error_model_file.is_some()),
     ];
-    if let Some((flag, _)) = unsupported.iter().find(|u| u.1) {
+    if let Some((flag, _)) = own_model.iter().find(|u| u.1) {
         bail!(
             "{flag} is not available for a capture survey (--depth): its uncertainty is the \
              probe's own (docs/drilling-survey.md)"
+        );
+    }
+    if args.convergence_deg.is_some() || args.azimuth_reference != Reference::True {
+        bail!(
+            "--azimuth-reference grid and --convergence-deg are not available for a capture \
+             survey (--depth): the probe gyrocompasses, its azimuths are true north"
         );
     }
     // The capture's uncertainty is the probe's own model: a job naming
@@ -343,6 +350,10 @@ fn capture_inputs(args: &Args, resolved: &Resolved) -> Result<CaptureSurveyInput
         tie: resolved.tie_on(args, LengthUnit::Metre),
         latitude: resolved.latitude,
         probe: resolved.probe,
+        sensor_to_bit_m: resolved
+            .job
+            .sensor_to_bit
+            .map(|d| d * resolved.job.tie_on.unit.to_m()),
     })
 }
 

@@ -3,13 +3,17 @@
 //! log, listed with their position uncertainty; `--trajectory OUT.csv`: the
 //! continuous trajectory from the 20 Hz solutions. docs/drilling-survey.md.
 //! The survey is `host_sim::survey::capture`'s; `survey` checks the
-//! options and gives the inputs.
+//! options and gives the inputs. The JSON, WITSML, figures and an offset
+//! well's separation are written by the station-file survey's writers
+//! (`host_sim::survey::outputs`).
 
 use super::limits::number_in;
 use anyhow::Result;
 use host_sim::formats::files::write_text;
 use host_sim::survey::capture::{trajectory_csv, CaptureSurvey, CaptureSurveyInputs};
-use std::path::{Path, PathBuf};
+use host_sim::survey::outputs::{write_outputs, OutputPaths};
+use host_sim::survey::well_survey::{OffsetInputs, SiteFor};
+use std::path::PathBuf;
 
 fn step_m(text: &str) -> Result<f64, String> {
     let v = number_in(text, "the trajectory step", (0.0, 1000.0), "m")?;
@@ -35,18 +39,48 @@ pub struct CaptureArgs {
     pub trajectory_step_m: f64,
 }
 
-/// Surveys the capture, prints the listing and writes `csv` (one row per
-/// station) and `--trajectory`.
+/// What a capture survey writes besides the listing.
+pub struct CaptureOutputs<'a> {
+    /// The CSV is the capture's own (toolface, time, each angle's sigma);
+    /// the rest go through the station-file survey's writers.
+    pub paths: OutputPaths<'a>,
+    pub confidence: f64,
+    /// Vertical-section azimuth, rad (`None`: the closure).
+    pub vsec_azimuth: Option<f64>,
+    pub offset: Option<OffsetInputs<'a>>,
+}
+
+/// Surveys the capture, prints the listing and writes the outputs asked
+/// for and `--trajectory`.
 pub fn run(
     args: &CaptureArgs,
     inputs: &CaptureSurveyInputs,
-    csv: Option<&Path>,
-    confidence: f64,
+    outputs: &CaptureOutputs,
+    site_for: SiteFor,
 ) -> Result<()> {
+    let confidence = outputs.confidence;
     let survey = CaptureSurvey::run(inputs)?;
+    let mut exported = survey.well_survey(confidence, outputs.vsec_azimuth)?;
+    if let Some(offset) = &outputs.offset {
+        exported.add_offset(offset, site_for)?;
+    }
     out!("{}", survey.report(confidence));
-    if let Some(path) = csv {
+    for line in exported.separation_summary() {
+        outln!("{line}");
+    }
+    if let Some(path) = outputs.paths.csv {
         write_text(path, &survey.stations_csv(confidence))?;
+    }
+    let others = OutputPaths {
+        csv: None,
+        ..outputs.paths
+    };
+    let well = inputs
+        .capture
+        .file_stem()
+        .map_or_else(|| "capture".into(), |n| n.to_string_lossy());
+    for f in write_outputs(&exported, &others, &well)? {
+        outln!("wrote {}", f.display());
     }
     if let Some(path) = &args.trajectory {
         let points = survey.trajectory(args.trajectory_step_m)?;

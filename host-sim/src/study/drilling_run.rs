@@ -536,6 +536,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         tie,
         terms: config.terms.clone(),
         site: config.site,
+        sensor_to_bit_m: None,
     };
     let survey = collected.survey(&links, &setup, &depth);
     let (td, td_note, method_td_error_ne) = match survey {

@@ -12,7 +12,8 @@ use crate::formats::files::read_depth_log;
 use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::listing::drilling::{self, DrillingSurvey, TrajectoryPoint};
-use crate::survey::listing::{drilling_text, TieOnInput};
+use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
+use crate::survey::well_survey::WellSurvey;
 use crate::survey::stations::{StationCollector, SurveySetup};
 use anyhow::{Context, Result};
 use mwd_core::calibration::ProbeCalibration;
@@ -44,6 +45,9 @@ pub struct CaptureSurveyInputs {
     /// Latitude of the site, rad (the model's site).
     pub latitude: f64,
     pub probe: ProbeSetup,
+    /// From the survey sensors to the bit, m: the survey ends with the
+    /// bit's projection.
+    pub sensor_to_bit_m: Option<f64>,
 }
 
 /// A capture's survey and what its listing says about the capture.
@@ -66,13 +70,16 @@ impl CaptureSurvey {
     pub fn run(inputs: &CaptureSurveyInputs) -> Result<Self> {
         let read = read_stations(&inputs.capture, &inputs.probe)?;
         let depth = read_depth_log(&inputs.depth)?;
-        let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?;
+        let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?
+            .with_sensor_to_bit(inputs.sensor_to_bit_m);
         let links = read.links;
         let survey = read
             .collected
             .survey(links.as_deref().unwrap_or(&[]), &setup, &depth)
             .with_context(|| format!("{}", inputs.capture.display()))?;
-        let SurveySetup { tie, terms, site } = setup;
+        let SurveySetup {
+            tie, terms, site, ..
+        } = setup;
         Ok(Self {
             survey,
             stats: read.stats,
@@ -90,6 +97,9 @@ impl CaptureSurvey {
     /// (the ellipse at `confidence`).
     pub fn report(&self, confidence: f64) -> String {
         let mut text = String::new();
+        if let Some(note) = placement_note(&self.tie) {
+            text += &format!("note: {note}\n");
+        }
         let s = &self.stats;
         let bad = s.crc_errors + s.malformed + s.unknown_kind;
         if bad > 0 || s.lost > 0 {
@@ -109,6 +119,59 @@ impl CaptureSurvey {
             ),
         };
         text + &drilling_text::listing(&self.survey, confidence)
+    }
+
+    /// The survey as a station file's survey is exported (JSON, WITSML,
+    /// figures, an offset well's separation: [`crate::survey::outputs`]):
+    /// the stations up to the first undetermined position, metres along
+    /// true north, with the probe's covariance at `confidence`; the
+    /// vertical section along `vsec_azimuth` (rad; `None`: the last
+    /// exported station's closure azimuth).
+    pub fn well_survey(&self, confidence: f64, vsec_azimuth: Option<f64>) -> Result<WellSurvey> {
+        let mut rows: Vec<Row> = self
+            .survey
+            .rows
+            .iter()
+            .take_while(|r| r.position_determined && r.row.cov.is_some())
+            .map(|r| r.row)
+            .collect();
+        let left_out = self.survey.rows.len() - rows.len();
+        let bit = self
+            .survey
+            .bit
+            .map(|b| b.row)
+            .filter(|b| left_out == 0 && b.cov.is_some());
+        let direction = vsec_azimuth.unwrap_or_else(|| {
+            rows.last()
+                .map_or(0.0, |r| r.east_m.atan2(r.north_m).rem_euclid(std::f64::consts::TAU))
+        });
+        let (sin, cos) = direction.sin_cos();
+        for r in rows.iter_mut() {
+            r.vsec_m = r.north_m * cos + r.east_m * sin;
+        }
+        let bit = bit.map(|b| Row {
+            vsec_m: b.north_m * cos + b.east_m * sin,
+            ..b
+        });
+        let mut notes: Vec<String> = placement_note(&self.tie).into_iter().collect();
+        if let Some(first) = self.survey.rows.get(rows.len()) {
+            notes.push(format!(
+                "{left_out} stations from station {} (MD {:.2} m) on have no determined position \
+                 (their azimuth or an earlier one is undetermined) and are not in this output",
+                first.survey.station, first.row.md_m
+            ));
+        }
+        Ok(WellSurvey {
+            rows,
+            vsec_azimuth_deg: direction.to_degrees(),
+            model: Some(listing::model(drilling::MODEL_NAME)?),
+            invalid_from: None,
+            confidence,
+            unit: LengthUnit::Metre,
+            offset: None,
+            bit,
+            header_note: (!notes.is_empty()).then(|| notes.join("; ")),
+        })
     }
 
     /// One row per station (CSV).
@@ -150,6 +213,22 @@ impl CaptureSurvey {
         }
         points
     }
+}
+
+/// How the stations are placed when no tie-on was given (all zero: the
+/// survey's default), as the listing and the exports say on top.
+fn placement_note(tie: &TieOnInput) -> Option<String> {
+    let surface = TieOnInput {
+        md: None,
+        tvd: 0.0,
+        north: 0.0,
+        east: 0.0,
+    };
+    (*tie == surface).then(|| {
+        "no tie-on given: the stations are placed from N 0, E 0, TVD 0 at the first station's \
+         MD, not where the well is (give the job's survey.tie_on or --tie-on-*)"
+            .to_string()
+    })
 }
 
 /// The trajectory as CSV (the ellipse at `confidence`).

@@ -15,6 +15,8 @@
 //!   it (positions, the model's covariance, an offset well's separation).
 //! - [`outputs`]: that survey's listing, CSV, JSON, WITSML and figures.
 //! - [`capture`]: the survey of a drilling capture with its depth log.
+//! - [`simulated`]: a simulated drilling run surveyed end to end and
+//!   checked against its truth (`host-sim drill`).
 //! - [`stations`]: the probe's downlink to the survey's stations (each
 //!   station's start sigma, stations sent again), positioned from the tie-on:
 //!   the one collector the capture survey, the dashboard and the studies use.
@@ -24,5 +26,6 @@ pub mod iscwsa;
 pub mod job;
 pub mod listing;
 pub mod outputs;
+pub mod simulated;
 pub mod stations;
 pub mod well_survey;

@@ -196,30 +196,37 @@ pub fn csv_text(s: &WellSurvey) -> String {
     out
 }
 
+/// One station of the JSON: position, and with a model its covariance and
+/// ellipse at `s.confidence`.
+fn json_station(s: &WellSurvey, r: &crate::survey::listing::Row) -> serde_json::Value {
+    let mut v = serde_json::json!({
+        "md_m": r.md_m, "inc_deg": r.inc_deg, "azi_deg": r.azi_deg,
+        "tvd_m": r.tvd_m, "north_m": r.north_m, "east_m": r.east_m,
+        "dls_deg_per_30m": r.dls_deg_per_30m, "vsec_m": r.vsec_m,
+        "toolface_deg": r.input.toolface_deg, "time_s": r.input.time_s,
+    });
+    if s.model.is_some() {
+        let e = r.ellipse();
+        let scaled = e.map(|e| e.scaled(s.confidence));
+        v["nev_covariance_m2"] = serde_json::json!(r.cov);
+        v["sigma_north_m"] = serde_json::json!(r.cov.map(|c| c[0].max(0.0).sqrt()));
+        v["sigma_east_m"] = serde_json::json!(r.cov.map(|c| c[1].max(0.0).sqrt()));
+        v["sigma_vert_m"] = serde_json::json!(e.map(|e| e.sigma_vert));
+        v["ellipse_semi_major_m"] = serde_json::json!(scaled.map(|x| x.0));
+        v["ellipse_semi_minor_m"] = serde_json::json!(scaled.map(|x| x.1));
+        v["ellipse_azimuth_deg"] = serde_json::json!(e.map(|e| e.azimuth_deg));
+        v["error_model_valid"] = serde_json::json!(r.cov.is_some());
+    }
+    v
+}
+
 pub fn json_text(s: &WellSurvey) -> Result<String> {
     let stations: Vec<serde_json::Value> = s
         .rows
         .iter()
         .enumerate()
         .map(|(k, r)| {
-            let mut v = serde_json::json!({
-                "md_m": r.md_m, "inc_deg": r.inc_deg, "azi_deg": r.azi_deg,
-                "tvd_m": r.tvd_m, "north_m": r.north_m, "east_m": r.east_m,
-                "dls_deg_per_30m": r.dls_deg_per_30m, "vsec_m": r.vsec_m,
-                "toolface_deg": r.input.toolface_deg, "time_s": r.input.time_s,
-            });
-            if s.model.is_some() {
-                let e = r.ellipse();
-                let scaled = e.map(|e| e.scaled(s.confidence));
-                v["nev_covariance_m2"] = serde_json::json!(r.cov);
-                v["sigma_north_m"] = serde_json::json!(r.cov.map(|c| c[0].max(0.0).sqrt()));
-                v["sigma_east_m"] = serde_json::json!(r.cov.map(|c| c[1].max(0.0).sqrt()));
-                v["sigma_vert_m"] = serde_json::json!(e.map(|e| e.sigma_vert));
-                v["ellipse_semi_major_m"] = serde_json::json!(scaled.map(|x| x.0));
-                v["ellipse_semi_minor_m"] = serde_json::json!(scaled.map(|x| x.1));
-                v["ellipse_azimuth_deg"] = serde_json::json!(e.map(|e| e.azimuth_deg));
-                v["error_model_valid"] = serde_json::json!(r.cov.is_some());
-            }
+            let mut v = json_station(s, r);
             if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
                 let c = &x.closest;
                 v["offset_md_m"] = serde_json::json!(c.md_m);
@@ -244,6 +251,13 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         "stations": stations,
     });
     let mut doc = doc;
+    if let Some(note) = &s.header_note {
+        doc["placement_note"] = serde_json::json!(note);
+    }
+    if let Some(bit) = &s.bit {
+        // the last station's angles held straight ahead to the bit
+        doc["bit_projection"] = json_station(s, bit);
+    }
     if let Some(o) = &s.offset {
         let min = sep::minimum(&o.seps);
         doc["separation"] = serde_json::json!({

@@ -14,9 +14,9 @@ use mwd_core::probe::StationLink;
 use mwd_core::protocol::{Frame, NavSolution, Payload, StationSurvey};
 
 use crate::formats::depth_log::DepthLog;
-use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::job::Job;
 use crate::survey::listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
+pub use crate::survey::listing::drilling::SurveySetup;
 use crate::survey::listing::{LengthUnit, TieOnInput};
 
 /// The stations of one run as they come, each with its start.
@@ -94,41 +94,8 @@ impl StationCollector {
             &self.azimuth_sigma_before(),
             links,
             depth,
-            setup.tie,
-            &setup.terms,
-            &setup.site,
+            setup,
         )
-    }
-}
-
-/// What positioning the probe's stations needs besides the stations and
-/// the depth log: the tie-on and the probe's own error model at the site.
-#[derive(Debug, Clone)]
-pub struct SurveySetup {
-    /// The tie-on, metres (MD `None`: the first station's).
-    pub tie: TieOnInput,
-    /// The probe's angle sigmas plus the depth log's scale and stretch
-    /// terms (no magnetic terms: the probe has none).
-    pub terms: Vec<ErrorTerm>,
-    pub site: Site,
-}
-
-impl SurveySetup {
-    /// The probe's survey at a site at `latitude_rad`, tied on at `tie`.
-    pub fn probe(tie: TieOnInput, latitude_rad: f64) -> Result<Self> {
-        Ok(Self {
-            tie,
-            terms: drilling::survey_terms()?,
-            site: Site {
-                gravity: 9.806_65,
-                b_total: 0.0,
-                dip: 0.0,
-                declination: 0.0,
-                vertical_limit: 0.0001_f64.to_radians(),
-                latitude: latitude_rad,
-                gyro_noise_reduction: 1.0,
-            },
-        })
     }
 }
 

@@ -89,6 +89,13 @@ pub struct WellSurvey {
     /// Length unit of the station file (the figures use it).
     pub unit: LengthUnit,
     pub offset: Option<Offset>,
+    /// The bit projected from the last station, where the survey has one
+    /// (a capture survey with the sensor-to-bit distance).
+    pub bit: Option<Row>,
+    /// What a reader must know before the positions: how the stations
+    /// are placed, what they are not (a capture survey without a
+    /// tie-on); the listing, the JSON and the figures carry it.
+    pub header_note: Option<String>,
 }
 
 impl WellSurvey {
@@ -116,6 +123,8 @@ impl WellSurvey {
             confidence: inputs.confidence,
             unit: file.unit,
             offset: None,
+            bit: None,
+            header_note: None,
         })
     }
 

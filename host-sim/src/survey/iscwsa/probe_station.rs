@@ -120,8 +120,39 @@ pub fn angle_covariance(
     stations: &[Station],
     sigmas: &[AngleSigma],
 ) -> Result<Vec<Cov6>, PropagationError> {
-    let n = stations.len();
-    if sigmas.len() != n {
+    checked(stations, sigmas)?;
+    Ok(propagate(stations, sigmas, None))
+}
+
+/// [`angle_covariance`] at every station and, last, at a point `ahead`
+/// (m, > 0) beyond the last station along its own inclination and azimuth:
+/// the projection to the bit. The projection's angles are the last
+/// station's, so are their errors: every source's error at the last
+/// station acts over the whole projected leg too.
+pub fn angle_covariance_ahead(
+    stations: &[Station],
+    sigmas: &[AngleSigma],
+    ahead: f64,
+) -> Result<Vec<Cov6>, PropagationError> {
+    checked(stations, sigmas)?;
+    let Some(last) = stations.last() else {
+        return Ok(Vec::new());
+    };
+    if !(ahead.is_finite() && ahead > 0.0) {
+        return Err(PropagationError::MdNotIncreasing(stations.len()));
+    }
+    let mut extended = stations.to_vec();
+    extended.push(Station {
+        md: last.md + ahead,
+        toolface: None,
+        ..*last
+    });
+    Ok(propagate(&extended, sigmas, Some(stations.len())))
+}
+
+/// One sigma per station, each a finite number >= 0, MD increasing.
+fn checked(stations: &[Station], sigmas: &[AngleSigma]) -> Result<(), PropagationError> {
+    if sigmas.len() != stations.len() {
         return Err(PropagationError::LengthMismatch);
     }
     for (k, s) in sigmas.iter().enumerate() {
@@ -133,12 +164,23 @@ pub fn angle_covariance(
             return Err(PropagationError::MdNotIncreasing(k));
         }
     }
+    Ok(())
+}
+
+/// The covariance at every one of `stations`; with `projected = Some(n)`
+/// the stations from `n` on are the last sigma's station held straight
+/// ahead (its errors repeated), `sigmas` covering the first `n`.
+fn propagate(stations: &[Station], sigmas: &[AngleSigma], projected: Option<usize>) -> Vec<Cov6> {
+    let n = stations.len();
+    let own = projected.unwrap_or(n);
+    // The sigma whose errors station k carries.
+    let of = |k: usize| k.min(own - 1);
     let vectors = unit_vectors(stations);
     let mut total = vec![[0.0; 6]; n];
     for src in &sources(sigmas) {
         let per_length: Vec<[f64; 3]> = (0..n)
             .map(|k| {
-                let [di, da] = src.weights[k];
+                let [di, da] = src.weights[of(k)];
                 let u = &vectors[k];
                 std::array::from_fn(|j| u.di[j] * di + u.da[j] * da)
             })
@@ -147,14 +189,14 @@ pub fn angle_covariance(
     }
     let shortening: Vec<[f64; 3]> = (0..n)
         .map(|k| {
-            let (s, u) = (&sigmas[k], &vectors[k]);
+            let (s, u) = (&sigmas[of(k)], &vectors[k]);
             let sin_inc = u.along[0].hypot(u.along[1]);
             let size = 0.5 * 3f64.sqrt() * (s.inc.powi(2) + (sin_inc * s.azi).powi(2));
             u.along.map(|t| -t * size)
         })
         .collect();
     add_source(&mut total, &vectors, &shortening);
-    Ok(total)
+    total
 }
 
 /// Adds one independent unit source's NEV covariance at every station,
@@ -679,5 +721,33 @@ mod tests {
             east(&with),
             east(&without)
         );
+    }
+
+    #[test]
+    fn the_bit_carries_the_last_stations_angle_errors_over_the_projected_leg() {
+        // Tie-on (exact) and one station L = 28 m on, horizontal, due
+        // north; the station's inclination error alone (no azimuth
+        // error): it tilts half the leg before the station (balanced
+        // tangential) and the whole leg to the bit, d = 12 m.
+        let (l, d, s_inc) = (28.0, 12.0, 0.01);
+        let st = straight(2, l, 90.0, 0.0);
+        let sig = [sigma(0.0, 0.0), sigma(s_inc, 0.0)];
+        let ahead = angle_covariance_ahead(&st, &sig, d).unwrap();
+        let plain = angle_covariance(&st, &sig).unwrap();
+        assert_eq!(ahead.len(), 3);
+        assert_eq!(&ahead[..2], &plain[..], "the stations keep their covariance");
+        let vertical = ((0.5 * l + d) * s_inc).powi(2);
+        assert!(
+            (ahead[2][2] - vertical).abs() < 1e-12 * vertical.max(1.0),
+            "{} against {vertical}",
+            ahead[2][2]
+        );
+        assert!(ahead[2][2] > plain[1][2], "the bit is less certain than the station");
+        // and an azimuth error swings the bit sideways over the same lever
+        let sig = [sigma(0.0, 0.0), sigma(0.0, 0.02)];
+        let east = angle_covariance_ahead(&st, &sig, d).unwrap()[2][1];
+        let want = ((0.5 * l + d) * 0.02).powi(2);
+        assert!((east - want).abs() < 1e-12, "{east} against {want}");
+        assert!(angle_covariance_ahead(&st, &sig, 0.0).is_err());
     }
 }

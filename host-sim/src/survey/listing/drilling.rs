@@ -15,7 +15,9 @@
 
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
 use crate::formats::depth_log::DepthLog;
-use crate::survey::iscwsa::probe_station::{angle_covariance, links_in_order, AngleSigma};
+use crate::survey::iscwsa::probe_station::{
+    angle_covariance, angle_covariance_ahead, links_in_order, AngleSigma,
+};
 use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site, Station};
 use anyhow::{anyhow, bail, Result};
 use mwd_core::probe::StationLink;
@@ -55,6 +57,67 @@ pub struct DrillingSurvey {
     /// Added to the depth log's MD (m): `--tie-on-md` minus the log at the
     /// first station; 0 without it.
     pub md_offset_m: f64,
+    /// The bit, projected from the last station ([`SurveySetup::sensor_to_bit_m`]).
+    pub bit: Option<BitProjection>,
+}
+
+/// The bit's position projected from the last station: its inclination
+/// and azimuth held straight ahead over the sensor-to-bit distance (the
+/// bit's own angles are not measured), with the last station's angle
+/// errors acting over that distance too.
+#[derive(Clone, Copy, Debug)]
+pub struct BitProjection {
+    /// From the last station to the bit along the hole, m.
+    pub sensor_to_bit_m: f64,
+    /// MD, angles (the last station's) and position; `cov` where the last
+    /// station's position is determined.
+    pub row: Row,
+    /// The survey method's part of `row.cov`.
+    pub method_cov: Option<Cov6>,
+}
+
+/// What positioning the probe's stations needs besides the stations and
+/// the depth log: the tie-on, the probe's own error model at the site and
+/// where the bit is.
+#[derive(Debug, Clone)]
+pub struct SurveySetup {
+    /// The tie-on, metres (MD `None`: the first station's).
+    pub tie: TieOnInput,
+    /// The probe's angle sigmas plus the depth log's scale and stretch
+    /// terms (no magnetic terms: the probe has none).
+    pub terms: Vec<ErrorTerm>,
+    pub site: Site,
+    /// From the survey sensors to the bit, m (> 0); `None`: no projection.
+    pub sensor_to_bit_m: Option<f64>,
+}
+
+impl SurveySetup {
+    /// The probe's survey at a site at `latitude_rad`, tied on at `tie`.
+    pub fn probe(tie: TieOnInput, latitude_rad: f64) -> Result<Self> {
+        Ok(Self {
+            tie,
+            terms: survey_terms()?,
+            site: Site {
+                gravity: 9.806_65,
+                b_total: 0.0,
+                dip: 0.0,
+                declination: 0.0,
+                vertical_limit: 0.0001_f64.to_radians(),
+                latitude: latitude_rad,
+                gyro_noise_reduction: 1.0,
+            },
+            sensor_to_bit_m: None,
+        })
+    }
+
+    /// The same, with the bit `m` metres ahead of the sensors (`None`, 0:
+    /// no projection).
+    pub fn with_sensor_to_bit(self, m: Option<f64>) -> Self {
+        Self {
+            sensor_to_bit_m: m.filter(|m| *m > 0.0),
+            ..self
+        }
+    }
 }
 
 /// The probe's tool model (docs/probe-tool-model.md): a capture survey's.
@@ -197,8 +260,8 @@ fn unusable(s: &StationSurvey) -> Option<&'static str> {
 type Kept = (StationSurvey, f64, f64, Option<f64>, Option<StationLink>);
 
 /// The survey of `stations` (in the order the probe sent them) with MD
-/// from `depth`; `tie`: the tie-on's position, and its MD if given;
-/// `azi_before`: each station's azimuth sigma at its start
+/// from `depth`, positioned as `setup` says (the tie-on's position, and
+/// its MD if given; the bit's projection); `azi_before`: each station's azimuth sigma at its start
 /// ([`AzimuthSigmaTrack::before`] its `start_sample`), for the stations'
 /// correlation; shorter than `stations` (empty) where not known; `links`:
 /// each station's link from the probe (`Navigator::station_link`; empty
@@ -209,10 +272,12 @@ pub fn survey(
     azi_before: &[Option<f64>],
     links: &[Option<StationLink>],
     depth: &DepthLog,
-    tie: TieOnInput,
-    terms: &[ErrorTerm],
-    site: &Site,
+    setup: &SurveySetup,
 ) -> Result<DrillingSurvey> {
+    let SurveySetup {
+        tie, terms, site, ..
+    } = setup;
+    let ahead = setup.sensor_to_bit_m;
     let mut skipped = Vec::new();
     let mut kept: Vec<Kept> = Vec::new();
     let (first, last) = depth.span();
@@ -266,7 +331,7 @@ pub fn survey(
         bail!("no usable station survey in the capture");
     };
     let md_offset_m = tie.md.map_or(0.0, |md| md - first_md);
-    let file = StationFile {
+    let mut file = StationFile {
         unit: LengthUnit::Metre,
         stations: kept
             .iter()
@@ -279,8 +344,17 @@ pub fn survey(
             })
             .collect(),
     };
-    let tie_position = TieOnInput { md: None, ..tie };
-    let (rows, _) = compute(&file, AzimuthReference::True, tie_position, None)?;
+    if let (Some(d), Some(&last)) = (ahead, file.stations.last()) {
+        file.stations.push(InputStation {
+            md: last.md + d,
+            toolface_deg: None,
+            time_s: None,
+            ..last
+        });
+    }
+    let tie_position = TieOnInput { md: None, ..*tie };
+    let (mut rows, _) = compute(&file, AzimuthReference::True, tie_position, None)?;
+    let bit_row = ahead.and_then(|_| rows.pop());
     let numbered: Vec<_> = kept.iter().map(|k| (k.0.station, k.4)).collect();
     let sigmas: Vec<Option<AngleSigma>> = kept
         .iter()
@@ -295,7 +369,16 @@ pub fn survey(
             })
         })
         .collect();
-    let covs = covariance(&rows, &sigmas, terms, site)?;
+    let mut covs = covariance(&rows, &sigmas, terms, site, ahead)?;
+    let bit_cov = (covs.len() > rows.len()).then(|| covs.pop()).flatten();
+    let bit = bit_row.zip(ahead).map(|(mut row, d)| {
+        row.cov = bit_cov.map(|c| c.total);
+        BitProjection {
+            sensor_to_bit_m: d,
+            row,
+            method_cov: bit_cov.map(|c| c.method),
+        }
+    });
     let rows = kept
         .iter()
         .zip(rows)
@@ -316,6 +399,7 @@ pub fn survey(
         rows,
         skipped,
         md_offset_m,
+        bit,
     })
 }
 
@@ -338,19 +422,22 @@ fn is_method_term(t: &ErrorTerm) -> bool {
 /// a determined azimuth: the probe's angle errors plus `terms`
 /// ([`survey_terms`]), the latter on MD counted from the tie-on (the log's
 /// error at the tie-on is in the tie-on's MD, not in the positions: module
-/// docs).
+/// docs). With `ahead` (m) and every row determined, one more: the last
+/// row projected that far straight ahead ([`BitProjection`]).
 pub fn covariance(
     rows: &[Row],
     sigmas: &[Option<AngleSigma>],
     terms: &[ErrorTerm],
     site: &Site,
+    ahead: Option<f64>,
 ) -> Result<Vec<PositionCovariance>> {
     let valid = sigmas.iter().take_while(|s| s.is_some()).count();
     if valid == 0 {
         return Ok(Vec::new());
     }
+    let ahead = ahead.filter(|_| valid == rows.len());
     let md0 = rows[0].md_m;
-    let stations: Vec<Station> = rows[..valid]
+    let mut stations: Vec<Station> = rows[..valid]
         .iter()
         .map(|r| Station {
             md: r.md_m,
@@ -361,7 +448,19 @@ pub fn covariance(
         })
         .collect();
     let sig: Vec<AngleSigma> = sigmas[..valid].iter().flatten().copied().collect();
-    let angles = angle_covariance(&stations, &sig).map_err(|e| anyhow!("{e}"))?;
+    let angles = match ahead {
+        Some(d) => angle_covariance_ahead(&stations, &sig, d),
+        None => angle_covariance(&stations, &sig),
+    }
+    .map_err(|e| anyhow!("{e}"))?;
+    if let (Some(d), Some(&last)) = (ahead, stations.last()) {
+        stations.push(Station {
+            md: last.md + d,
+            toolface: None,
+            ..last
+        });
+    }
+    let valid = stations.len();
     let from_tie_on: Vec<Station> = stations
         .iter()
         .map(|s| Station {
@@ -498,7 +597,7 @@ pub fn trajectory(
             })
         })
         .collect();
-    let covs = covariance(&rows, &sigmas, terms, site)?;
+    let covs = covariance(&rows, &sigmas, terms, site, None)?;
     Ok(rows
         .into_iter()
         .enumerate()

@@ -2,7 +2,7 @@
 //! position with its sigma; an undetermined azimuth, and every position
 //! from the first one on, shown as undetermined, never as a number.
 
-use super::drilling::{DrillingRow, DrillingSurvey, TrajectoryPoint};
+use super::drilling::{BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint};
 use super::ellipse::scale_2d;
 use mwd_core::probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD;
 use mwd_core::protocol::frame::station_flags;
@@ -45,6 +45,15 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
     for r in &s.rows {
         let _ = writeln!(out, "{}", line(r, confidence));
     }
+    if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {
+        let _ = writeln!(out, "{}", bit_line(bit, last, confidence));
+        let _ = writeln!(
+            out,
+            "bit: projected {:.2} m straight ahead of station {} (its inclination and azimuth; \
+             their errors act over the projection too)",
+            bit.sensor_to_bit_m, last.survey.station
+        );
+    }
     if let Some(u) = s.rows.iter().find(|r| !r.position_determined) {
         let _ = writeln!(
             out,
@@ -80,7 +89,7 @@ fn line(r: &DrillingRow, confidence: f64) -> String {
         Some(tf) if sd[2].is_finite() => angle(tf, sd[2]),
         _ => "n/a".into(),
     };
-    let mut text = format!(
+    let text = format!(
         "{:>3} {:>9.2} {:>15} {:>16} {:>16}",
         r.survey.station,
         r.row.md_m,
@@ -88,26 +97,49 @@ fn line(r: &DrillingRow, confidence: f64) -> String {
         azi,
         tf
     );
-    match (r.position_determined, r.row.cov, r.row.ellipse()) {
+    text + &position_text(&r.row, r.position_determined, confidence)
+}
+
+/// The listing's position columns, or "position undetermined".
+fn position_text(row: &super::Row, determined: bool, confidence: f64) -> String {
+    match (determined, row.cov, row.ellipse()) {
         (true, Some(c), Some(e)) => {
             let (a, b) = e.scaled(confidence);
-            let _ = write!(
-                text,
+            format!(
                 " {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2} {:>7.2} {:>5.1}",
-                r.row.tvd_m,
-                r.row.north_m,
-                r.row.east_m,
+                row.tvd_m,
+                row.north_m,
+                row.east_m,
                 c[0].max(0.0).sqrt(),
                 c[1].max(0.0).sqrt(),
                 e.sigma_vert,
                 a,
                 b,
                 e.azimuth_deg
-            );
+            )
         }
-        _ => text += "  position undetermined",
+        _ => "  position undetermined".into(),
     }
-    text
+}
+
+/// The bit's line: the last station's angles (and sigmas) held straight
+/// ahead, "projected" where the toolface would be.
+fn bit_line(bit: &BitProjection, last: &DrillingRow, confidence: f64) -> String {
+    let sd = last.survey.angles_std.map(f64::from);
+    let azi = if last.azimuth_determined {
+        angle(bit.row.azi_deg, sd[1])
+    } else {
+        "undetermined".into()
+    };
+    let text = format!(
+        "{:>3} {:>9.2} {:>15} {:>16} {:>16}",
+        "bit",
+        bit.row.md_m,
+        angle(bit.row.inc_deg, sd[0]),
+        azi,
+        "projected"
+    );
+    text + &position_text(&bit.row, bit.row.cov.is_some(), confidence)
 }
 
 fn opt(v: Option<f64>) -> String {
@@ -169,6 +201,25 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
             sd[2].to_degrees(),
             opt(corr.filter(|c| c.is_finite())),
             position_cells(&r.row, r.position_determined, confidence)
+        );
+    }
+    if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {
+        // the bit: "bit" for the station number, no time, the last
+        // station's angles and sigmas, no toolface
+        let sd = last.survey.angles_std.map(f64::from);
+        let determined = last.azimuth_determined;
+        let _ = writeln!(
+            out,
+            "bit,,{},{},{},{},{},,,{},{},{confidence}",
+            bit.row.md_m,
+            bit.row.inc_deg,
+            sd[0].to_degrees(),
+            opt(determined.then_some(bit.row.azi_deg)),
+            opt(determined.then_some(sd[1].to_degrees())),
+            opt(determined
+                .then_some(f64::from(last.survey.correlations[0]))
+                .filter(|c| c.is_finite())),
+            position_cells(&bit.row, bit.row.cov.is_some(), confidence)
         );
     }
     out

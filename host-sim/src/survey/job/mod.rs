@@ -1,12 +1,16 @@
 //! The job file: what one run needs, in one JSON file that
-//! `host-sim probe configure` sends to the probe and that `host-sim survey`
-//! and `host-sim replay` read (`--job`), so one file describes a run end to
-//! end.
+//! `host-sim probe configure` sends to the probe and that `host-sim survey`,
+//! `host-sim replay` and `host-sim drill` read (`--job`), so one file
+//! describes a run end to end. `examples/lateral-100m/job.json` is one
+//! that runs as it is.
 //!
 //! ```json
 //! {
 //!   "format": "mwd-job", "version": 1,
 //!   "site": { "latitude_deg": 45.77755, "longitude_deg": 126.687898, "height_m": 124.0 },
+//!   "well": { "name": "Parent 1", "uid": "parent-1",
+//!             "wellbore": "Parent 1 lateral A", "wellbore_uid": "parent-1-la" },
+//!   "plan": "plan.json",
 //!   "tie_in": { "inclination_deg": 88.0, "azimuth_deg": 271.0, "toolface_deg": 15.0,
 //!               "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 1.5,
 //!               "toolface_sigma_deg": 0.3 },
@@ -14,19 +18,25 @@
 //!   "still": { "z_enter": 3.09, "z_stay": 5.199, "enter_epochs": 20,
 //!              "max_station_samples": 6000, "zupt_velocity_sigma": 0.01 },
 //!   "survey": { "length_unit": "ft", "error_model": "PROBE-SCC1300",
-//!               "tie_on": { "md": 1500.0, "tvd": 1480.0, "north": 12.0, "east": -3.5 } }
+//!               "tie_on": { "md": 1500.0, "tvd": 1480.0, "north": 12.0, "east": -3.5 },
+//!               "sensor_to_bit": 40.0 }
 //! }
 //! ```
-//! `tie_in`, `calibration_file` and `still` are optional (absent: the
-//! static alignment, no correction, the probe's still settings left as
-//! they are); a relative calibration path is taken from the job file's
-//! folder. `still` is the still detector's and the station's settings
+//! Only `format`, `version` and `site` are required. Without `tie_in`,
+//! `calibration_file` or `still`: the static alignment, no correction, the
+//! probe's still settings left as they are. Paths (`calibration_file`,
+//! `plan`) are taken from the job file's folder, so a job runs from any
+//! directory. `still` is the still detector's and the station's settings
 //! (uplink command 0x44, `protocol::uplink::StillSettings`, all five
-//! fields, with its ranges; the defaults are the values above). `survey` is optional and only the host reads it:
-//! the tie-on (the well's position where the survey starts, in
-//! `length_unit`, "m" or "ft", default "m"; every part optional, as the
-//! `--tie-on-*` flags) and the tool's error model (a name `survey
-//! --error-model` takes).
+//! fields, with its ranges; the defaults are the values above). `well`
+//! names the well and wellbore (the WITSML trajectory's names and uids;
+//! all four keys). `plan` is the well plan a simulated run drills
+//! (`host-sim drill`, `sim::plan`). `survey` only the host reads: the
+//! tie-on (the well's position where the survey starts, in `length_unit`,
+//! "m" or "ft", default "m"; every part optional, as the `--tie-on-*`
+//! flags), the tool's error model (a name `survey --error-model` takes) and
+//! the distance from the survey sensors to the bit (in `length_unit`),
+//! for the projection to the bit.
 //!
 //! Who reads what: `probe configure` sends the site, tie-in, calibration
 //! and still settings; `survey` takes the site's latitude, the tie-on and
@@ -125,6 +135,16 @@ struct SurveyEntry {
     length_unit: Option<String>,
     tie_on: Option<TieOnEntry>,
     error_model: Option<String>,
+    sensor_to_bit: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WellEntry {
+    name: String,
+    uid: String,
+    wellbore: String,
+    wellbore_uid: String,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -137,6 +157,8 @@ struct JobEntry {
     calibration_file: Option<PathBuf>,
     still: Option<StillEntry>,
     survey: Option<SurveyEntry>,
+    well: Option<WellEntry>,
+    plan: Option<PathBuf>,
 }
 
 /// The survey's tie-on from a job, in the job's length unit (true north);
@@ -191,6 +213,56 @@ pub struct SurveyJob {
     pub tie_on: JobTieOn,
     /// A name `survey_listing::model` knows (checked when read).
     pub error_model: Option<String>,
+    /// From the survey sensors to the bit along the hole, in the tie-on's
+    /// length unit: the survey projects its last station this far ahead.
+    pub sensor_to_bit: Option<f64>,
+}
+
+/// The names and uids of the well and the wellbore the survey belongs to,
+/// as the WITSML trajectory and the figures carry them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WellNames {
+    pub well: String,
+    pub well_uid: String,
+    pub wellbore: String,
+    pub wellbore_uid: String,
+}
+
+impl Default for WellNames {
+    /// Placeholders a reader sees as such.
+    fn default() -> Self {
+        Self {
+            well: "unnamed well".into(),
+            well_uid: "well".into(),
+            wellbore: "unnamed wellbore".into(),
+            wellbore_uid: "wellbore".into(),
+        }
+    }
+}
+
+impl WellEntry {
+    fn checked(self) -> Result<WellNames> {
+        for (key, value) in [
+            ("name", &self.name),
+            ("uid", &self.uid),
+            ("wellbore", &self.wellbore),
+            ("wellbore_uid", &self.wellbore_uid),
+        ] {
+            let trimmed = value.trim();
+            if trimmed.is_empty() || trimmed.len() != value.len() || value.len() > 64 {
+                bail!("well.{key} {value:?}: expected 1 to 64 characters, no spaces at either end");
+            }
+            if value.chars().any(char::is_control) {
+                bail!("well.{key} {value:?}: control characters are not allowed");
+            }
+        }
+        Ok(WellNames {
+            well: self.name,
+            well_uid: self.uid,
+            wellbore: self.wellbore,
+            wellbore_uid: self.wellbore_uid,
+        })
+    }
 }
 
 /// A checked job.
@@ -204,10 +276,19 @@ pub struct Job {
     /// defaults); its ranges are checked by the probe's decoding.
     pub still: Option<StillSettings>,
     pub survey: SurveyJob,
+    pub well: WellNames,
+    /// The well plan (`sim::plan`) a simulated run drills, resolved
+    /// against the job file's folder; checked to exist when read.
+    pub plan: Option<PathBuf>,
 }
 
 /// The range `survey --tie-on-*` takes, in the length unit given.
 const TIE_ON_LIMIT: f64 = 1e6;
+
+/// The longest sensor-to-bit distance taken, m: a bottom-hole assembly
+/// places its survey sensors a few metres to a few tens of metres behind
+/// the bit.
+const SENSOR_TO_BIT_LIMIT_M: f64 = 100.0;
 
 impl SurveyEntry {
     fn checked(self) -> Result<SurveyJob> {
@@ -235,9 +316,16 @@ impl SurveyEntry {
         if let Some(name) = &self.error_model {
             listing::model(name).context("survey.error_model")?;
         }
+        let limit = SENSOR_TO_BIT_LIMIT_M / unit.to_m();
+        if let Some(d) = self.sensor_to_bit {
+            if !(d.is_finite() && (0.0..=limit).contains(&d)) {
+                bail!("survey.sensor_to_bit = {d}: expected 0 to {limit:.0} (the survey's length unit)");
+            }
+        }
         Ok(SurveyJob {
             tie_on,
             error_model: self.error_model,
+            sensor_to_bit: self.sensor_to_bit,
         })
     }
 }
@@ -304,6 +392,22 @@ impl Job {
             })
             .transpose()?;
         let still = entry.still.as_ref().map(StillEntry::narrowed);
+        let well = entry
+            .well
+            .map(WellEntry::checked)
+            .transpose()?
+            .unwrap_or_default();
+        let plan = entry
+            .plan
+            .map(|file| {
+                let path = folder.join(&file);
+                if path.is_file() {
+                    Ok(path)
+                } else {
+                    Err(anyhow::anyhow!("plan: {} is not a file", path.display()))
+                }
+            })
+            .transpose()?;
         let survey = entry
             .survey
             .map(SurveyEntry::checked)
@@ -315,6 +419,8 @@ impl Job {
             calibration,
             still,
             survey,
+            well,
+            plan,
         };
         for (label, command) in job.commands() {
             probe_accepts(&command).with_context(|| format!("the probe would refuse: {label}"))?;
@@ -411,156 +517,4 @@ fn probe_accepts(command: &Command) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const JOB: &str = r#"{"format": "mwd-job", "version": 1,
-        "site": {"latitude_deg": 30.0, "longitude_deg": 270.0, "height_m": 12.5},
-        "tie_in": {"inclination_deg": 88.0, "azimuth_deg": 271.0, "toolface_deg": 15.0,
-                   "inclination_sigma_deg": 0.1, "azimuth_sigma_deg": 1.5,
-                   "toolface_sigma_deg": 0.3}}"#;
-
-    #[test]
-    fn a_job_becomes_the_commands_that_configure_the_probe() {
-        let job = Job::parse(JOB, Path::new(".")).unwrap();
-        assert_eq!(job.site, Position::from_degrees(30.0, -90.0, 12.5));
-        let commands = job.commands();
-        assert_eq!(commands.len(), 4);
-        assert!(matches!(commands[1].1, Command::SetTieIn { .. }));
-        assert!(
-            commands[1].0.contains("271.000 +- 1.500 deg"),
-            "{}",
-            commands[1].0
-        );
-        assert_eq!(
-            commands[3].1,
-            Command::SetCalibration {
-                part: 1,
-                accel: Default::default(),
-                gyro: Default::default()
-            }
-        );
-    }
-
-    #[test]
-    fn bad_jobs_are_refused_with_the_reason() {
-        let refused = |text: &str, needle: &str| {
-            let e = format!("{:#}", Job::parse(text, Path::new(".")).unwrap_err());
-            assert!(e.contains(needle), "{e}");
-        };
-        refused(&JOB.replace("88.0", "0.5"), "vertical");
-        refused(
-            &JOB.replace("\"height_m\": 12.5", "\"height_m\": 1e9"),
-            "height",
-        );
-        refused(&JOB.replace("mwd-job", "other"), "version 1");
-        refused(&JOB.replace("\"site\"", "\"sight\""), "mwd-job v1");
-        refused(
-            &JOB.replace("}}", "}, \"calibration_file\": \"/nonexistent/cal.json\"}"),
-            "cal.json",
-        );
-        let with_survey = |survey: &str| JOB.replace("}}", &format!("}}, \"survey\": {survey}}}"));
-        refused(&with_survey(r#"{"length_unit": "yd"}"#), "\"yd\"");
-        refused(&with_survey(r#"{"tie_on": {"md": 1e7}}"#), "tie_on.md");
-        refused(
-            &with_survey(r#"{"error_model": "NOPE"}"#),
-            "unknown error model",
-        );
-        refused(&with_survey(r#"{"tie_on": {"mdd": 1}}"#), "mdd");
-    }
-
-    const STILL: &str = r#"{"z_enter": 3.5, "z_stay": 6.0, "enter_epochs": 40,
-        "max_station_samples": 1200, "zupt_velocity_sigma": 0.02}"#;
-
-    fn with_still(still: &str) -> String {
-        JOB.replace("}}", &format!("}}, \"still\": {still}}}"))
-    }
-
-    #[test]
-    fn a_jobs_still_settings_are_sent_last_and_only_if_given() {
-        let job = Job::parse(&with_still(STILL), Path::new(".")).unwrap();
-        let expected = StillSettings {
-            z_enter: 3.5,
-            z_stay: 6.0,
-            enter_epochs: 40,
-            max_station_samples: 1200,
-            zupt_velocity_sigma: 0.02,
-        };
-        assert_eq!(job.still, Some(expected));
-        let commands = job.commands();
-        assert_eq!(commands.len(), 5);
-        let (label, command) = &commands[4];
-        assert_eq!(*command, Command::SetStillSettings(expected));
-        assert!(label.contains("enter_epochs 40"), "{label}");
-        let plain = Job::parse(JOB, Path::new(".")).unwrap();
-        assert_eq!(plain.still, None);
-        assert!(plain
-            .commands()
-            .iter()
-            .all(|(_, c)| !matches!(c, Command::SetStillSettings(_))));
-    }
-
-    #[test]
-    fn still_settings_out_of_the_probes_ranges_are_refused_by_name() {
-        let refused = |from: &str, to: &str, needle: &str| {
-            let text = with_still(&STILL.replace(from, to));
-            let e = format!("{:#}", Job::parse(&text, Path::new(".")).unwrap_err());
-            assert!(e.contains(needle), "{from} -> {to}: {e}");
-        };
-        refused(
-            "\"z_enter\": 3.5",
-            "\"z_enter\": 1.5",
-            "still entering quantile",
-        );
-        // Staying must be easier than entering.
-        refused(
-            "\"z_stay\": 6.0",
-            "\"z_stay\": 3.0",
-            "still staying quantile",
-        );
-        refused(
-            "\"enter_epochs\": 40",
-            "\"enter_epochs\": 0",
-            "still entering epochs",
-        );
-        refused(
-            "\"enter_epochs\": 40",
-            "\"enter_epochs\": 70000",
-            "still entering epochs",
-        );
-        refused("1200", "-5", "longest station");
-        refused("1200", "5000000000", "longest station");
-        refused("1200", "100", "longest station");
-        refused("0.02", "2.0", "station ZUPT velocity sigma");
-        refused("0.02", "-0.02", "station ZUPT velocity sigma");
-        refused(", \"zupt_velocity_sigma\": 0.02", "", "zupt_velocity_sigma");
-        refused("\"z_enter\"", "\"z_entre\"", "z_entre");
-        refused("3.5", "\"3.5\"", "expected f64");
-    }
-
-    #[test]
-    fn the_survey_part_is_read_in_its_unit_and_converted() {
-        let job = Job::parse(
-            &JOB.replace(
-                "}}",
-                r#"}, "survey": {"length_unit": "ft", "error_model": "gyro-mwd",
-                      "tie_on": {"md": 1000.0, "north": -10.0}}}"#,
-            ),
-            Path::new("."),
-        )
-        .unwrap();
-        let t = job.survey.tie_on;
-        assert_eq!(
-            (t.unit, t.md, t.north),
-            (LengthUnit::Foot, Some(1000.0), Some(-10.0))
-        );
-        assert_eq!((t.tvd, t.east), (None, None));
-        let m = t.in_unit(LengthUnit::Metre);
-        assert!((m.md.unwrap() - 304.8).abs() < 1e-12, "{m:?}");
-        assert!((m.north.unwrap() + 3.048).abs() < 1e-12, "{m:?}");
-        assert_eq!(t.in_unit(LengthUnit::Foot), t);
-        assert_eq!(job.survey.error_model.as_deref(), Some("gyro-mwd"));
-        let plain = Job::parse(JOB, Path::new(".")).unwrap();
-        assert_eq!(plain.survey, SurveyJob::default());
-    }
-}
+mod tests;
