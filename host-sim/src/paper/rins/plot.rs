@@ -2,7 +2,7 @@
 //! survey figures' renderer (`survey_listing::plot::write_svg_png`).
 
 use super::{Record, Results};
-use crate::formats::figure::{plot_error, write_svg_png, Figure, FONT};
+use crate::formats::figure::{legend_line, plot_error, write_svg_png, Figure, FONT};
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -91,9 +91,7 @@ impl Figure for Lines {
             ))
             .map_err(plot_error)?
             .label("master fails")
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1))
-            });
+            .legend(legend_line(grey.stroke_width(1)));
         for (i, (name, points)) in self.curves.iter().enumerate() {
             let colour = COLOURS[i % COLOURS.len()];
             chart
@@ -103,9 +101,7 @@ impl Figure for Lines {
                 ))
                 .map_err(plot_error)?
                 .label(name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+                .legend(legend_line(colour.stroke_width(2)));
         }
         chart
             .configure_series_labels()

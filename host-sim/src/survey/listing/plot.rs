@@ -12,7 +12,7 @@
 //! the unit vectors (cos A, sin A, 0) and (0, 0, 1), A the section azimuth.
 
 use super::{LengthUnit, Row};
-use crate::formats::figure::{plot_error, prepare_dir, write_svg_png, Figure, FONT};
+use crate::formats::figure::{legend_line, plot_error, prepare_dir, write_svg_png, Figure, FONT};
 use crate::survey::iscwsa::Cov6;
 use anyhow::Result;
 use plotters::coord::Shift;
@@ -190,9 +190,7 @@ impl Figure for Panel {
             ))
             .map_err(plot_error)?
             .label("well path (minimum curvature)")
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], PATH_COLOUR.stroke_width(2))
-            });
+            .legend(legend_line(PATH_COLOUR.stroke_width(2)));
         for (label, points) in &self.others {
             chart
                 .draw_series(LineSeries::new(
@@ -201,9 +199,7 @@ impl Figure for Panel {
                 ))
                 .map_err(plot_error)?
                 .label(label.as_str())
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], OTHER_COLOUR.stroke_width(2))
-                });
+                .legend(legend_line(OTHER_COLOUR.stroke_width(2)));
         }
         if !self.no_cov.is_empty() {
             chart
