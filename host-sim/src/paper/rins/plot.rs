@@ -120,6 +120,18 @@ impl Figure for Lines {
 /// into `dir`, SVG and PNG each; returns the files.
 pub fn write_figures(dir: &Path, r: &Results, failure_hour: f64) -> Result<Vec<PathBuf>> {
     let h = &r.history;
+    // Fig. 4, one per axis: the backup's error along it, the part due to
+    // the azimuth drift and its prediction
+    let fig4 = |axis: &str, y_label: &str, [error, drift, predicted]: [fn(&Record) -> f64; 3]| {
+        Lines::new(
+            &format!("Fig. 4: backup {axis} error and its prediction"),
+            y_label,
+            failure_hour,
+        )
+        .curve("backup error", h, error)
+        .curve("part due to the azimuth drift", h, drift)
+        .curve("prediction (eq. 31)", h, predicted)
+    };
     let figures = [
         (
             "fig3-drift-estimate",
@@ -134,25 +146,19 @@ pub fn write_figures(dir: &Path, r: &Results, failure_hour: f64) -> Result<Vec<P
         ),
         (
             "fig4-latitude",
-            Lines::new(
-                "Fig. 4: backup latitude error and its prediction",
+            fig4(
+                "latitude",
                 "north error (m)",
-                failure_hour,
-            )
-            .curve("backup error", h, |r| r.backup_north)
-            .curve("part due to the azimuth drift", h, |r| r.drift_north)
-            .curve("prediction (eq. 31)", h, |r| r.predicted_north),
+                [|r| r.backup_north, |r| r.drift_north, |r| r.predicted_north],
+            ),
         ),
         (
             "fig4-longitude",
-            Lines::new(
-                "Fig. 4: backup longitude error and its prediction",
+            fig4(
+                "longitude",
                 "east error (m)",
-                failure_hour,
-            )
-            .curve("backup error", h, |r| r.backup_east)
-            .curve("part due to the azimuth drift", h, |r| r.drift_east)
-            .curve("prediction (eq. 31)", h, |r| r.predicted_east),
+                [|r| r.backup_east, |r| r.drift_east, |r| r.predicted_east],
+            ),
         ),
         (
             "fig5-radial",
