@@ -344,7 +344,7 @@ impl SurveyPlot<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::survey::listing::ellipse::Ellipse;
+    use crate::survey::listing::ellipse::{three_by_one_cov, Ellipse};
 
     fn close(a: f64, b: f64, tol: f64) {
         assert!((a - b).abs() <= tol, "{a} vs {b}");
@@ -387,16 +387,7 @@ mod tests {
     #[test]
     fn plan_ellipse_agrees_with_the_listing_ellipse() {
         // major axis at azimuth 60 deg (clockwise from north) in NEV
-        let az = 60f64.to_radians();
-        let (s, c) = az.sin_cos();
-        let cov = [
-            9.0 * c * c + s * s,
-            9.0 * s * s + c * c,
-            4.0,
-            8.0 * c * s,
-            0.0,
-            0.0,
-        ];
+        let cov = three_by_one_cov(60.0, 4.0);
         let e = Ellipse::from_cov(&cov);
         let (xx, yy, xy) = plan_block(&cov);
         let pts = ellipse_outline((0.0, 0.0), xx, yy, xy, SIGMA);
