@@ -350,16 +350,7 @@ pub fn covariance(
         return Ok(Vec::new());
     }
     let md0 = rows[0].md_m;
-    let stations: Vec<Station> = rows[..valid]
-        .iter()
-        .map(|r| Station {
-            md: r.md_m,
-            inc: r.inc_deg.to_radians(),
-            azi: r.azi_deg.to_radians(),
-            tvd: r.tvd_m,
-            toolface: r.input.toolface_deg.map(f64::to_radians),
-        })
-        .collect();
+    let stations: Vec<Station> = rows[..valid].iter().map(Row::iscwsa_station).collect();
     let sig: Vec<AngleSigma> = sigmas[..valid].iter().flatten().copied().collect();
     let angles = angle_covariance(&stations, &sig).map_err(|e| anyhow!("{e}"))?;
     let from_tie_on: Vec<Station> = stations
