@@ -342,9 +342,10 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn toolface_indexing_is_split_into_two_static_segments() {
-        let traj = Trajectory {
+    /// Two 20 s dwells at the paper's site, half a turn of toolface (6 s)
+    /// between them.
+    fn one_toolface_turn() -> Trajectory {
+        Trajectory {
             position: Position::paper_site(),
             start: Euler::new(0.3, -0.1, 0.2),
             motion: Motion::ToolfaceSteps {
@@ -353,7 +354,12 @@ mod tests {
                 dwell: 20.0,
                 steps: 1,
             },
-        };
+        }
+    }
+
+    #[test]
+    fn toolface_indexing_is_split_into_two_static_segments() {
+        let traj = one_toolface_turn();
         let recs = records(traj.clone(), SensorModel::ideal(), traj.scripted_duration());
         let spans = find_segments(&recs);
         assert_eq!(spans.len(), 2, "{spans:?}");
@@ -409,16 +415,7 @@ mod tests {
     /// names every range left out with its reason.
     #[test]
     fn samples_left_out_are_reported() {
-        let traj = Trajectory {
-            position: Position::paper_site(),
-            start: Euler::new(0.3, -0.1, 0.2),
-            motion: Motion::ToolfaceSteps {
-                step: std::f64::consts::PI,
-                turn_rate: 30.0 * DEG,
-                dwell: 20.0,
-                steps: 1,
-            },
-        };
+        let traj = one_toolface_turn();
         let mut recs = records(
             traj.clone(),
             SensorModel::scc1300(3),

@@ -5,7 +5,7 @@
 //! most a short excerpt of the input.
 
 use super::units::InputUnit;
-use crate::formats::samples_csv::Record;
+use crate::formats::samples_csv::{Record, MEASURED_COLUMNS};
 use crate::formats::text_records::for_each_record;
 pub use crate::formats::text_records::{excerpt, name_list};
 use anyhow::{bail, Context, Result};
@@ -217,16 +217,8 @@ fn capture_columns(path: &Path) -> Result<Columns> {
             column.push(value);
         }
     }
-    let names = [
-        "time_s",
-        "gyro_x_rad_s",
-        "gyro_z_rad_s",
-        "accel_x_m_s2",
-        "accel_y_m_s2",
-        "accel_z_m_s2",
-    ];
     Ok(Columns {
-        names: names.iter().map(|n| n.to_string()).collect(),
+        names: MEASURED_COLUMNS.iter().map(|n| n.to_string()).collect(),
         data,
     })
 }

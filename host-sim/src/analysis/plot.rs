@@ -2,7 +2,10 @@
 //! measured points with vertical error bars and model lines, and plain
 //! line plots of time series.
 
+use crate::formats::figure::legend_line;
 use anyhow::{anyhow, Result};
+use plotters::chart::SeriesLabelStyle;
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use std::ops::Range;
 use std::path::Path;
@@ -58,6 +61,31 @@ fn bounds(series: &[Series]) -> Option<((f64, f64), (f64, f64))> {
     (xs.0 < xs.1 && ys.0 <= ys.1).then(|| ((xs.0 / 1.2, xs.1 * 1.2), (ys.0 / 2.0, ys.1 * 2.0)))
 }
 
+/// A chart on `root` with the title and room for the axes' labels
+/// (`x_label_area` pixels below).
+fn chart_builder<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    labels: &Labels,
+    x_label_area: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .caption(labels.title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(x_label_area)
+        .y_label_area_size(80);
+    builder
+}
+
+/// The legend's box (drawn by the caller, where it wants it).
+fn legend<'a, 'b, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &'b mut ChartContext<'a, DB, CT>,
+) -> SeriesLabelStyle<'a, 'b, DB, CT> {
+    let mut style = chart.configure_series_labels();
+    style.background_style(WHITE.mix(0.8)).border_style(BLACK);
+    style
+}
+
 /// Writes a log-log plot of `series` to an SVG file.
 pub fn loglog_svg(path: &Path, labels: &Labels, series: &[Series]) -> Result<()> {
     crate::formats::figure::register_font()?;
@@ -66,11 +94,7 @@ pub fn loglog_svg(path: &Path, labels: &Labels, series: &[Series]) -> Result<()>
     let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
     let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(labels.title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(80)
+    let mut chart = chart_builder(&root, labels, 48)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(|e| err(&e))?;
     chart
@@ -114,16 +138,11 @@ pub fn loglog_svg(path: &Path, labels: &Labels, series: &[Series]) -> Result<()>
                     .draw_series(LineSeries::new(pts, colour.mix(0.6).stroke_width(2)))
                     .map_err(|e| err(&e))?
                     .label(s.name.as_str())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                    });
+                    .legend(legend_line(colour.stroke_width(2)));
             }
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
+    legend(&mut chart)
         .position(SeriesLabelPosition::LowerLeft)
         .draw()
         .map_err(|e| err(&e))?;
@@ -154,11 +173,7 @@ pub fn line_svg(path: &Path, labels: &Labels, x_range: Range<f64>, curves: &[Cur
     let pad = 0.05 * (y1 - y0);
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(labels.title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(80)
+    let mut chart = chart_builder(&root, labels, 44)
         .build_cartesian_2d(x_range, (y0 - pad)..(y1 + pad))
         .map_err(|e| err(&e))?;
     chart
@@ -173,16 +188,9 @@ pub fn line_svg(path: &Path, labels: &Labels, x_range: Range<f64>, curves: &[Cur
             .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))
             .map_err(|e| err(&e))?
             .label(*name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+            .legend(legend_line(colour.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
+    legend(&mut chart).draw().map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }

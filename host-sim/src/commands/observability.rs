@@ -5,22 +5,19 @@
 use anyhow::{ensure, Result};
 use host_sim::alignment::observability::{analyse, Measurements};
 use host_sim::alignment::observability_report::report;
-use host_sim::paper::mgwd::PUBLISHED;
-use mwd_core::conventions::{Euler, DEG};
+use mwd_core::conventions::DEG;
 
-use super::site::SiteArgs;
+use super::site::{AttitudeArgs, SiteArgs};
 
 #[derive(clap::Args, Debug)]
+#[command(
+    mut_arg("roll", |a| a.help("Roll (toolface) of the first segment, degrees")),
+    mut_arg("pitch", |a| a.help("Pitch, degrees")),
+    mut_arg("heading", |a| a.help("Heading, degrees"))
+)]
 pub struct Args {
-    /// Roll (toolface) of the first segment, degrees.
-    #[arg(long, default_value_t = PUBLISHED.coarse_deg[0], allow_hyphen_values = true)]
-    pub roll: f64,
-    /// Pitch, degrees.
-    #[arg(long, default_value_t = PUBLISHED.coarse_deg[1], allow_hyphen_values = true)]
-    pub pitch: f64,
-    /// Heading, degrees.
-    #[arg(long, default_value_t = PUBLISHED.coarse_deg[2], allow_hyphen_values = true)]
-    pub heading: f64,
+    #[command(flatten)]
+    pub attitude: AttitudeArgs,
     #[command(flatten)]
     pub site: SiteArgs,
     /// Toolface offsets of the segments, degrees (e.g. 0,180 for indexing).
@@ -45,7 +42,7 @@ pub fn run(args: Args) -> Result<()> {
         !args.toolfaces.is_empty() && args.toolfaces.len() <= 16,
         "1 to 16 toolface segments"
     );
-    let start = Euler::new(args.roll * DEG, args.pitch * DEG, args.heading * DEG);
+    let start = args.attitude.euler();
     let offsets: Vec<f64> = args.toolfaces.iter().map(|t| t * DEG).collect();
     let a = analyse(
         &start,

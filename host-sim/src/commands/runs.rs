@@ -5,12 +5,39 @@
 
 use anyhow::Context;
 
-/// Worker threads: `--threads`, else all cores.
-pub fn threads(given: Option<u64>) -> usize {
-    given.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    )
+/// Where a study's seeds start and how many threads run them (after its
+/// own `--runs`, whose default and help differ by study).
+#[derive(clap::Args, Debug)]
+pub struct SeedsAndThreads {
+    #[arg(long, default_value_t = 1)]
+    pub first_seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+}
+
+impl SeedsAndThreads {
+    /// Worker threads: `--threads`, else all cores.
+    pub fn threads(&self) -> usize {
+        self.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |t| t as usize,
+        )
+    }
+}
+
+/// A study's results: `table` on standard output and, with `--json`, the
+/// results in that file.
+pub fn print_and_write_json<T: serde::Serialize>(
+    table: &str,
+    json: Option<&std::path::Path>,
+    results: &T,
+) -> anyhow::Result<()> {
+    out!("{table}");
+    if let Some(path) = json {
+        host_sim::formats::files::write_json(path, results)?;
+    }
+    Ok(())
 }
 
 /// A progress bar over `len` runs drawn with `template`.

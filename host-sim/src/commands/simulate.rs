@@ -3,7 +3,6 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
-use host_sim::paper::mgwd::PUBLISHED;
 use host_sim::sim::outputs::{drill, write_samples, LateralOutputs, SampleSink};
 use host_sim::sim::plan::Vibration;
 use host_sim::sim::{
@@ -11,7 +10,7 @@ use host_sim::sim::{
     Trajectory,
 };
 use host_sim::survey::job::Job;
-use mwd_core::conventions::{Euler, DEG};
+use mwd_core::conventions::DEG;
 use mwd_core::earth::Position;
 use mwd_core::probe::TieIn;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
@@ -19,7 +18,7 @@ use nalgebra::Vector3;
 use std::path::PathBuf;
 
 use super::limits::{self, BodyRate};
-use super::site::SiteArgs;
+use super::site::{AttitudeArgs, SiteArgs};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum MotionKind {
@@ -48,15 +47,8 @@ pub enum SensorKind {
 /// Where and how the probe sits and moves (shared with `demo`).
 #[derive(clap::Args, Debug, Clone)]
 pub struct TrajectoryArgs {
-    /// Roll (gravity toolface) at the start, degrees.
-    #[arg(long, default_value_t = PUBLISHED.coarse_deg[0], allow_hyphen_values = true)]
-    pub roll: f64,
-    /// Pitch (tool axis above horizontal), degrees.
-    #[arg(long, default_value_t = PUBLISHED.coarse_deg[1], allow_hyphen_values = true)]
-    pub pitch: f64,
-    /// Heading (azimuth of the tool axis), degrees.
-    #[arg(long, default_value_t = PUBLISHED.coarse_deg[2], allow_hyphen_values = true)]
-    pub heading: f64,
+    #[command(flatten)]
+    pub attitude: AttitudeArgs,
     #[command(flatten)]
     pub site: SiteArgs,
     #[arg(long, value_enum, default_value_t = MotionKind::Static)]
@@ -102,7 +94,7 @@ impl TrajectoryArgs {
         };
         Trajectory {
             position: self.site.position(),
-            start: Euler::new(self.roll * DEG, self.pitch * DEG, self.heading * DEG),
+            start: self.attitude.euler(),
             motion,
         }
     }

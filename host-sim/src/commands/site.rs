@@ -4,6 +4,8 @@
 //! height -15,000..10,000 m (below the deepest well, above the highest
 //! ground).
 use super::limits::number_in;
+use host_sim::paper::mgwd::PUBLISHED;
+use mwd_core::conventions::{Euler, DEG};
 use mwd_core::earth::Position;
 
 /// Latitude range, degrees.
@@ -62,6 +64,29 @@ impl SiteArgs {
     /// The site as the core takes it (radians).
     pub fn position(&self) -> Position {
         Position::from_degrees(self.lat, self.lon, self.height)
+    }
+}
+
+/// How the probe sits at the start (degrees on the command line; by
+/// default the MGWD paper's coarse alignment). A command whose start means
+/// something narrower says so in its own help (`mut_arg`).
+#[derive(clap::Args, Debug, Clone, Copy, PartialEq)]
+pub struct AttitudeArgs {
+    /// Roll (gravity toolface) at the start, degrees.
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[0], allow_hyphen_values = true)]
+    pub roll: f64,
+    /// Pitch (tool axis above horizontal), degrees.
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[1], allow_hyphen_values = true)]
+    pub pitch: f64,
+    /// Heading (azimuth of the tool axis), degrees.
+    #[arg(long, default_value_t = PUBLISHED.coarse_deg[2], allow_hyphen_values = true)]
+    pub heading: f64,
+}
+
+impl AttitudeArgs {
+    /// The attitude as the core takes it (radians).
+    pub fn euler(&self) -> Euler {
+        Euler::new(self.roll * DEG, self.pitch * DEG, self.heading * DEG)
     }
 }
 

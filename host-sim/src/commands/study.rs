@@ -2,9 +2,8 @@
 //! station sigmas over seeded simulated laterals (docs/drilling-survey.md).
 
 use super::limits::{azimuth_sigma_deg, number_in};
-use super::runs::{progress_bar, stop_on_ctrl_c, threads};
+use super::runs::{print_and_write_json, progress_bar, stop_on_ctrl_c, SeedsAndThreads};
 use anyhow::Result;
-use host_sim::formats::files::write_json;
 use host_sim::sim::Plan;
 use host_sim::study::drilling_coverage::{study, table};
 use host_sim::study::drilling_run::{RunConfig, Scalar};
@@ -38,11 +37,8 @@ pub struct CoverageArgs {
     /// Number of runs (seeds first-seed, first-seed + 1, ...).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub runs: u64,
-    #[arg(long, default_value_t = 1)]
-    pub first_seed: u64,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
-    pub threads: Option<u64>,
+    #[command(flatten)]
+    pub seeds: SeedsAndThreads,
     /// 1-sigma of the parent well's azimuth at the tie-in, deg.
     #[arg(long, default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
     pub tie_in_azimuth_sigma_deg: f64,
@@ -82,7 +78,7 @@ fn drilling_coverage(args: CoverageArgs) -> Result<()> {
     )?;
     config.uncalibrated = args.uncalibrated;
     config.scalar = args.scalar;
-    let threads = threads(args.threads);
+    let threads = args.seeds.threads();
     let bar = progress_bar(
         args.runs,
         "{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
@@ -91,7 +87,7 @@ fn drilling_coverage(args: CoverageArgs) -> Result<()> {
     let summary = study(
         &config,
         args.runs as usize,
-        args.first_seed,
+        args.seeds.first_seed,
         threads,
         &|| bar.inc(1),
         &stop,
@@ -101,7 +97,7 @@ fn drilling_coverage(args: CoverageArgs) -> Result<()> {
         "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads, filter {}{})",
         args.plan.display(),
         args.runs,
-        args.first_seed,
+        args.seeds.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
         args.scalar.name(),
@@ -111,10 +107,7 @@ fn drilling_coverage(args: CoverageArgs) -> Result<()> {
             ""
         }
     );
-    out!("{}", table(&summary));
-    if let Some(path) = &args.json {
-        write_json(path, &summary)?;
-    }
+    print_and_write_json(&table(&summary), args.json.as_deref(), &summary)?;
     if let Some(i) = summary.interrupted {
         anyhow::bail!(
             "interrupted after {} of {} runs: the outputs above hold the runs done",
@@ -144,11 +137,8 @@ pub struct RinsProbeArgs {
     /// Runs per grade (seeds first-seed, first-seed + 1, ...).
     #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub runs: u64,
-    #[arg(long, default_value_t = 1)]
-    pub first_seed: u64,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
-    pub threads: Option<u64>,
+    #[command(flatten)]
+    pub seeds: SeedsAndThreads,
     /// Gyro grades (the SCC1300's gyro errors divided by 1, 10, 1000);
     /// default all three.
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -175,7 +165,7 @@ pub struct RinsProbeArgs {
 fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     use host_sim::study::rins_probe::table;
     let plan = Plan::load(&args.plan)?;
-    let threads = threads(args.threads);
+    let threads = args.seeds.threads();
     let mut summaries = Vec::new();
     // One bar per grade: the note goes to standard error.
     let stop = stop_on_ctrl_c(None)?;
@@ -186,7 +176,7 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
         "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads{})",
         args.plan.display(),
         args.runs,
-        args.first_seed,
+        args.seeds.first_seed,
         args.reference_sigma_deg,
         args.reference_stations,
         args.tie_in_azimuth_sigma_deg,
@@ -197,10 +187,7 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
             ""
         }
     );
-    out!("{}", table(&summaries));
-    if let Some(path) = &args.json {
-        write_json(path, &summaries)?;
-    }
+    print_and_write_json(&table(&summaries), args.json.as_deref(), &summaries)?;
     if stop.load(std::sync::atomic::Ordering::Relaxed) {
         anyhow::bail!("interrupted: the outputs above hold the runs done");
     }
@@ -250,7 +237,7 @@ fn rins_probe_grade(
     let summary = study(
         &config,
         args.runs as usize,
-        args.first_seed,
+        args.seeds.first_seed,
         threads,
         &|| bar.inc(1),
         stop,

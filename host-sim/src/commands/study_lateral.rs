@@ -3,7 +3,7 @@
 //! progress bar over every job, the tables, CSV and JSON.
 
 use super::limits::{azimuth_sigma_deg, number_in};
-use super::runs::{progress_bar, stop_on_ctrl_c, threads};
+use super::runs::{progress_bar, stop_on_ctrl_c, SeedsAndThreads};
 use anyhow::{Context, Result};
 use host_sim::formats::files::{write_json, write_text};
 use host_sim::study::drilling_run::Scalar;
@@ -57,11 +57,8 @@ pub struct LateralArgs {
     /// Runs per grade and well (seeds first-seed, first-seed + 1, ...).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub runs: u64,
-    #[arg(long, default_value_t = 1)]
-    pub first_seed: u64,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
-    pub threads: Option<u64>,
+    #[command(flatten)]
+    pub seeds: SeedsAndThreads,
     /// Rate of penetration, m/h (default: the plan's).
     #[arg(long = "rop", value_parser = rop)]
     pub rop_m_per_h: Option<f64>,
@@ -112,12 +109,12 @@ pub fn run(args: LateralArgs) -> Result<()> {
         connection_still_s: args.connection_still_s,
     };
     let wells = wells(&args, &overrides)?;
-    let threads = threads(args.threads);
+    let threads = args.seeds.threads();
     let config = StudyConfig {
         grades,
         wells,
         runs: args.runs as usize,
-        first_seed: args.first_seed,
+        first_seed: args.seeds.first_seed,
         threads,
         tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
         monte_carlo: !args.covariance_only,
@@ -142,7 +139,7 @@ pub fn run(args: LateralArgs) -> Result<()> {
         names.join(", "),
         wells.join(", "),
         runs,
-        args.first_seed,
+        args.seeds.first_seed,
         args.tie_in_azimuth_sigma_deg,
         threads,
         args.scalar.name(),

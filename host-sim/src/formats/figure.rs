@@ -39,6 +39,11 @@ pub fn plot_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>
     anyhow!("drawing: {e}")
 }
 
+/// A line's sample in a legend: 20 pixels of `style`.
+pub fn legend_line(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style)
+}
+
 /// Renders `figure` to `DIR/STEM.svg` and `DIR/STEM.png` (`size` pixels);
 /// returns the two paths.
 pub fn write_svg_png(

@@ -28,7 +28,9 @@ pub struct SimSample {
     pub position_code: Option<u8>,
 }
 
-const MEASURED: [&str; 6] = [
+/// The measured columns, SI units in their names (also the columns a
+/// capture's samples are read as).
+pub const MEASURED_COLUMNS: [&str; 6] = [
     "time_s",
     "gyro_x_rad_s",
     "gyro_z_rad_s",
@@ -66,7 +68,7 @@ pub fn write<W: Write>(mut out: W, samples: impl IntoIterator<Item = SimSample>)
     writeln!(
         out,
         "{},{}{position_header}",
-        MEASURED.join(","),
+        MEASURED_COLUMNS.join(","),
         TRUTH.join(",")
     )?;
     for s in samples {
@@ -165,7 +167,7 @@ struct Header {
 fn parse_header(fields: &[&str]) -> Result<Header> {
     let find = |name: &str| fields.iter().position(|n| *n == name);
     let mut measured = [0usize; 6];
-    for (slot, name) in measured.iter_mut().zip(MEASURED) {
+    for (slot, name) in measured.iter_mut().zip(MEASURED_COLUMNS) {
         *slot = find(name).with_context(|| {
             format!(
                 "not a probe sample CSV: no `{name}` column in the header `{}`",
@@ -215,7 +217,7 @@ mod tests {
         let err = |text: &str| read(text.as_bytes()).unwrap_err().to_string();
         assert!(err("").contains("empty file"));
         assert!(err("a,b,c\n1,2,3\n").contains("no `time_s` column"));
-        let header = MEASURED.join(",");
+        let header = MEASURED_COLUMNS.join(",");
         assert!(err(&format!("{header}\n")).contains("no samples"));
         let bad = format!("{header}\n0.05,1,2,3,4,x\n");
         let e = err(&bad);

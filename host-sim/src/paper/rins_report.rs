@@ -44,13 +44,14 @@ pub fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     let mut row = |what: &str, ours: String, paper: &str| {
         lines.push(format!("{what:<58} {ours:>26} | {paper}"))
     };
+    let pm = |value: f64, sigma: f64| format!("{} +- {}", num(value, 6), num(sigma, 6));
+    let slash = |parts: &[String]| parts.join(" / ");
+    let nums = |values: &[f64], decimals: usize| {
+        slash(&values.iter().map(|&v| num(v, decimals)).collect::<Vec<_>>())
+    };
     row(
         "drift estimate error at failure, reduced (deg/h, 1 sigma)",
-        format!(
-            "{} +- {}",
-            num(red.error_at_failure, 6),
-            num(red.sigma_at_failure, 6)
-        ),
+        pm(red.error_at_failure, red.sigma_at_failure),
         "accuracy 0.00005 (Fig. 3)",
     );
     row(
@@ -60,29 +61,23 @@ pub fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     );
     row(
         "drift estimate error at failure, full (deg/h, 1 sigma)",
-        format!(
-            "{} +- {}",
-            num(full.error_at_failure, 6),
-            num(full.sigma_at_failure, 6)
-        ),
+        pm(full.error_at_failure, full.sigma_at_failure),
         "not given",
     );
     row(
         "reduced error inside 3 sigma, before failure / whole run",
-        format!(
-            "{} / {}",
+        slash(&[
             pct(red.inside_3sigma_before_failure),
-            pct(red.inside_3sigma_run)
-        ),
+            pct(red.inside_3sigma_run),
+        ]),
         "within bounds (Fig. 3)",
     );
     row(
         "full error inside 3 sigma, before failure / whole run",
-        format!(
-            "{} / {}",
+        slash(&[
             pct(full.inside_3sigma_before_failure),
-            pct(full.inside_3sigma_run)
-        ),
+            pct(full.inside_3sigma_run),
+        ]),
         "not given",
     );
     row(
@@ -106,10 +101,12 @@ pub fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     );
     row(
         "  backup compensated, reduced / full filter (m)",
-        format!(
-            "{} / {}",
-            num(m.radial_compensated_reduced_end, 0),
-            num(m.radial_compensated_full_end, 0)
+        nums(
+            &[
+                m.radial_compensated_reduced_end,
+                m.radial_compensated_full_end,
+            ],
+            0,
         ),
         "comparable with master (Fig. 5-6)",
     );
@@ -120,21 +117,19 @@ pub fn report(s: &Scenario, r: &Results, wall: f64) -> String {
     );
     row(
         "largest radial error after failure: master / backup / comp. (m)",
-        format!(
-            "{} / {} / {}",
-            num(m.radial_master_max, 0),
-            num(m.radial_backup_max, 0),
-            num(m.radial_compensated_reduced_max, 0)
+        nums(
+            &[
+                m.radial_master_max,
+                m.radial_backup_max,
+                m.radial_compensated_reduced_max,
+            ],
+            0,
         ),
         "curve only",
     );
     row(
         "cost per step, reduced / full filter (us, this build)",
-        format!(
-            "{} / {}",
-            num(red.micros_per_step, 1),
-            num(full.micros_per_step, 1)
-        ),
+        nums(&[red.micros_per_step, full.micros_per_step], 1),
         "reduced 'relaxes the burden'",
     );
     lines.push(String::new());

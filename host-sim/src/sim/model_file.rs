@@ -137,31 +137,39 @@ impl SensorModelFile {
     /// as AR-model files are.
     pub fn check(&self) -> Result<()> {
         use limits::*;
-        let g = &self.gyro;
-        let a = &self.accel;
-        ARW_DEG_PER_SQRT_H.check("gyro.arw_deg_per_sqrt_h", g.arw_deg_per_sqrt_h)?;
-        GYRO_BIAS_DEG_PER_H.check(
-            "gyro.bias_instability_deg_per_h",
-            g.bias_instability_deg_per_h,
-        )?;
-        CORRELATION_TIME_S.check("gyro.correlation_time_s", g.correlation_time_s)?;
-        GYRO_BIAS_DEG_PER_H.check("gyro.residual_bias_deg_per_h", g.residual_bias_deg_per_h)?;
-        for (i, &b) in g.bias_deg_per_s.iter().enumerate() {
-            GYRO_OFFSET_DEG_PER_S.check(&format!("gyro.bias_deg_per_s[{i}]"), b)?;
+        // a figure against its range, named by its path in the file
+        macro_rules! check {
+            ($range:expr, $part:ident . $field:ident) => {
+                $range.check(
+                    concat!(stringify!($part), ".", stringify!($field)),
+                    self.$part.$field,
+                )?
+            };
         }
-        for (i, &k) in g.scale_factor_ppm.iter().enumerate() {
-            SCALE_FACTOR_PPM.check(&format!("gyro.scale_factor_ppm[{i}]"), k)?;
+        // the same for each element of an array
+        macro_rules! check_each {
+            ($range:expr, $part:ident . $field:ident) => {
+                for (i, &value) in self.$part.$field.iter().enumerate() {
+                    let name = concat!(stringify!($part), ".", stringify!($field));
+                    $range.check(&format!("{name}[{i}]"), value)?;
+                }
+            };
         }
-        VRW_M_PER_S_PER_SQRT_H.check("accel.vrw_m_per_s_per_sqrt_h", a.vrw_m_per_s_per_sqrt_h)?;
-        ACCEL_BIAS_INSTABILITY_M_PER_S2.check(
-            "accel.bias_instability_m_per_s2",
-            a.bias_instability_m_per_s2,
-        )?;
-        CORRELATION_TIME_S.check("accel.correlation_time_s", a.correlation_time_s)?;
-        RESIDUAL_BIAS_MG.check("accel.residual_bias_mg", a.residual_bias_mg)?;
-        for (i, &b) in a.bias_m_per_s2.iter().enumerate() {
-            cal::ACCEL_BIAS_M_S2.check(&format!("accel.bias_m_per_s2[{i}]"), b)?;
-        }
+        check!(ARW_DEG_PER_SQRT_H, gyro.arw_deg_per_sqrt_h);
+        check!(GYRO_BIAS_DEG_PER_H, gyro.bias_instability_deg_per_h);
+        check!(CORRELATION_TIME_S, gyro.correlation_time_s);
+        check!(GYRO_BIAS_DEG_PER_H, gyro.residual_bias_deg_per_h);
+        check_each!(GYRO_OFFSET_DEG_PER_S, gyro.bias_deg_per_s);
+        check_each!(SCALE_FACTOR_PPM, gyro.scale_factor_ppm);
+        check!(VRW_M_PER_S_PER_SQRT_H, accel.vrw_m_per_s_per_sqrt_h);
+        check!(
+            ACCEL_BIAS_INSTABILITY_M_PER_S2,
+            accel.bias_instability_m_per_s2
+        );
+        check!(CORRELATION_TIME_S, accel.correlation_time_s);
+        check!(RESIDUAL_BIAS_MG, accel.residual_bias_mg);
+        check_each!(cal::ACCEL_BIAS_M_S2, accel.bias_m_per_s2);
+        let (g, a) = (&self.gyro, &self.accel);
         for (r, row) in a.scale_misalignment.iter().enumerate() {
             for (c, &k) in row.iter().enumerate() {
                 let range = if r == c {

@@ -6,8 +6,8 @@
 //! (95 +- 3 %), TD inside the predicted 95 % horizontal ellipse
 //! (95 +- 3 % of runs).
 
-use super::drilling_run::{run, RunConfig, RunOutcome};
-use super::stats::{median, rms};
+use super::drilling_run::{failures, outcomes, run, RunConfig, RunOutcome};
+use super::stats::{rms, rms_and_median_sigma};
 use super::Interruption;
 use crate::survey::listing::drilling::station_valid;
 use crate::survey::listing::ellipse::scale_2d;
@@ -135,14 +135,8 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
     let k2 = scale_2d(0.95).powi(2);
     let mut unchecked: std::collections::BTreeMap<String, usize> = Default::default();
     let mut by_station: std::collections::BTreeMap<u16, StationTally> = Default::default();
-    for (_, r) in results {
-        let o = match r {
-            Ok(o) => o,
-            Err(e) => {
-                s.failed_runs.push(e.clone());
-                continue;
-            }
-        };
+    s.failed_runs = failures(results);
+    for o in outcomes(results) {
         s.samples += o.samples;
         for st in &o.stations {
             s.stations += 1;
@@ -180,17 +174,7 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
                 inside[3] += usize::from(t.d2 <= k2);
                 td.push(t.error_ne[0].hypot(t.error_ne[1]));
             }
-            (None, note) => {
-                let reason = note.clone().unwrap_or_else(|| "unknown".into());
-                // group by the reason's kind, not its numbers
-                let key = reason.split(':').next().unwrap_or("").to_string();
-                let key = if key.starts_with("last station at MD") {
-                    "last station not at TD".to_string()
-                } else {
-                    key
-                };
-                *unchecked.entry(key).or_default() += 1;
-            }
+            (None, _) => *unchecked.entry(o.td_unchecked_kind()).or_default() += 1,
         }
     }
     s.inclination_within_2_sigma = Fraction::of(inside[0], totals[0]);
@@ -218,14 +202,6 @@ struct StationTally {
     /// (error, its sigma), deg: toolface, determined azimuth.
     toolface: Vec<(f64, f64)>,
     azimuth: Vec<(f64, f64)>,
-}
-
-/// The RMS of the errors and the median of the sigmas of (error, sigma)
-/// pairs.
-fn rms_and_median_sigma(pairs: &[(f64, f64)]) -> (Option<f64>, Option<f64>) {
-    let errors: Vec<f64> = pairs.iter().map(|(e, _)| *e).collect();
-    let sigmas: Vec<f64> = pairs.iter().map(|(_, s)| *s).collect();
-    (rms(&errors), median(&sigmas))
 }
 
 impl StationTally {

@@ -265,6 +265,32 @@ impl RunOutcome {
     pub fn method_td_error_m(&self) -> Option<f64> {
         self.method_td_error_ne.map(|[n, e]| n.hypot(e))
     }
+
+    /// Why the TD was not checked, by the reason's kind, not its numbers:
+    /// the summaries count the runs by it.
+    pub fn td_unchecked_kind(&self) -> String {
+        let reason = self.td_note.as_deref().unwrap_or("unknown");
+        if reason.starts_with("last station at MD") {
+            "last station not at TD".to_string()
+        } else {
+            reason.split(':').next().unwrap_or("").to_string()
+        }
+    }
+}
+
+/// The runs of a study that gave an outcome, in seed order.
+pub fn outcomes(
+    results: &[(u64, Result<RunOutcome, String>)],
+) -> impl Iterator<Item = &RunOutcome> {
+    results.iter().filter_map(|(_, r)| r.as_ref().ok())
+}
+
+/// The errors of the runs of a study that failed, in seed order.
+pub fn failures(results: &[(u64, Result<RunOutcome, String>)]) -> Vec<String> {
+    results
+        .iter()
+        .filter_map(|(_, r)| r.as_ref().err().cloned())
+        .collect()
 }
 
 /// The calling thread's CPU time so far (s): Linux's

@@ -21,6 +21,14 @@ pub fn median(values: &[f64]) -> Option<f64> {
     percentile(values, 0.5)
 }
 
+/// The RMS of the errors and the median of the sigmas of (error, sigma)
+/// pairs.
+pub fn rms_and_median_sigma(pairs: &[(f64, f64)]) -> (Option<f64>, Option<f64>) {
+    let errors: Vec<f64> = pairs.iter().map(|(e, _)| *e).collect();
+    let sigmas: Vec<f64> = pairs.iter().map(|(_, s)| *s).collect();
+    (rms(&errors), median(&sigmas))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

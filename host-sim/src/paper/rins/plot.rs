@@ -2,7 +2,7 @@
 //! survey figures' renderer (`survey_listing::plot::write_svg_png`).
 
 use super::{Record, Results};
-use crate::formats::figure::{plot_error, write_svg_png, Figure, FONT};
+use crate::formats::figure::{legend_line, plot_error, write_svg_png, Figure, FONT};
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -91,9 +91,7 @@ impl Figure for Lines {
             ))
             .map_err(plot_error)?
             .label("master fails")
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1))
-            });
+            .legend(legend_line(grey.stroke_width(1)));
         for (i, (name, points)) in self.curves.iter().enumerate() {
             let colour = COLOURS[i % COLOURS.len()];
             chart
@@ -103,9 +101,7 @@ impl Figure for Lines {
                 ))
                 .map_err(plot_error)?
                 .label(name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+                .legend(legend_line(colour.stroke_width(2)));
         }
         chart
             .configure_series_labels()
@@ -124,6 +120,18 @@ impl Figure for Lines {
 /// into `dir`, SVG and PNG each; returns the files.
 pub fn write_figures(dir: &Path, r: &Results, failure_hour: f64) -> Result<Vec<PathBuf>> {
     let h = &r.history;
+    // Fig. 4, one per axis: the backup's error along it, the part due to
+    // the azimuth drift and its prediction
+    let fig4 = |axis: &str, y_label: &str, [error, drift, predicted]: [fn(&Record) -> f64; 3]| {
+        Lines::new(
+            &format!("Fig. 4: backup {axis} error and its prediction"),
+            y_label,
+            failure_hour,
+        )
+        .curve("backup error", h, error)
+        .curve("part due to the azimuth drift", h, drift)
+        .curve("prediction (eq. 31)", h, predicted)
+    };
     let figures = [
         (
             "fig3-drift-estimate",
@@ -138,25 +146,19 @@ pub fn write_figures(dir: &Path, r: &Results, failure_hour: f64) -> Result<Vec<P
         ),
         (
             "fig4-latitude",
-            Lines::new(
-                "Fig. 4: backup latitude error and its prediction",
+            fig4(
+                "latitude",
                 "north error (m)",
-                failure_hour,
-            )
-            .curve("backup error", h, |r| r.backup_north)
-            .curve("part due to the azimuth drift", h, |r| r.drift_north)
-            .curve("prediction (eq. 31)", h, |r| r.predicted_north),
+                [|r| r.backup_north, |r| r.drift_north, |r| r.predicted_north],
+            ),
         ),
         (
             "fig4-longitude",
-            Lines::new(
-                "Fig. 4: backup longitude error and its prediction",
+            fig4(
+                "longitude",
                 "east error (m)",
-                failure_hour,
-            )
-            .curve("backup error", h, |r| r.backup_east)
-            .curve("part due to the azimuth drift", h, |r| r.drift_east)
-            .curve("prediction (eq. 31)", h, |r| r.predicted_east),
+                [|r| r.backup_east, |r| r.drift_east, |r| r.predicted_east],
+            ),
         ),
         (
             "fig5-radial",

@@ -396,7 +396,10 @@ mod tests {
     use super::*;
     use crate::sim::plan::{DrillingParams, Plan, Section, Site, TieOnSpec, Vibration};
 
-    fn plan() -> BuiltPlan {
+    /// A hold to `hold_end_md_m` at `hold_toolface_deg`, then a 6 deg/30 m
+    /// curve to 92 deg inclination and `curve_azimuth_deg`, in stands of
+    /// 9 m with 60 s still at each connection.
+    fn hold_then_curve(hold_end_md_m: f64, hold_toolface_deg: f64, curve_azimuth_deg: f64) -> Plan {
         Plan {
             site: Site::default(),
             tie_on: TieOnSpec {
@@ -409,13 +412,13 @@ mod tests {
             },
             sections: vec![
                 Section::Hold {
-                    end_md_m: 3010.0,
-                    toolface_deg: 20.0,
+                    end_md_m: hold_end_md_m,
+                    toolface_deg: hold_toolface_deg,
                 },
                 Section::Curve {
                     dls_deg_per_30m: 6.0,
                     inclination_deg: 92.0,
-                    azimuth_deg: 14.0,
+                    azimuth_deg: curve_azimuth_deg,
                 },
             ],
             drilling: DrillingParams {
@@ -426,8 +429,12 @@ mod tests {
                 ..DrillingParams::default()
             },
         }
-        .build()
-        .expect("valid plan")
+    }
+
+    fn plan() -> BuiltPlan {
+        hold_then_curve(3010.0, 20.0, 14.0)
+            .build()
+            .expect("valid plan")
     }
 
     #[test]
@@ -460,30 +467,7 @@ mod tests {
         // The boundary 0.01 m into the second stand: the turn from
         // toolface 150 deg to the build's 0 deg (15 s) starts at the
         // connection, before drilling resumes.
-        let p = plan();
-        let mut plan = Plan {
-            site: Site::default(),
-            tie_on: TieOnSpec {
-                md_m: 3000.0,
-                tvd_m: 2000.0,
-                north_m: 0.0,
-                east_m: 0.0,
-                inclination_deg: 90.0,
-                azimuth_deg: 10.0,
-            },
-            sections: vec![
-                Section::Hold {
-                    end_md_m: 3009.01,
-                    toolface_deg: 150.0,
-                },
-                Section::Curve {
-                    dls_deg_per_30m: 6.0,
-                    inclination_deg: 92.0,
-                    azimuth_deg: 10.0,
-                },
-            ],
-            drilling: p.drilling,
-        };
+        let mut plan = hold_then_curve(3009.01, 150.0, 10.0);
         plan.drilling.toolface_change_per_connection_deg = 0.0;
         plan.drilling.sliding_toolface_steps_per_hour = 0.0;
         let sim = Drilling::new(plan.build().expect("valid"), 1);

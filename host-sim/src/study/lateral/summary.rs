@@ -14,8 +14,8 @@ use super::consistency::{azimuth_consistency, AzimuthConsistency};
 use super::correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::stations::{station_rows, StationRow};
 use crate::study::drilling_coverage::Fraction;
-use crate::study::drilling_run::RunOutcome;
-use crate::study::stats::{median, percentile, rms};
+use crate::study::drilling_run::{failures, outcomes, RunOutcome};
+use crate::study::stats::{percentile, rms, rms_and_median_sigma};
 use crate::survey::listing::drilling::station_valid;
 use crate::survey::listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
@@ -176,32 +176,29 @@ struct Tally {
 
 impl Tally {
     fn along(&self, station: u16) -> AlongMd {
-        let errors: Vec<f64> = self.azimuth.iter().map(|a| a.0).collect();
-        let sigmas: Vec<f64> = self.azimuth.iter().map(|a| a.1).collect();
-        let inside = self.azimuth.iter().filter(|(e, s)| *e <= 2.0 * s).count();
-        let inc_errors: Vec<f64> = self.inclination.iter().map(|a| a.0).collect();
-        let inc_sigmas: Vec<f64> = self.inclination.iter().map(|a| a.1).collect();
-        let inc_inside = self
-            .inclination
-            .iter()
-            .filter(|(e, s)| *e <= 2.0 * s)
-            .count();
-        let radial: Vec<f64> = self.position.iter().map(|p| p.0).collect();
-        let predicted: Vec<f64> = self.position.iter().map(|p| p.1).collect();
+        let within_2_sigma = |pairs: &[(f64, f64)]| {
+            let inside = pairs.iter().filter(|(e, s)| *e <= 2.0 * s).count();
+            Fraction::of(inside, pairs.len())
+        };
+        let (rms_azimuth_error_deg, median_azimuth_sigma_deg) = rms_and_median_sigma(&self.azimuth);
+        let (rms_inclination_error_deg, median_inclination_sigma_deg) =
+            rms_and_median_sigma(&self.inclination);
+        let (rms_horizontal_error_m, median_horizontal_sigma_m) =
+            rms_and_median_sigma(&self.position);
         AlongMd {
             station,
             truth_md_m: self.md.iter().sum::<f64>() / self.md.len().max(1) as f64,
             stations: self.md.len(),
             azimuth_undetermined: self.undetermined,
-            rms_azimuth_error_deg: rms(&errors),
-            median_azimuth_sigma_deg: median(&sigmas),
-            azimuth_within_2_sigma: Fraction::of(inside, self.azimuth.len()),
-            rms_inclination_error_deg: rms(&inc_errors),
-            median_inclination_sigma_deg: median(&inc_sigmas),
-            inclination_within_2_sigma: Fraction::of(inc_inside, self.inclination.len()),
+            rms_azimuth_error_deg,
+            median_azimuth_sigma_deg,
+            azimuth_within_2_sigma: within_2_sigma(&self.azimuth),
+            rms_inclination_error_deg,
+            median_inclination_sigma_deg,
+            inclination_within_2_sigma: within_2_sigma(&self.inclination),
             positioned: self.position.len(),
-            rms_horizontal_error_m: rms(&radial),
-            median_horizontal_sigma_m: median(&predicted),
+            rms_horizontal_error_m,
+            median_horizontal_sigma_m,
             station_correction_ratio: None,
             drilling_growth_ratio: None,
             start_error_ratio: None,
@@ -234,14 +231,8 @@ pub fn summarise(
     let mut unchecked: BTreeMap<String, usize> = BTreeMap::new();
     let mut by_station: BTreeMap<u16, Tally> = BTreeMap::new();
     let mut cpu = Some(0.0);
-    for (_, r) in results {
-        let o = match r {
-            Ok(o) => o,
-            Err(e) => {
-                s.failed_runs.push(e.clone());
-                continue;
-            }
-        };
+    s.failed_runs = failures(results);
+    for o in outcomes(results) {
         s.samples += o.samples;
         s.run_wall_s += o.elapsed_s;
         cpu = cpu.zip(o.cpu_s).map(|(a, b)| a + b);
@@ -297,16 +288,7 @@ pub fn summarise(
                     method_sigma.push(own.sigma_horizontal());
                 }
             }
-            (None, note) => {
-                let reason = note.clone().unwrap_or_else(|| "unknown".into());
-                // by the reason's kind, not its numbers
-                let key = if reason.starts_with("last station at MD") {
-                    "last station not at TD".to_string()
-                } else {
-                    reason.split(':').next().unwrap_or("").to_string()
-                };
-                *unchecked.entry(key).or_default() += 1;
-            }
+            (None, _) => *unchecked.entry(o.td_unchecked_kind()).or_default() += 1,
         }
     }
     s.rms_station_inclination_deg = rms(&inc);
@@ -333,11 +315,9 @@ pub fn summarise(
         method_rms_error_m: rms(&method_err),
         method_predicted_1_sigma_m: rms(&method_sigma),
     };
-    s.azimuth_correlation =
-        azimuth_lag_correlations(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
+    s.azimuth_correlation = azimuth_lag_correlations(outcomes(results));
     let by_number;
-    (s.azimuth_consistency, by_number) =
-        azimuth_consistency(results.iter().filter_map(|(_, r)| r.as_ref().ok()));
+    (s.azimuth_consistency, by_number) = azimuth_consistency(outcomes(results));
     s.td_unchecked = unchecked.into_iter().collect();
     s.along_md = by_station
         .iter()

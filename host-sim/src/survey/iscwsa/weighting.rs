@@ -38,6 +38,16 @@ pub(super) fn weighting(
         singular: None,
     };
     let vertical = s.inc < site.vertical_limit;
+    // the XY misalignments: dI = f |cos I| c, dA = f |cos I| d / sin I
+    // (0 at vertical, where `singular` stands in)
+    let xy_misalignment = |f: f64, c: f64, d: f64, singular: [f64; 3]| Weight {
+        w: [
+            0.0,
+            f * ci.abs() * c,
+            if vertical { 0.0 } else { f * ci.abs() * d / si },
+        ],
+        singular: Some(singular),
+    };
     Some(match name {
         "DREF" => w(1.0, 0.0, 0.0),
         "DSF" => w(s.md, 0.0, 0.0),
@@ -94,35 +104,15 @@ pub(super) fn weighting(
         ),
         "XYM1" => w(0.0, si.abs(), 0.0),
         "XYM2" => w(0.0, 0.0, -1.0),
+        // XYM4 is XYM3 with the azimuth turned by 90 deg (cos A -> sin A,
+        // -sin A -> cos A) and the other horizontal singularity
         "XYM3" | "XYM3L" | "XYM3E" => {
             let f = enhanced(name, course);
-            Weight {
-                w: [
-                    0.0,
-                    f * ci.abs() * cat,
-                    if vertical {
-                        0.0
-                    } else {
-                        -f * ci.abs() * sat / si
-                    },
-                ],
-                singular: Some([f, 0.0, 0.0]),
-            }
+            xy_misalignment(f, cat, -sat, [f, 0.0, 0.0])
         }
         "XYM4" | "XYM4L" | "XYM4E" => {
             let f = enhanced(name, course);
-            Weight {
-                w: [
-                    0.0,
-                    f * ci.abs() * sat,
-                    if vertical {
-                        0.0
-                    } else {
-                        f * ci.abs() * cat / si
-                    },
-                ],
-                singular: Some([0.0, f, 0.0]),
-            }
+            xy_misalignment(f, sat, cat, [0.0, f, 0.0])
         }
         // this probe's gyrocompass, valid through 90 deg (probe_weighting.rs)
         p if p.starts_with("PRB-") => Weight {

@@ -437,16 +437,7 @@ pub fn covariance(
     }
     let ahead = ahead.filter(|_| valid == rows.len());
     let md0 = rows[0].md_m;
-    let mut stations: Vec<Station> = rows[..valid]
-        .iter()
-        .map(|r| Station {
-            md: r.md_m,
-            inc: r.inc_deg.to_radians(),
-            azi: r.azi_deg.to_radians(),
-            tvd: r.tvd_m,
-            toolface: r.input.toolface_deg.map(f64::to_radians),
-        })
-        .collect();
+    let mut stations: Vec<Station> = rows[..valid].iter().map(Row::iscwsa_station).collect();
     let sig: Vec<AngleSigma> = sigmas[..valid].iter().flatten().copied().collect();
     let angles = match ahead {
         Some(d) => angle_covariance_ahead(&stations, &sig, d),

@@ -60,6 +60,22 @@ pub fn scale_2d(p: f64) -> f64 {
     (-2.0 * (1.0 - p).ln()).sqrt()
 }
 
+/// A test covariance: the horizontal ellipse R diag(9, 1) R^T, semi-axes
+/// 3 and 1 m with the major axis (cos a, sin a) in (N, E) at azimuth
+/// `azimuth_deg`, and `vv` vertical.
+#[cfg(test)]
+pub(crate) fn three_by_one_cov(azimuth_deg: f64, vv: f64) -> [f64; 6] {
+    let (s, c) = azimuth_deg.to_radians().sin_cos();
+    [
+        9.0 * c * c + s * s,
+        9.0 * s * s + c * c,
+        vv,
+        8.0 * c * s,
+        0.0,
+        0.0,
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -93,30 +109,14 @@ mod tests {
 
     #[test]
     fn orientation_of_a_rotated_ellipse() {
-        // semi-axes 3 and 1 with the major axis at azimuth a: the covariance
-        // is R diag(9, 1) R^T with the axis (cos a, sin a) in (N, E).
         for a_deg in [0.0, 10.0, 60.0, 90.0, 135.0, 179.0] {
-            let a = f64::to_radians(a_deg);
-            let (c, s) = (a.cos(), a.sin());
-            let nn = 9.0 * c * c + s * s;
-            let ee = 9.0 * s * s + c * c;
-            let ne = 8.0 * c * s;
-            let e = Ellipse::from_cov(&[nn, ee, 1.0, ne, 0.0, 0.0]);
+            let e = Ellipse::from_cov(&three_by_one_cov(a_deg, 1.0));
             close(e.semi_major, 3.0, 1e-9);
             close(e.semi_minor, 1.0, 1e-9);
             close(e.azimuth_deg, a_deg, 1e-9);
         }
         // the same axis given as 190 deg folds to 10 deg
-        let a = f64::to_radians(190.0);
-        let (c, s) = (a.cos(), a.sin());
-        let e = Ellipse::from_cov(&[
-            9.0 * c * c + s * s,
-            9.0 * s * s + c * c,
-            0.0,
-            8.0 * c * s,
-            0.0,
-            0.0,
-        ]);
+        let e = Ellipse::from_cov(&three_by_one_cov(190.0, 0.0));
         close(e.azimuth_deg, 10.0, 1e-9);
     }
 

@@ -290,16 +290,7 @@ pub fn apply_model(
             .map(|reason| Invalid { station: k, reason })
     });
     let valid_to = invalid.as_ref().map_or(rows.len(), |i| i.station);
-    let stations: Vec<iscwsa::Station> = rows[..valid_to]
-        .iter()
-        .map(|r| iscwsa::Station {
-            md: r.md_m,
-            inc: r.inc_deg.to_radians(),
-            azi: r.azi_deg.to_radians(),
-            tvd: r.tvd_m,
-            toolface: r.input.toolface_deg.map(f64::to_radians),
-        })
-        .collect();
+    let stations: Vec<iscwsa::Station> = rows[..valid_to].iter().map(Row::iscwsa_station).collect();
     if !stations.is_empty() {
         iscwsa::check_stations(&stations).map_err(|e| anyhow!("{e}"))?;
         let result = iscwsa::run(terms, &stations, site);

@@ -12,7 +12,7 @@
 //! the unit vectors (cos A, sin A, 0) and (0, 0, 1), A the section azimuth.
 
 use super::{LengthUnit, Row};
-use crate::formats::figure::{plot_error, prepare_dir, write_svg_png, Figure, FONT};
+use crate::formats::figure::{legend_line, plot_error, prepare_dir, write_svg_png, Figure, FONT};
 use crate::survey::iscwsa::Cov6;
 use anyhow::Result;
 use plotters::coord::Shift;
@@ -190,9 +190,7 @@ impl Figure for Panel {
             ))
             .map_err(plot_error)?
             .label("well path (minimum curvature)")
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], PATH_COLOUR.stroke_width(2))
-            });
+            .legend(legend_line(PATH_COLOUR.stroke_width(2)));
         for (label, points) in &self.others {
             chart
                 .draw_series(LineSeries::new(
@@ -201,9 +199,7 @@ impl Figure for Panel {
                 ))
                 .map_err(plot_error)?
                 .label(label.as_str())
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], OTHER_COLOUR.stroke_width(2))
-                });
+                .legend(legend_line(OTHER_COLOUR.stroke_width(2)));
         }
         if !self.no_cov.is_empty() {
             chart
@@ -348,7 +344,7 @@ impl SurveyPlot<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::survey::listing::ellipse::Ellipse;
+    use crate::survey::listing::ellipse::{three_by_one_cov, Ellipse};
 
     fn close(a: f64, b: f64, tol: f64) {
         assert!((a - b).abs() <= tol, "{a} vs {b}");
@@ -391,16 +387,7 @@ mod tests {
     #[test]
     fn plan_ellipse_agrees_with_the_listing_ellipse() {
         // major axis at azimuth 60 deg (clockwise from north) in NEV
-        let az = 60f64.to_radians();
-        let (s, c) = az.sin_cos();
-        let cov = [
-            9.0 * c * c + s * s,
-            9.0 * s * s + c * c,
-            4.0,
-            8.0 * c * s,
-            0.0,
-            0.0,
-        ];
+        let cov = three_by_one_cov(60.0, 4.0);
         let e = Ellipse::from_cov(&cov);
         let (xx, yy, xy) = plan_block(&cov);
         let pts = ellipse_outline((0.0, 0.0), xx, yy, xy, SIGMA);

@@ -5,7 +5,7 @@
 
 use super::ellipse::Ellipse;
 use crate::formats::station_csv::{InputStation, StationFile};
-use crate::survey::iscwsa::Cov6;
+use crate::survey::iscwsa::{self, Cov6};
 use anyhow::{anyhow, bail, Context, Result};
 use mwd_core::survey::{positions, GridConvergence, Station, TieOn, TrueNorth};
 use nalgebra::Matrix3;
@@ -48,6 +48,17 @@ pub struct Row {
 impl Row {
     pub fn ellipse(&self) -> Option<Ellipse> {
         self.cov.as_ref().map(Ellipse::from_cov)
+    }
+
+    /// The station as the ISCWSA model takes it (radians).
+    pub fn iscwsa_station(&self) -> iscwsa::Station {
+        iscwsa::Station {
+            md: self.md_m,
+            inc: self.inc_deg.to_radians(),
+            azi: self.azi_deg.to_radians(),
+            tvd: self.tvd_m,
+            toolface: self.input.toolface_deg.map(f64::to_radians),
+        }
     }
 }
 

@@ -293,37 +293,24 @@ mod tests {
         }
     }
 
+    /// Five stations 100 m apart down a vertical well `north_m` north of
+    /// the origin, each with the covariance `cov`.
+    fn vertical_well(north_m: f64, cov: Cov6) -> Vec<Row> {
+        (0..5)
+            .map(|i| {
+                let md = 100.0 * f64::from(i);
+                row(md, 0.0, 0.0, north_m, 0.0, md, Some(cov))
+            })
+            .collect()
+    }
+
     #[test]
     fn parallel_vertical_wells_hand_computed() {
         // reference at the origin, offset 10 m north; both vertical
         let c_ref = [4.0, 1.0, 9.0, 0.5, 0.0, 0.0];
         let c_off = [2.25, 3.0, 16.0, -0.5, 0.0, 0.0];
-        let reference: Vec<Row> = (0..5)
-            .map(|i| {
-                row(
-                    100.0 * f64::from(i),
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    100.0 * f64::from(i),
-                    Some(c_ref),
-                )
-            })
-            .collect();
-        let offset: Vec<Row> = (0..5)
-            .map(|i| {
-                row(
-                    100.0 * f64::from(i),
-                    0.0,
-                    0.0,
-                    10.0,
-                    0.0,
-                    100.0 * f64::from(i),
-                    Some(c_off),
-                )
-            })
-            .collect();
+        let reference = vertical_well(0.0, c_ref);
+        let offset = vertical_well(10.0, c_off);
         let seps = separations(&reference, &offset, &rule()).unwrap();
         for (r, s) in reference.iter().zip(&seps) {
             assert!((s.ctc_m - 10.0).abs() < 1e-9, "{}", s.ctc_m);
