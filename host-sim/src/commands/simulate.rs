@@ -9,6 +9,7 @@ use host_sim::sim::{
     DeterministicErrors, Drilling, Motion, Plan, SensorModel, SensorModelFile, SensorSimulator,
     Trajectory,
 };
+use host_sim::formats::capture::ProbeSetup;
 use host_sim::survey::job::Job;
 use mwd_core::conventions::DEG;
 use mwd_core::earth::Position;
@@ -264,8 +265,7 @@ fn sample_sink(args: &Args, site: Position) -> Result<SampleSink<'_>> {
             let tie_in = tie_in(args)?;
             SampleSink::Capture {
                 path: output,
-                site,
-                tie_in,
+                probe: ProbeSetup { tie_in, ..ProbeSetup::at(site) },
             }
         }
         OutputFormat::Csv if to_stdout => SampleSink::Stdout,

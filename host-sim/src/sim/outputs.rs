@@ -6,13 +6,12 @@
 //! kept).
 
 use crate::formats::files::{create_buffered, is_broken_pipe};
+use crate::formats::capture::ProbeSetup;
 use crate::formats::{capture, samples_csv};
 use crate::sim::stream::SensorStreamWriter;
 use crate::sim::{Drilling, DrillingSimulator, SensorModel, SimSample, Truth};
 use anyhow::{Context, Result};
 use mwd_core::conventions::DEG;
-use mwd_core::earth::Position;
-use mwd_core::probe::TieIn;
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -22,11 +21,7 @@ use std::path::{Path, PathBuf};
 pub enum SampleSink<'a> {
     /// A capture (`.bin`) of a probe at `site` (tied in to `tie_in`): a
     /// boot event, then raw-sample and navigation frames.
-    Capture {
-        path: &'a Path,
-        site: Position,
-        tie_in: Option<TieIn>,
-    },
+    Capture { path: &'a Path, probe: ProbeSetup },
     /// A sample CSV file.
     Csv(&'a Path),
     /// The sample CSV on standard output; a reader that stopped (`| head`)
@@ -38,7 +33,7 @@ pub enum SampleSink<'a> {
 /// a CSV).
 pub fn write_samples(sink: SampleSink, samples: impl Iterator<Item = SimSample>) -> Result<u64> {
     match sink {
-        SampleSink::Capture { path, site, tie_in } => write_capture(path, samples, site, tie_in),
+        SampleSink::Capture { path, probe } => write_capture(path, samples, &probe),
         SampleSink::Csv(path) => {
             write_csv(path, samples)?;
             Ok(0)
@@ -55,12 +50,11 @@ pub fn write_samples(sink: SampleSink, samples: impl Iterator<Item = SimSample>)
 fn write_capture(
     path: &Path,
     samples: impl Iterator<Item = SimSample>,
-    site: Position,
-    tie_in: Option<TieIn>,
+    probe: &ProbeSetup,
 ) -> Result<u64> {
     let mut capture =
         capture::create_capture(path).with_context(|| format!("creating {}", path.display()))?;
-    capture::write_simulated_probe(&mut capture, samples, site, tie_in)?;
+    capture::write_simulated_probe(&mut capture, samples, probe)?;
     let bytes = capture.bytes_written();
     capture.finish()?;
     Ok(bytes)

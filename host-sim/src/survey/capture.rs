@@ -6,6 +6,7 @@
 //! trajectory from the 20 Hz solutions ([`drilling::trajectory`]).
 //! docs/drilling-survey.md.
 
+pub use crate::formats::capture::ProbeSetup;
 use crate::formats::capture::{Item, ProbeCaptureFile};
 use crate::formats::depth_log::DepthLog;
 use crate::formats::files::read_depth_log;
@@ -16,22 +17,9 @@ use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
 use crate::survey::well_survey::WellSurvey;
 use crate::survey::stations::{StationCollector, SurveySetup};
 use anyhow::{Context, Result};
-use mwd_core::calibration::ProbeCalibration;
-use mwd_core::earth::Position;
-use mwd_core::probe::{StationLink, TieIn};
-use mwd_core::protocol::uplink::StillSettings;
+use mwd_core::probe::StationLink;
 use mwd_core::protocol::{DecoderStats, Frame, Payload};
 use std::path::{Path, PathBuf};
-
-/// What a capture's replay needs of the probe's configuration: the site,
-/// the calibration, still settings and tie-in it ran with.
-#[derive(Clone, Copy, Debug)]
-pub struct ProbeSetup {
-    pub site: Position,
-    pub calibration: ProbeCalibration,
-    pub still: StillSettings,
-    pub tie_in: Option<TieIn>,
-}
 
 /// A capture survey's inputs.
 #[derive(Clone, Debug)]

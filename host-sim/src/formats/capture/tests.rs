@@ -75,7 +75,7 @@ fn a_saturated_gyro_is_flagged_as_the_driver_flags_it_and_samples_are_stamped_n_
     )
     .take(3);
     let mut w = CaptureWriter::new(Vec::new());
-    write_simulated_probe(&mut w, samples, Position::paper_site(), None).unwrap();
+    write_simulated_probe(&mut w, samples, &ProbeSetup::at(Position::paper_site())).unwrap();
     let cap = decode_bytes(&w.finish().unwrap());
     let stamps: Vec<u64> = cap
         .frames

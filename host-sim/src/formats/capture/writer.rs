@@ -6,8 +6,11 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use anyhow::Context;
+use mwd_core::calibration::ProbeCalibration;
+use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;
 use mwd_core::probe::{Navigator, TieIn};
+use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::bytes::OutOfRoom;
 use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
 use mwd_core::protocol::uplink::Reply;
@@ -155,6 +158,31 @@ pub fn create_capture(path: &Path) -> io::Result<CaptureWriter<BufWriter<File>>>
 /// firmware version, from 1): 0 marks the capture as the simulator's.
 const SIMULATED_FIRMWARE_VERSION: u16 = 0;
 
+/// How a probe is configured: the site, the calibration, the still
+/// detector's settings and the tie-in it takes after its first navigating
+/// cycle. What a simulated probe runs with, and what a capture's replay
+/// must be given to run as the probe did.
+#[derive(Clone, Copy, Debug)]
+pub struct ProbeSetup {
+    pub site: Position,
+    pub calibration: ProbeCalibration,
+    pub still: StillSettings,
+    pub tie_in: Option<TieIn>,
+}
+
+impl ProbeSetup {
+    /// A probe at `site` as it boots: no calibration, the default still
+    /// settings, no tie-in.
+    pub fn at(site: Position) -> Self {
+        Self {
+            site,
+            calibration: ProbeCalibration::default(),
+            still: default_still_settings(),
+            tie_in: None,
+        }
+    }
+}
+
 /// Writes what a probe at `site` sends for simulated `samples`: its boot
 /// event, then per sample the raw frame and the navigation frame its own
 /// navigation code (the same `Navigator` the firmware runs) makes of that
@@ -164,9 +192,9 @@ const SIMULATED_FIRMWARE_VERSION: u16 = 0;
 pub fn write_simulated_probe<W: Write>(
     capture: &mut CaptureWriter<W>,
     samples: impl IntoIterator<Item = SimSample>,
-    site: Position,
-    mut tie_in: Option<TieIn>,
+    probe: &ProbeSetup,
 ) -> anyhow::Result<()> {
+    let mut tie_in = probe.tie_in;
     capture.write(&Payload::Event(Event {
         time_us: 0,
         kind: EventKind::Boot,
@@ -174,7 +202,7 @@ pub fn write_simulated_probe<W: Write>(
         code: SIMULATED_FIRMWARE_VERSION,
         value: 0,
     }))?;
-    let mut navigator = Navigator::new(site);
+    let mut navigator = Navigator::with_settings(probe.site, probe.calibration, &probe.still);
     for (index, s) in samples.into_iter().enumerate() {
         // Both parts' triads see the same body-frame specific force; the
         // encoder turns each into its part's axes and counts.

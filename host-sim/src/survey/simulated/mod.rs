@@ -70,15 +70,7 @@ impl SimulatedRun {
             depth: files.depth.clone(),
             tie,
             latitude: job.site.lat,
-            probe: ProbeSetup {
-                site: job.site,
-                calibration: job
-                    .calibration
-                    .as_ref()
-                    .map_or_else(Default::default, |(_, c)| *c),
-                still: job.still.unwrap_or_else(default_still_settings),
-                tie_in: job.tie_in,
-            },
+            probe: probe_setup(job),
             sensor_to_bit_m: job
                 .survey
                 .sensor_to_bit
@@ -140,6 +132,20 @@ impl RunFiles {
     }
 }
 
+/// The probe as the job configures it (`probe configure`): site,
+/// calibration, still settings, tie-in.
+fn probe_setup(job: &Job) -> ProbeSetup {
+    ProbeSetup {
+        site: job.site,
+        calibration: job
+            .calibration
+            .as_ref()
+            .map_or_else(Default::default, |(_, c)| *c),
+        still: job.still.unwrap_or_else(default_still_settings),
+        tie_in: job.tie_in,
+    }
+}
+
 /// The probe configured by the job is where the plan is: the job's site is
 /// the plan's (the navigator's earth rate and gravity are the site's).
 fn check_site(job: &Job, plan_site: &mwd_core::earth::Position, plan_path: &Path) -> Result<()> {
@@ -167,8 +173,7 @@ fn simulate(drilling: &Drilling, job: &Job, seed: u64, files: &RunFiles) -> Resu
     };
     let sink = SampleSink::Capture {
         path: &files.capture,
-        site: job.site,
-        tie_in: job.tie_in,
+        probe: probe_setup(job),
     };
     let over = drill(drilling, SensorModel::scc1300(seed), &outputs, |samples| {
         write_samples(sink, samples).map(drop)

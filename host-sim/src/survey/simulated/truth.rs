@@ -120,14 +120,18 @@ impl TruthChecks {
     /// The summary's lines.
     pub fn summary(&self) -> String {
         let p = self.confidence;
-        let positioned: Vec<&PointCheck> =
-            self.stations.iter().filter(|c| c.cov.is_some()).collect();
+        // (the tie-on is given, not surveyed: no ellipse to be inside)
+        let positioned: Vec<&PointCheck> = self
+            .stations
+            .iter()
+            .filter(|c| c.d2_horizontal().is_some())
+            .collect();
         let count = |f: fn(&PointCheck, f64) -> Option<bool>| {
             positioned.iter().filter(|c| f(c, p) == Some(true)).count()
         };
         let mut text = format!(
-            "stations: {} surveyed, {} positioned; the truth inside the {:.0} % ellipse at {} \
-             of {} horizontally, {} of {} vertically\n",
+            "stations: {} surveyed, {} positioned beyond the tie-on; the truth inside the {:.0} % \
+             ellipse at {} of {} horizontally, {} of {} vertically\n",
             self.stations.len(),
             positioned.len(),
             100.0 * p,
@@ -177,8 +181,13 @@ fn along_hole(drilling: &Drilling, md: f64) -> Vector3<f64> {
 /// horizontally (0.9 of the ellipse), 0.05 m vertically: inside".
 fn point_line(c: &PointCheck, p: f64) -> String {
     let [n, e, v] = c.error_nev;
+    let label = if c.label == "bit" {
+        String::new()
+    } else {
+        format!("({}) ", c.label)
+    };
     let Some(cov) = c.cov else {
-        return format!("({}) MD {:.2} m: position undetermined", c.label, c.md_m);
+        return format!("{label}MD {:.2} m: position undetermined", c.md_m);
     };
     let ellipse = Ellipse::from_cov(&cov);
     let (a, b) = ellipse.scaled(p);
@@ -192,9 +201,8 @@ fn point_line(c: &PointCheck, p: f64) -> String {
         _ => "undetermined",
     };
     format!(
-        "({}) MD {:.2} m: {:.0} % ellipse {:.2} x {:.2} m at {:.1} deg, TVD +-{:.2} m; off the \
+        "{label}MD {:.2} m: {:.0} % ellipse {:.2} x {:.2} m at {:.1} deg, TVD +-{:.2} m; off the \
          truth by {:.2} m horizontally ({} of the ellipse), {:.2} m vertically: {verdict}",
-        c.label,
         c.md_m,
         100.0 * p,
         a,
