@@ -9,12 +9,14 @@
 //! power-cut test), [`uplink_rx`] receives the host's commands and
 //! [`uplink_service`] answers them from the main loop; [`boot`] packs the
 //! boot event's reset cause and configuration source; [`main_loop`] is
-//! the probe's main loop, the same on every board.
+//! the probe's main loop, the same on every board, [`board_basics`] what
+//! it uses alike of every board.
 //! Pure code (no registers, no heap), so the host tests it and every board
 //! binary runs the same logic; a board only supplies the timer interrupt,
 //! its UART ([`Transmitter`]), the sensors' SPI, the watchdog and the
 //! rest of what the main loop needs of it ([`Board`]).
 
+pub mod board_basics;
 pub mod boot;
 pub mod budget;
 pub mod config_store;
@@ -33,6 +35,7 @@ pub mod uplink_rx;
 pub mod uplink_service;
 pub mod watchdog;
 
+pub use board_basics::{BoardBasics, SamplePeriods};
 pub use cycle::{AcquisitionCycle, CycleReport};
 pub use frame_queue::{FrameQueue, TX_QUEUE_LEN};
 pub use main_loop::{Board, Pass};

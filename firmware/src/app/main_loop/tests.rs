@@ -11,7 +11,7 @@ use super::*;
 use crate::app::boot::ConfigSource;
 use crate::app::ram_flash::{RamNorFlash, RAM_FLASH_ERASE_SIZE};
 use crate::app::uplink_rx::{InboxWriter, UplinkInbox};
-use crate::app::{FrameQueue, TX_QUEUE_LEN};
+use crate::app::{BoardBasics, FrameQueue, SamplePeriods, TX_QUEUE_LEN};
 use crate::scc1300::Part;
 use hil_mock::{
     AccelSpi, GyroSpi, MountedSource, Scc1300, SimClock, SimDelay, StillProbe, TimeSource,
@@ -74,9 +74,9 @@ impl Watchdog for FakeWatchdog<'_> {
 struct FakeBoard<'a> {
     clock: &'a SimClock,
     probe: &'a Probe<'a>,
-    delay: SimDelay<'a>,
-    watchdog: FakeWatchdog<'a>,
-    ticks: u32,
+    basics: BoardBasics<SimDelay<'a>, FakeWatchdog<'a>>,
+    /// Counts a period each time the loop sleeps.
+    periods: &'static SamplePeriods,
     /// The timer stops sampling after this many samples (as QEMU's does).
     samples_to_run: u32,
     /// Each period's commands arrive on the uplink at its tick.
@@ -96,26 +96,23 @@ impl<'a> Board for FakeBoard<'a> {
     /// The samples taken.
     type Stop = u32;
 
-    fn delay_and_watchdog(&mut self) -> (&mut SimDelay<'a>, &mut FakeWatchdog<'a>) {
-        (&mut self.delay, &mut self.watchdog)
-    }
-
-    fn ticks(&self) -> u32 {
-        self.ticks
+    fn basics(&mut self) -> &mut BoardBasics<SimDelay<'a>, FakeWatchdog<'a>> {
+        &mut self.basics
     }
 
     /// One sample period: the timer's interrupt, the uplink's bytes of the
     /// period, then the UART's interrupts until the queue is empty.
     fn wait_for_interrupt(&mut self) {
         self.clock.advance_ns(SAMPLE_PERIOD_NS);
-        self.ticks += 1;
+        self.periods.begin();
+        let tick = self.periods.count();
         let samples_to_run = self.samples_to_run;
         self.probe.with(|shared| {
             if shared.probe().cycle().samples() < samples_to_run {
                 shared.acquire();
             }
         });
-        for (_, bytes) in self.commands.iter().filter(|(at, _)| *at == self.ticks) {
+        for (_, bytes) in self.commands.iter().filter(|(at, _)| *at == tick) {
             bytes.iter().for_each(|b| self.uplink.push(*b));
         }
         while self.probe.with(|shared| {
@@ -134,7 +131,8 @@ impl<'a> Board for FakeBoard<'a> {
         _uplink: &UplinkService<RamNorFlash<'a>>,
         pass: &Pass,
     ) -> ControlFlow<u32> {
-        self.passes.push((*pass, self.watchdog.fed_at_ns.len()));
+        self.passes
+            .push((*pass, self.basics.watchdog.fed_at_ns.len()));
         let (samples, idle) = probe.with(|s| {
             let p = s.probe();
             let idle = p.queue().is_empty() && s.transmitter().is_idle();
@@ -174,15 +172,20 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
     let mut memory = [0u8; 2 * RAM_FLASH_ERASE_SIZE];
     let mut inbox = UplinkInbox::new();
     let (writer, mut reader) = inbox.split();
+    // This test's own count (a static, as a board's is).
+    static PERIODS: SamplePeriods = SamplePeriods::new();
     let mut board = FakeBoard {
         clock: &clock,
         probe: &probe,
-        delay: SimDelay::new(&clock),
-        watchdog: FakeWatchdog {
-            clock: &clock,
-            fed_at_ns: Vec::new(),
-        },
-        ticks: 0,
+        basics: BoardBasics::new(
+            SimDelay::new(&clock),
+            FakeWatchdog {
+                clock: &clock,
+                fed_at_ns: Vec::new(),
+            },
+            &PERIODS,
+        ),
+        periods: &PERIODS,
         samples_to_run: SAMPLES,
         commands: std::vec![
             (10, command(1, &Command::ReportConfig)),
@@ -251,8 +254,8 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
         .enumerate()
         .all(|(i, (pass, _))| pass.tick == i as u32));
     assert!(passes.windows(2).all(|w| w[1].1 >= w[0].1 + 2));
-    let streaming_from = board.watchdog.fed_at_ns[passes[0].1 - 1];
-    let fed = &board.watchdog.fed_at_ns;
+    let streaming_from = board.basics.watchdog.fed_at_ns[passes[0].1 - 1];
+    let fed = &board.basics.watchdog.fed_at_ns;
     assert!(fed
         .windows(2)
         .filter(|w| w[0] >= streaming_from)
