@@ -224,8 +224,8 @@ mod tests {
     /// A new probe that has started the parts on `mocks` (their start-up
     /// frames queued) and the parts, not yet streaming.
     fn started_parts<'a>(
+        clock: &SimClock,
         mocks: &'a [RefCell<MockPart<'a>>; 2],
-        delay: &mut SimDelay,
     ) -> (
         ProbeState<MockGyro<'a>, MockAccel<'a>>,
         Sensors<MockGyro<'a>, MockAccel<'a>>,
@@ -233,7 +233,7 @@ mod tests {
         let mut parts =
             [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
         let mut probe = ProbeState::new();
-        start_parts(&mut parts, delay, &mut || {}, |p| {
+        start_parts(&mut parts, &mut SimDelay::new(clock), &mut || {}, |p| {
             probe.push(p);
         });
         (probe, parts)
@@ -253,8 +253,7 @@ mod tests {
     fn a_recovery_takes_the_parts_away_and_gives_them_back_with_a_resync() {
         let clock = SimClock::new();
         let mocks = constant_parts(&clock);
-        let mut delay = SimDelay::new(&clock);
-        let (mut probe, parts) = started_parts(&mocks, &mut delay);
+        let (mut probe, parts) = started_parts(&clock, &mocks);
         probe.acquire();
         assert!(probe.nav_inbox().is_empty(), "not streaming yet");
         probe.start_streaming(parts);
@@ -280,7 +279,9 @@ mod tests {
         clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire(); // a sample while the parts are away
         let mut resets = Vec::new();
-        job.run(&mut delay, |part, code| resets.push((part, code)));
+        job.run(&mut SimDelay::new(&clock), |part, code| {
+            resets.push((part, code))
+        });
         assert_eq!(resets, [(1, 0)], "a transient: the part came back");
         let resync = probe.end_recovery(job);
         assert!(matches!(resync, Payload::Event(e) if e.kind == EventKind::Resync && e.value == 1));
@@ -310,8 +311,7 @@ mod tests {
 
         let clock = SimClock::new();
         let mocks = constant_parts(&clock);
-        let mut delay = SimDelay::new(&clock);
-        let (mut probe, parts) = started_parts(&mocks, &mut delay);
+        let (mut probe, parts) = started_parts(&clock, &mocks);
         probe.start_streaming(parts);
         // Part 1 at 200 degC for samples 2..5 (the count clips at 8191),
         // back at 0 degC, then at -60 degC for samples 8..10.
