@@ -30,6 +30,8 @@ pub mod sample_inbox;
 pub mod sensor_wire;
 pub mod shared;
 pub mod start_up;
+#[cfg(test)]
+mod test_support;
 pub mod transmitter;
 pub mod uplink_rx;
 pub mod uplink_service;
@@ -44,5 +46,5 @@ pub use sample_inbox::{SampleInbox, NAV_INBOX_LEN};
 pub use sensor_wire::{fault_code, raw_part, reset_event_code, sensor_fault_event};
 pub use shared::{Shared, SharedProbe, FIRMWARE_VERSION};
 pub use start_up::{start_parts, START_ATTEMPTS};
-pub use transmitter::Transmitter;
+pub use transmitter::{OneByteTransmitter, Transmitter, TxDataRegister};
 pub use watchdog::{Watchdog, WATCHDOG_TIMEOUT_MS};

@@ -10,8 +10,9 @@ use core::cell::RefCell;
 use super::*;
 use crate::app::boot::ConfigSource;
 use crate::app::ram_flash::{RamNorFlash, RAM_FLASH_ERASE_SIZE};
+use crate::app::test_support::{drain, take_wire, TestUart};
 use crate::app::uplink_rx::{InboxWriter, UplinkInbox};
-use crate::app::{BoardBasics, FrameQueue, SamplePeriods, TX_QUEUE_LEN};
+use crate::app::{BoardBasics, SamplePeriods};
 use crate::scc1300::Part;
 use hil_mock::{
     AccelSpi, GyroSpi, MountedSource, Scc1300, SimClock, SimDelay, StillProbe, TimeSource,
@@ -28,36 +29,7 @@ use std::vec::Vec;
 type Mock<'a> = Scc1300<&'a SimClock, MountedSource<StillProbe>>;
 type Gyro<'a> = GyroSpi<'a, &'a SimClock, MountedSource<StillProbe>>;
 type Accel<'a> = AccelSpi<'a, &'a SimClock, MountedSource<StillProbe>>;
-type Probe<'a> = SharedProbe<Gyro<'a>, Accel<'a>, Uart>;
-
-/// A UART with a one-byte transmit buffer; the fake board's period sends
-/// all that waits.
-#[derive(Default)]
-struct Uart {
-    wire: Vec<u8>,
-    busy: bool,
-}
-
-impl Transmitter for Uart {
-    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        if self.busy {
-            return;
-        }
-        if let Some(byte) = queue.pop() {
-            self.wire.push(byte);
-            self.busy = true;
-        }
-    }
-
-    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        self.busy = false;
-        self.kick(queue);
-    }
-
-    fn is_idle(&self) -> bool {
-        !self.busy
-    }
-}
+type Probe<'a> = SharedProbe<Gyro<'a>, Accel<'a>, TestUart>;
 
 /// Notes the simulated time of each feed.
 struct FakeWatchdog<'a> {
@@ -89,7 +61,7 @@ struct FakeBoard<'a> {
 impl<'a> Board for FakeBoard<'a> {
     type Gyro = Gyro<'a>;
     type Accel = Accel<'a>;
-    type Uart = Uart;
+    type Uart = TestUart;
     type Flash = RamNorFlash<'a>;
     type Delay = SimDelay<'a>;
     type Watchdog = FakeWatchdog<'a>;
@@ -115,10 +87,7 @@ impl<'a> Board for FakeBoard<'a> {
         for (_, bytes) in self.commands.iter().filter(|(at, _)| *at == tick) {
             bytes.iter().for_each(|b| self.uplink.push(*b));
         }
-        while self.probe.with(|shared| {
-            shared.transmitter_ready();
-            !shared.transmitter().is_idle()
-        }) {}
+        drain(self.probe);
     }
 
     fn reboot(&mut self) -> ! {
@@ -168,7 +137,7 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
         RefCell::new(Scc1300::new(&clock, source, 1 + i as u32))
     });
     let sensors = [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
-    let probe: Probe = SharedProbe::new(Uart::default());
+    let probe: Probe = SharedProbe::new(TestUart::default());
     let mut memory = [0u8; 2 * RAM_FLASH_ERASE_SIZE];
     let mut inbox = UplinkInbox::new();
     let (writer, mut reader) = inbox.split();
@@ -204,7 +173,7 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
     );
     assert_eq!(samples, SAMPLES);
 
-    let wire = probe.with(|s| core::mem::take(&mut s.transmitter_mut().wire));
+    let wire = take_wire(&probe);
     let mut decoder = Decoder::new();
     let (mut boot, mut raws, mut navs, mut replies) = (Vec::new(), 0, Vec::new(), Vec::new());
     for byte in wire {

@@ -56,7 +56,8 @@ use firmware::app::ram_flash::RamNorFlash;
 use firmware::app::uplink_rx::{InboxWriter, UplinkInbox};
 use firmware::app::uplink_service::UplinkService;
 use firmware::app::{
-    BoardBasics, FrameQueue, SharedProbe, Transmitter, Watchdog, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS,
+    BoardBasics, OneByteTransmitter, SharedProbe, Transmitter, TxDataRegister, Watchdog,
+    WATCHDOG_TIMEOUT_MS,
 };
 use mwd_core::timing::SAMPLE_PERIOD_US;
 
@@ -88,38 +89,27 @@ const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
-/// CMSDK UART0's transmitter: a one-byte buffer whose interrupt fires when
-/// it empties.
-struct Uart0 {
-    /// A byte is in the UART and its interrupt will ask for the next.
-    busy: bool,
-}
+/// CMSDK UART0's data register: its transmitter holds one byte and
+/// interrupts when it empties.
+struct Uart0Data;
 
-impl Transmitter for Uart0 {
-    /// Sends the next byte if the UART is idle. (If it is unexpectedly
-    /// still full, the next push or timer tick tries again.)
-    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        if self.busy || !registers::uart_ready() {
-            return;
-        }
-        if let Some(byte) = queue.pop() {
-            registers::uart_write(byte);
-            self.busy = true;
-        }
+impl TxDataRegister for Uart0Data {
+    /// Full only unexpectedly: the next push or timer tick tries again.
+    fn has_room(&self) -> bool {
+        registers::uart_ready()
     }
 
-    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        self.busy = false;
-        self.kick(queue);
-    }
-
-    fn is_idle(&self) -> bool {
-        !self.busy
+    fn write(&mut self, byte: u8) {
+        registers::uart_write(byte);
     }
 }
+
+/// UART0's transmitter.
+type Uart0 = OneByteTransmitter<Uart0Data>;
 
 /// Everything the contexts share.
-static PROBE: SharedProbe<MockBus, MockBus, Uart0> = SharedProbe::new(Uart0 { busy: false });
+static PROBE: SharedProbe<MockBus, MockBus, Uart0> =
+    SharedProbe::new(OneByteTransmitter::new(Uart0Data));
 
 #[exception]
 fn SysTick() {
