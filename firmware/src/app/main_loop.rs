@@ -20,6 +20,7 @@ use mwd_core::config::ProbeConfig;
 use mwd_core::probe::Navigator;
 use mwd_core::protocol::frame::nav_mode;
 
+use super::board_basics::BoardBasics;
 use super::boot::{boot_event_value, ResetCause};
 use super::probe::Sensors;
 use super::shared::SharedProbe;
@@ -51,13 +52,10 @@ pub trait Board {
     /// real board, whose loop never ends.
     type Stop;
 
-    /// The delay and the watchdog together: a recovery waits and feeds
-    /// between its parts.
-    fn delay_and_watchdog(&mut self) -> (&mut Self::Delay, &mut Self::Watchdog);
-
-    /// Sample periods begun since boot (the acquisition timer's
-    /// interrupts; wrapping).
-    fn ticks(&self) -> u32;
+    /// The delay, the watchdog (a recovery waits and feeds between its
+    /// parts) and the sample periods begun since boot (the acquisition
+    /// timer's interrupts).
+    fn basics(&mut self) -> &mut BoardBasics<Self::Delay, Self::Watchdog>;
 
     /// Sleeps until the next interrupt.
     fn wait_for_interrupt(&mut self);
@@ -80,16 +78,17 @@ pub trait Board {
         ControlFlow::Continue(())
     }
 
-    /// Feeds the watchdog ([`Board::delay_and_watchdog`]'s).
+    /// Feeds the watchdog ([`Board::basics`]').
     fn feed_watchdog(&mut self) {
-        self.delay_and_watchdog().1.feed();
+        self.basics().watchdog.feed();
     }
 }
 
 /// One pass of the main loop, as [`Board::end_of_pass`] sees it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Pass {
-    /// [`Board::ticks`] when the pass began.
+    /// The sample periods begun ([`BoardBasics::ticks`]) when the pass
+    /// began.
     pub tick: u32,
     /// The navigation changed mode in this pass (the once-only end of the
     /// coarse alignment and the filter's start: a far longer pass than
@@ -118,8 +117,8 @@ pub fn run<B: Board>(
     ));
     board.feed_watchdog();
     {
-        let (delay, watchdog) = board.delay_and_watchdog();
-        probe.start_streaming(sensors, delay, &mut || watchdog.feed());
+        let basics = board.basics();
+        probe.start_streaming(sensors, &mut basics.delay, &mut || basics.watchdog.feed());
     }
     #[cfg(feature = "defmt")]
     defmt::info!(
@@ -135,7 +134,7 @@ pub fn run<B: Board>(
     let mut mode = nav_mode::INITIALISING;
     let mut last_pass_tick = None;
     loop {
-        let tick = board.ticks();
+        let tick = board.basics().ticks();
         // One pass per sample period: every byte received wakes the main
         // loop (its interrupt), and a pass per byte would cost a stream of
         // them far more than the pass's work (all of which follows a new
@@ -147,11 +146,11 @@ pub fn run<B: Board>(
         last_pass_tick = Some(tick);
         let mut mode_changed = false;
         {
-            let (delay, watchdog) = board.delay_and_watchdog();
+            let basics = board.basics();
             probe.main_loop_pass(
-                delay,
+                &mut basics.delay,
                 &mut navigator,
-                &mut || watchdog.feed(),
+                &mut || basics.watchdog.feed(),
                 |part, code| {
                     #[cfg(feature = "defmt")]
                     defmt::warn!("part {=u8} recovered, code {=u16}", part, code);

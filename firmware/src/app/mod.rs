@@ -9,12 +9,14 @@
 //! power-cut test), [`uplink_rx`] receives the host's commands and
 //! [`uplink_service`] answers them from the main loop; [`boot`] packs the
 //! boot event's reset cause and configuration source; [`main_loop`] is
-//! the probe's main loop, the same on every board.
+//! the probe's main loop, the same on every board, [`board_basics`] what
+//! it uses alike of every board.
 //! Pure code (no registers, no heap), so the host tests it and every board
 //! binary runs the same logic; a board only supplies the timer interrupt,
 //! its UART ([`Transmitter`]), the sensors' SPI, the watchdog and the
 //! rest of what the main loop needs of it ([`Board`]).
 
+pub mod board_basics;
 pub mod boot;
 pub mod budget;
 pub mod config_store;
@@ -28,11 +30,14 @@ pub mod sample_inbox;
 pub mod sensor_wire;
 pub mod shared;
 pub mod start_up;
+#[cfg(test)]
+mod test_support;
 pub mod transmitter;
 pub mod uplink_rx;
 pub mod uplink_service;
 pub mod watchdog;
 
+pub use board_basics::{BoardBasics, SamplePeriods};
 pub use cycle::{AcquisitionCycle, CycleReport};
 pub use frame_queue::{FrameQueue, TX_QUEUE_LEN};
 pub use main_loop::{Board, Pass};
@@ -41,5 +46,5 @@ pub use sample_inbox::{SampleInbox, NAV_INBOX_LEN};
 pub use sensor_wire::{fault_code, raw_part, reset_event_code, sensor_fault_event};
 pub use shared::{Shared, SharedProbe, FIRMWARE_VERSION};
 pub use start_up::{start_parts, START_ATTEMPTS};
-pub use transmitter::Transmitter;
+pub use transmitter::{OneByteTransmitter, Transmitter, TxDataRegister};
 pub use watchdog::{Watchdog, WATCHDOG_TIMEOUT_MS};

@@ -212,18 +212,48 @@ mod tests {
     use mwd_core::protocol::Decoder;
     use std::vec::Vec;
 
+    type MockPart<'a> = Scc1300<&'a SimClock, Constant>;
+    type MockGyro<'a> = GyroSpi<'a, &'a SimClock, Constant>;
+    type MockAccel<'a> = AccelSpi<'a, &'a SimClock, Constant>;
+
+    /// Two simulated parts on `clock` reading constant values.
+    fn constant_parts(clock: &SimClock) -> [RefCell<MockPart<'_>>; 2] {
+        [0, 1].map(|i| RefCell::new(Scc1300::new(clock, Constant::default(), i as u32)))
+    }
+
+    /// A new probe that has started the parts on `mocks` (their start-up
+    /// frames queued) and the parts, not yet streaming.
+    fn started_parts<'a>(
+        clock: &SimClock,
+        mocks: &'a [RefCell<MockPart<'a>>; 2],
+    ) -> (
+        ProbeState<MockGyro<'a>, MockAccel<'a>>,
+        Sensors<MockGyro<'a>, MockAccel<'a>>,
+    ) {
+        let mut parts =
+            [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
+        let mut probe = ProbeState::new();
+        start_parts(&mut parts, &mut SimDelay::new(clock), &mut || {}, |p| {
+            probe.push(p);
+        });
+        (probe, parts)
+    }
+
+    /// The payloads of the frames waiting for the UART, taken off its queue.
+    fn queued_payloads<G, A>(probe: &mut ProbeState<G, A>) -> Vec<Payload> {
+        let mut decoder = Decoder::new();
+        let mut payloads = Vec::new();
+        while let Some(b) = probe.next_byte() {
+            decoder.feed(&[b], |f| payloads.push(f.payload));
+        }
+        payloads
+    }
+
     #[test]
     fn a_recovery_takes_the_parts_away_and_gives_them_back_with_a_resync() {
         let clock = SimClock::new();
-        let mocks =
-            [0, 1].map(|i| RefCell::new(Scc1300::new(&clock, Constant::default(), i as u32)));
-        let mut parts =
-            [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
-        let mut delay = SimDelay::new(&clock);
-        let mut probe = ProbeState::new();
-        start_parts(&mut parts, &mut delay, &mut || {}, |p| {
-            probe.push(p);
-        });
+        let mocks = constant_parts(&clock);
+        let (mut probe, parts) = started_parts(&clock, &mocks);
         probe.acquire();
         assert!(probe.nav_inbox().is_empty(), "not streaming yet");
         probe.start_streaming(parts);
@@ -249,7 +279,9 @@ mod tests {
         clock.advance_ns(SAMPLE_PERIOD_NS);
         probe.acquire(); // a sample while the parts are away
         let mut resets = Vec::new();
-        job.run(&mut delay, |part, code| resets.push((part, code)));
+        job.run(&mut SimDelay::new(&clock), |part, code| {
+            resets.push((part, code))
+        });
         assert_eq!(resets, [(1, 0)], "a transient: the part came back");
         let resync = probe.end_recovery(job);
         assert!(matches!(resync, Payload::Event(e) if e.kind == EventKind::Resync && e.value == 1));
@@ -263,13 +295,11 @@ mod tests {
             counters.push(sample.sample_counter);
         }
         assert_eq!(counters, (0..13).collect::<Vec<u32>>());
-        let mut decoder = Decoder::new();
-        let mut raw = 0;
-        while let Some(b) = probe.next_byte() {
-            decoder.feed(&[b], |f| {
-                raw += usize::from(matches!(f.payload, Payload::Raw(_)))
-            });
-        }
+        let payloads = queued_payloads(&mut probe);
+        let raw = payloads
+            .iter()
+            .filter(|p| matches!(p, Payload::Raw(_)))
+            .count();
         assert_eq!(raw, 13);
     }
 
@@ -280,15 +310,8 @@ mod tests {
         use mwd_core::sensor_units::COUNT_MAX;
 
         let clock = SimClock::new();
-        let mocks =
-            [0, 1].map(|i| RefCell::new(Scc1300::new(&clock, Constant::default(), i as u32)));
-        let mut parts =
-            [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
-        let mut delay = SimDelay::new(&clock);
-        let mut probe = ProbeState::new();
-        start_parts(&mut parts, &mut delay, &mut || {}, |p| {
-            probe.push(p);
-        });
+        let mocks = constant_parts(&clock);
+        let (mut probe, parts) = started_parts(&clock, &mocks);
         probe.start_streaming(parts);
         // Part 1 at 200 degC for samples 2..5 (the count clips at 8191),
         // back at 0 degC, then at -60 degC for samples 8..10.
@@ -323,17 +346,15 @@ mod tests {
         assert_eq!(flagged, [1, 2, 3, 6, 7]);
         assert!(out_of_range.iter().all(|p| !p[0]));
 
-        let mut decoder = Decoder::new();
-        let mut events = Vec::new();
-        while let Some(b) = probe.next_byte() {
-            decoder.feed(&[b], |f| {
-                if let Payload::Event(e) = f.payload {
-                    if e.kind == EventKind::Temperature {
-                        events.push((e.part, e.code, e.value as i32, e.time_us));
-                    }
+        let events: Vec<_> = queued_payloads(&mut probe)
+            .into_iter()
+            .filter_map(|p| match p {
+                Payload::Event(e) if e.kind == EventKind::Temperature => {
+                    Some((e.part, e.code, e.value as i32, e.time_us))
                 }
-            });
-        }
+                _ => None,
+            })
+            .collect();
         let zero_degc = -3250;
         let minus_60_degc = -60 * 65 - 3250;
         let at = |n: u64| n * mwd_core::timing::SAMPLE_PERIOD_US;

@@ -10,8 +10,9 @@ use core::cell::RefCell;
 use super::*;
 use crate::app::boot::ConfigSource;
 use crate::app::ram_flash::{RamNorFlash, RAM_FLASH_ERASE_SIZE};
+use crate::app::test_support::{drain, take_wire, TestUart};
 use crate::app::uplink_rx::{InboxWriter, UplinkInbox};
-use crate::app::{FrameQueue, TX_QUEUE_LEN};
+use crate::app::{BoardBasics, SamplePeriods};
 use crate::scc1300::Part;
 use hil_mock::{
     AccelSpi, GyroSpi, MountedSource, Scc1300, SimClock, SimDelay, StillProbe, TimeSource,
@@ -28,36 +29,7 @@ use std::vec::Vec;
 type Mock<'a> = Scc1300<&'a SimClock, MountedSource<StillProbe>>;
 type Gyro<'a> = GyroSpi<'a, &'a SimClock, MountedSource<StillProbe>>;
 type Accel<'a> = AccelSpi<'a, &'a SimClock, MountedSource<StillProbe>>;
-type Probe<'a> = SharedProbe<Gyro<'a>, Accel<'a>, Uart>;
-
-/// A UART with a one-byte transmit buffer; the fake board's period sends
-/// all that waits.
-#[derive(Default)]
-struct Uart {
-    wire: Vec<u8>,
-    busy: bool,
-}
-
-impl Transmitter for Uart {
-    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        if self.busy {
-            return;
-        }
-        if let Some(byte) = queue.pop() {
-            self.wire.push(byte);
-            self.busy = true;
-        }
-    }
-
-    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        self.busy = false;
-        self.kick(queue);
-    }
-
-    fn is_idle(&self) -> bool {
-        !self.busy
-    }
-}
+type Probe<'a> = SharedProbe<Gyro<'a>, Accel<'a>, TestUart>;
 
 /// Notes the simulated time of each feed.
 struct FakeWatchdog<'a> {
@@ -74,9 +46,9 @@ impl Watchdog for FakeWatchdog<'_> {
 struct FakeBoard<'a> {
     clock: &'a SimClock,
     probe: &'a Probe<'a>,
-    delay: SimDelay<'a>,
-    watchdog: FakeWatchdog<'a>,
-    ticks: u32,
+    basics: BoardBasics<SimDelay<'a>, FakeWatchdog<'a>>,
+    /// Counts a period each time the loop sleeps.
+    periods: &'static SamplePeriods,
     /// The timer stops sampling after this many samples (as QEMU's does).
     samples_to_run: u32,
     /// Each period's commands arrive on the uplink at its tick.
@@ -89,39 +61,33 @@ struct FakeBoard<'a> {
 impl<'a> Board for FakeBoard<'a> {
     type Gyro = Gyro<'a>;
     type Accel = Accel<'a>;
-    type Uart = Uart;
+    type Uart = TestUart;
     type Flash = RamNorFlash<'a>;
     type Delay = SimDelay<'a>;
     type Watchdog = FakeWatchdog<'a>;
     /// The samples taken.
     type Stop = u32;
 
-    fn delay_and_watchdog(&mut self) -> (&mut SimDelay<'a>, &mut FakeWatchdog<'a>) {
-        (&mut self.delay, &mut self.watchdog)
-    }
-
-    fn ticks(&self) -> u32 {
-        self.ticks
+    fn basics(&mut self) -> &mut BoardBasics<SimDelay<'a>, FakeWatchdog<'a>> {
+        &mut self.basics
     }
 
     /// One sample period: the timer's interrupt, the uplink's bytes of the
     /// period, then the UART's interrupts until the queue is empty.
     fn wait_for_interrupt(&mut self) {
         self.clock.advance_ns(SAMPLE_PERIOD_NS);
-        self.ticks += 1;
+        self.periods.begin();
+        let tick = self.periods.count();
         let samples_to_run = self.samples_to_run;
         self.probe.with(|shared| {
             if shared.probe().cycle().samples() < samples_to_run {
                 shared.acquire();
             }
         });
-        for (_, bytes) in self.commands.iter().filter(|(at, _)| *at == self.ticks) {
+        for (_, bytes) in self.commands.iter().filter(|(at, _)| *at == tick) {
             bytes.iter().for_each(|b| self.uplink.push(*b));
         }
-        while self.probe.with(|shared| {
-            shared.transmitter_ready();
-            !shared.transmitter().is_idle()
-        }) {}
+        drain(self.probe);
     }
 
     fn reboot(&mut self) -> ! {
@@ -134,7 +100,8 @@ impl<'a> Board for FakeBoard<'a> {
         _uplink: &UplinkService<RamNorFlash<'a>>,
         pass: &Pass,
     ) -> ControlFlow<u32> {
-        self.passes.push((*pass, self.watchdog.fed_at_ns.len()));
+        self.passes
+            .push((*pass, self.basics.watchdog.fed_at_ns.len()));
         let (samples, idle) = probe.with(|s| {
             let p = s.probe();
             let idle = p.queue().is_empty() && s.transmitter().is_idle();
@@ -170,19 +137,24 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
         RefCell::new(Scc1300::new(&clock, source, 1 + i as u32))
     });
     let sensors = [0, 1].map(|i| Part::new(GyroSpi::new(&mocks[i]), AccelSpi::new(&mocks[i])));
-    let probe: Probe = SharedProbe::new(Uart::default());
+    let probe: Probe = SharedProbe::new(TestUart::default());
     let mut memory = [0u8; 2 * RAM_FLASH_ERASE_SIZE];
     let mut inbox = UplinkInbox::new();
     let (writer, mut reader) = inbox.split();
+    // This test's own count (a static, as a board's is).
+    static PERIODS: SamplePeriods = SamplePeriods::new();
     let mut board = FakeBoard {
         clock: &clock,
         probe: &probe,
-        delay: SimDelay::new(&clock),
-        watchdog: FakeWatchdog {
-            clock: &clock,
-            fed_at_ns: Vec::new(),
-        },
-        ticks: 0,
+        basics: BoardBasics::new(
+            SimDelay::new(&clock),
+            FakeWatchdog {
+                clock: &clock,
+                fed_at_ns: Vec::new(),
+            },
+            &PERIODS,
+        ),
+        periods: &PERIODS,
         samples_to_run: SAMPLES,
         commands: std::vec![
             (10, command(1, &Command::ReportConfig)),
@@ -201,7 +173,7 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
     );
     assert_eq!(samples, SAMPLES);
 
-    let wire = probe.with(|s| core::mem::take(&mut s.transmitter_mut().wire));
+    let wire = take_wire(&probe);
     let mut decoder = Decoder::new();
     let (mut boot, mut raws, mut navs, mut replies) = (Vec::new(), 0, Vec::new(), Vec::new());
     for byte in wire {
@@ -251,8 +223,8 @@ fn the_loop_streams_navigates_answers_and_feeds_the_watchdog() {
         .enumerate()
         .all(|(i, (pass, _))| pass.tick == i as u32));
     assert!(passes.windows(2).all(|w| w[1].1 >= w[0].1 + 2));
-    let streaming_from = board.watchdog.fed_at_ns[passes[0].1 - 1];
-    let fed = &board.watchdog.fed_at_ns;
+    let streaming_from = board.basics.watchdog.fed_at_ns[passes[0].1 - 1];
+    let fed = &board.basics.watchdog.fed_at_ns;
     assert!(fed
         .windows(2)
         .filter(|w| w[0] >= streaming_from)

@@ -5,16 +5,16 @@
 
 extern crate std;
 
-use super::tests::{drain, TestUart};
 use super::*;
 use crate::app::sensor_wire::fault_code;
+use crate::app::test_support::{
+    assert_navigated_in_order, drain, events_of, sent_frames, TestUart,
+};
 use crate::scc1300::Part;
 use hil_mock::{
     AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, SAMPLE_PERIOD_NS,
 };
 use mwd_core::earth::Position;
-use mwd_core::protocol::{Decoder, Event, Frame, RawSample};
-use std::format;
 use std::vec::Vec;
 
 /// A board in simulated time, as the QEMU and real boards run: the 20 Hz
@@ -49,7 +49,7 @@ impl<'a, G: SpiDevice, A: SpiDevice> SimBoard<'a, G, A> {
     /// slot while it sends.
     fn next_interrupt_ns(&self) -> u64 {
         let now = self.clock.now_ns();
-        let byte = if self.probe.with(|s| s.transmitter().busy) {
+        let byte = if self.probe.with(|s| !s.transmitter().is_idle()) {
             (now / BYTE_NS + 1) * BYTE_NS
         } else {
             u64::MAX
@@ -99,16 +99,6 @@ impl<G: SpiDevice, A: SpiDevice> DelayNs for BoardDelay<'_, '_, G, A> {
     }
 }
 
-fn events_of(frames: &[Frame]) -> Vec<Event> {
-    frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Event(e) => Some(e),
-            _ => None,
-        })
-        .collect()
-}
-
 #[test]
 fn both_gyros_losing_their_loop_lose_no_frame_and_starve_no_watchdog() {
     use crate::app::budget::{RECOVERY_WORST_MS, WATCHDOG_UNFED_WORST_MS};
@@ -146,7 +136,7 @@ fn both_gyros_losing_their_loop_lose_no_frame_and_starve_no_watchdog() {
     }
     // Let the UART finish (the timer stops with the run).
     board.next_tick_ns.set(u64::MAX);
-    while probe.with(|s| s.transmitter().busy || !s.probe().nav_inbox().is_empty()) {
+    while probe.with(|s| !s.transmitter().is_idle() || !s.probe().nav_inbox().is_empty()) {
         probe.main_loop_pass(
             &mut delay,
             &mut navigator,
@@ -188,31 +178,8 @@ fn both_gyros_losing_their_loop_lose_no_frame_and_starve_no_watchdog() {
     // On the wire: no gap, every sample's raw frame and navigation frame,
     // and the navigation frames are what a fresh navigator makes of the
     // raw frames.
-    let wire = probe.with(|shared| core::mem::take(&mut shared.transmitter_mut().wire));
-    let mut decoder = Decoder::new();
-    let mut frames: Vec<Frame> = Vec::new();
-    decoder.feed(&wire, |f| frames.push(f));
-    assert_eq!((decoder.stats().corrupt(), decoder.stats().lost), (0, 0));
-    let raws: Vec<RawSample> = frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Raw(r) => Some(r),
-            _ => None,
-        })
-        .collect();
-    let navs: Vec<NavSolution> = frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Nav(n) => Some(n),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(raws.len(), samples as usize);
-    assert_eq!(navs.len(), samples as usize);
-    let mut replay = Navigator::new(Position::paper_site());
-    for (raw, nav) in raws.iter().zip(&navs) {
-        assert_eq!(format!("{:?}", replay.step(raw)), format!("{nav:?}"));
-    }
+    let frames = sent_frames(&probe);
+    assert_navigated_in_order(&frames, samples as usize);
     let events = events_of(&frames);
     assert!(events.iter().all(|e| e.kind != EventKind::SamplesDropped));
     assert!(events
@@ -244,11 +211,7 @@ fn samples_the_inbox_drops_are_reported_in_an_event() {
         assert!(probe.with(|s| s.probe().nav_inbox().is_empty()));
     }
 
-    let wire = probe.with(|shared| core::mem::take(&mut shared.transmitter_mut().wire));
-    let mut decoder = Decoder::new();
-    let mut frames: Vec<Frame> = Vec::new();
-    decoder.feed(&wire, |f| frames.push(f));
-    assert_eq!((decoder.stats().corrupt(), decoder.stats().lost), (0, 0));
+    let frames = sent_frames(&probe);
     let drops: Vec<(u8, u32, u64)> = events_of(&frames)
         .iter()
         .filter(|e| e.kind == EventKind::SamplesDropped)

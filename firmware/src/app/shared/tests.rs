@@ -5,48 +5,16 @@ extern crate std;
 
 use super::*;
 use crate::app::sensor_wire::fault_code;
-use crate::app::{FrameQueue, TX_QUEUE_LEN};
+use crate::app::test_support::{
+    assert_navigated_in_order, drain, events_of, sent_frames, take_wire, TestUart,
+};
 use crate::scc1300::Part;
 use hil_mock::{
     AccelSpi, Constant, GyroSpi, Scc1300, SimClock, SimDelay, TimeSource, Window, SAMPLE_PERIOD_NS,
 };
 use mwd_core::earth::Position;
-use mwd_core::protocol::{Decoder, Event, Frame, RawSample};
-use std::format;
+use mwd_core::protocol::{Decoder, Frame};
 use std::vec::Vec;
-
-/// A UART whose transmit buffer holds one byte, emptied by the test as
-/// the board's interrupt would; what it sent is on `wire`.
-#[derive(Default)]
-pub(super) struct TestUart {
-    pub(super) wire: Vec<u8>,
-    pub(super) busy: bool,
-}
-
-impl Transmitter for TestUart {
-    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        if self.busy {
-            return;
-        }
-        if let Some(byte) = queue.pop() {
-            self.wire.push(byte);
-            self.busy = true;
-        }
-    }
-
-    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        self.busy = false;
-        self.kick(queue);
-    }
-}
-
-/// The UART's interrupts until the queue is empty.
-pub(super) fn drain<G, A>(probe: &SharedProbe<G, A, TestUart>) {
-    while probe.with(|shared| {
-        shared.transmitter_ready();
-        shared.transmitter().busy
-    }) {}
-}
 
 #[test]
 fn boot_streaming_recovery_and_navigation_reach_the_uart_in_order() {
@@ -88,18 +56,8 @@ fn boot_streaming_recovery_and_navigation_reach_the_uart_in_order() {
     assert_eq!(resets, [(1, 0)]);
     assert_eq!(solutions, 12);
 
-    let wire = probe.with(|shared| core::mem::take(&mut shared.transmitter_mut().wire));
-    let mut decoder = Decoder::new();
-    let mut frames: Vec<Frame> = Vec::new();
-    decoder.feed(&wire, |f| frames.push(f));
-    assert_eq!((decoder.stats().corrupt(), decoder.stats().lost), (0, 0));
-    let events: Vec<Event> = frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Event(e) => Some(e),
-            _ => None,
-        })
-        .collect();
+    let frames = sent_frames(&probe);
+    let events = events_of(&frames);
     let kinds: Vec<(EventKind, u8, u16)> =
         events.iter().map(|e| (e.kind, e.part, e.code)).collect();
     assert_eq!(
@@ -112,30 +70,7 @@ fn boot_streaming_recovery_and_navigation_reach_the_uart_in_order() {
         ]
     );
 
-    // Every raw sample went out and was navigated, in order: a fresh
-    // navigator on the raw frames gives the navigation frames sent.
-    let raws: Vec<RawSample> = frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Raw(r) => Some(r),
-            _ => None,
-        })
-        .collect();
-    let navs: Vec<NavSolution> = frames
-        .iter()
-        .filter_map(|f| match f.payload {
-            Payload::Nav(n) => Some(n),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(raws.len(), 12);
-    assert_eq!(navs.len(), 12);
-    let mut replay = Navigator::new(Position::paper_site());
-    for (n, (raw, nav)) in raws.iter().zip(&navs).enumerate() {
-        assert_eq!(raw.sample_counter as usize, n);
-        // Debug text, so that NaN fields compare too.
-        assert_eq!(format!("{:?}", replay.step(raw)), format!("{nav:?}"));
-    }
+    assert_navigated_in_order(&frames, 12);
 }
 
 /// A still probe (the mock's constant level sample) past its alignment: it
@@ -181,7 +116,7 @@ fn a_station_survey_follows_its_navigation_frame_and_replays_identically() {
         probe.with(|shared| shared.acquire());
         probe.main_loop_pass(&mut delay, &mut navigator, &mut || {}, |_, _| {}, |_| {});
         drain(&probe);
-        let wire = probe.with(|shared| core::mem::take(&mut shared.transmitter_mut().wire));
+        let wire = take_wire(&probe);
         decoder.feed(&wire, |f| frames.push(f));
     }
     assert_eq!((decoder.stats().corrupt(), decoder.stats().lost), (0, 0));

@@ -46,7 +46,6 @@ mod stream_file;
 use core::cell::RefCell;
 use core::convert::Infallible;
 use core::ops::ControlFlow;
-use core::sync::atomic::Ordering;
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
@@ -57,7 +56,8 @@ use firmware::app::ram_flash::RamNorFlash;
 use firmware::app::uplink_rx::{InboxWriter, UplinkInbox};
 use firmware::app::uplink_service::UplinkService;
 use firmware::app::{
-    FrameQueue, SharedProbe, Transmitter, Watchdog, TX_QUEUE_LEN, WATCHDOG_TIMEOUT_MS,
+    BoardBasics, OneByteTransmitter, SharedProbe, Transmitter, TxDataRegister, Watchdog,
+    WATCHDOG_TIMEOUT_MS,
 };
 use mwd_core::timing::SAMPLE_PERIOD_US;
 
@@ -89,42 +89,31 @@ const STALL_AT_SAMPLE: u32 = 10 * SAMPLES_PER_SECOND;
 /// SysTick reload for one sample period at the board's clock.
 const RELOAD: u32 = (SYSTEM_CLOCK_HZ as u64 * SAMPLE_PERIOD_US / 1_000_000) as u32 - 1;
 
-/// CMSDK UART0's transmitter: a one-byte buffer whose interrupt fires when
-/// it empties.
-struct Uart0 {
-    /// A byte is in the UART and its interrupt will ask for the next.
-    busy: bool,
-}
+/// CMSDK UART0's data register: its transmitter holds one byte and
+/// interrupts when it empties.
+struct Uart0Data;
 
-impl Transmitter for Uart0 {
-    /// Sends the next byte if the UART is idle. (If it is unexpectedly
-    /// still full, the next push or timer tick tries again.)
-    fn kick(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        if self.busy || !registers::uart_ready() {
-            return;
-        }
-        if let Some(byte) = queue.pop() {
-            registers::uart_write(byte);
-            self.busy = true;
-        }
+impl TxDataRegister for Uart0Data {
+    /// Full only unexpectedly: the next push or timer tick tries again.
+    fn has_room(&self) -> bool {
+        registers::uart_ready()
     }
 
-    fn ready(&mut self, queue: &mut FrameQueue<TX_QUEUE_LEN>) {
-        self.busy = false;
-        self.kick(queue);
-    }
-
-    fn is_idle(&self) -> bool {
-        !self.busy
+    fn write(&mut self, byte: u8) {
+        registers::uart_write(byte);
     }
 }
+
+/// UART0's transmitter.
+type Uart0 = OneByteTransmitter<Uart0Data>;
 
 /// Everything the contexts share.
-static PROBE: SharedProbe<MockBus, MockBus, Uart0> = SharedProbe::new(Uart0 { busy: false });
+static PROBE: SharedProbe<MockBus, MockBus, Uart0> =
+    SharedProbe::new(OneByteTransmitter::new(Uart0Data));
 
 #[exception]
 fn SysTick() {
-    TICKS.fetch_add(1, Ordering::Relaxed);
+    TICKS.begin();
     PROBE.with(|shared| {
         // The run length is counted here, so the last sample is exact
         // whatever the main loop is doing.
@@ -186,9 +175,8 @@ struct CycleCost {
 /// the end of each pass the run's measurements, its end and the watchdog
 /// run's hang.
 struct Qemu {
+    basics: BoardBasics<TickDelay, CmsdkWatchdog>,
     cost: CycleCost,
-    delay: TickDelay,
-    watchdog: CmsdkWatchdog,
 }
 
 /// The CMSDK watchdog (started in `main`).
@@ -209,12 +197,8 @@ impl Board for Qemu {
     type Watchdog = CmsdkWatchdog;
     type Stop = Infallible;
 
-    fn delay_and_watchdog(&mut self) -> (&mut TickDelay, &mut CmsdkWatchdog) {
-        (&mut self.delay, &mut self.watchdog)
-    }
-
-    fn ticks(&self) -> u32 {
-        TICKS.load(Ordering::Relaxed)
+    fn basics(&mut self) -> &mut BoardBasics<TickDelay, CmsdkWatchdog> {
+        &mut self.basics
     }
 
     fn wait_for_interrupt(&mut self) {
@@ -262,19 +246,20 @@ impl CycleCost {
     /// (only if no new period started meanwhile).
     fn count(&mut self, pass: &Pass, samples: u32) {
         let elapsed = RELOAD - SYST::get_current();
-        let now_tick = TICKS.load(Ordering::Relaxed);
+        let now_tick = TICKS.count();
+        // Since the pass's period began: whole periods plus this one's
+        // part (read before the tick count, so possibly one period short:
+        // a lower bound).
+        let since_pass_began = || {
+            let periods = now_tick.wrapping_sub(pass.tick);
+            u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed)
+        };
         if pass.mode_changed {
-            let periods = now_tick.wrapping_sub(pass.tick);
-            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
             self.mode_changes += 1;
-            self.longest_mode_change = self.longest_mode_change.max(ticks);
+            self.longest_mode_change = self.longest_mode_change.max(since_pass_began());
         } else if now_tick != pass.tick {
-            // Whole periods plus this one's part (read before the tick
-            // count, so possibly one period short: a lower bound).
-            let periods = now_tick.wrapping_sub(pass.tick);
-            let ticks = u64::from(periods) * u64::from(RELOAD + 1) + u64::from(elapsed);
             self.overruns += 1;
-            self.longest_overrun = self.longest_overrun.max(ticks);
+            self.longest_overrun = self.longest_overrun.max(since_pass_began());
         } else if samples > 0 {
             self.worst = self.worst.max(elapsed);
             self.total += u64::from(elapsed);
@@ -310,9 +295,8 @@ fn main() -> ! {
     registers::watchdog_start(WATCHDOG_TIMEOUT_MS);
 
     let mut board = Qemu {
+        basics: BoardBasics::new(TickDelay, CmsdkWatchdog, &TICKS),
         cost: CycleCost::default(),
-        delay: TickDelay,
-        watchdog: CmsdkWatchdog,
     };
     // The loop never returns here (`Infallible`).
     match main_loop::run(

@@ -11,11 +11,11 @@
 //! and the run ends with the stream.
 
 use core::cell::{OnceCell, RefCell};
-use core::sync::atomic::{AtomicU32, Ordering};
 
 use critical_section::Mutex;
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
+use firmware::app::SamplePeriods;
 use firmware::scc1300::Part;
 use hil_mock::{
     AccelSpi, Chance, GyroSpi, MockBusError, Scc1300, TemperatureExcursion, TimeSource, Window,
@@ -29,14 +29,14 @@ use mwd_core::sensor_units::PART_MOUNTINGS;
 use crate::run_length::SAMPLES_PER_SECOND;
 
 /// Timer periods since boot, counted by the SysTick interrupt.
-pub static TICKS: AtomicU32 = AtomicU32::new(0);
+pub static TICKS: SamplePeriods = SamplePeriods::new();
 
 /// The board's clock as the simulated parts see it.
 pub struct BoardClock;
 
 impl TimeSource for BoardClock {
     fn now_ns(&self) -> u64 {
-        u64::from(TICKS.load(Ordering::Relaxed)) * SAMPLE_PERIOD_NS
+        u64::from(TICKS.count()) * SAMPLE_PERIOD_NS
     }
 }
 
@@ -47,9 +47,9 @@ pub struct TickDelay;
 impl DelayNs for TickDelay {
     fn delay_ns(&mut self, ns: u32) {
         let periods = u64::from(ns).div_ceil(SAMPLE_PERIOD_NS) as u32;
-        let target = TICKS.load(Ordering::Relaxed).wrapping_add(periods);
+        let target = TICKS.count().wrapping_add(periods);
         // Wrapping comparison: correct across the counter's overflow.
-        while (TICKS.load(Ordering::Relaxed).wrapping_sub(target) as i32) < 0 {
+        while (TICKS.count().wrapping_sub(target) as i32) < 0 {
             cortex_m::asm::wfi();
         }
     }

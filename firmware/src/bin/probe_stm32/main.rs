@@ -37,7 +37,6 @@ mod flash;
 
 use core::cell::RefCell;
 use core::convert::Infallible;
-use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use critical_section::Mutex;
@@ -46,7 +45,8 @@ use firmware::app::boot::ResetCause;
 use firmware::app::main_loop;
 use firmware::app::uplink_rx::{InboxWriter, UplinkInbox};
 use firmware::app::{
-    FrameQueue, SharedProbe, Transmitter, Watchdog, FIRMWARE_VERSION, TX_QUEUE_LEN,
+    BoardBasics, FrameQueue, SamplePeriods, SharedProbe, Transmitter, Watchdog, FIRMWARE_VERSION,
+    TX_QUEUE_LEN,
 };
 use mwd_core::timing::SAMPLE_RATE_HZ;
 use panic_probe as _;
@@ -104,7 +104,7 @@ static PROBE: SharedProbe<Device, Device, Usart1> = SharedProbe::new(Usart1 { ua
 /// The acquisition timer, whose interrupt flag its interrupt clears.
 static TIMER: Mutex<RefCell<Option<Timer>>> = Mutex::new(RefCell::new(None));
 /// Sample periods begun (TIM2 interrupts), for one main-loop pass each.
-static TICKS: AtomicU32 = AtomicU32::new(0);
+static TICKS: SamplePeriods = SamplePeriods::new();
 /// USART1's receiver and the interrupt's end of the uplink inbox (set once
 /// in `main`).
 static UPLINK_RX: Mutex<RefCell<Option<(UartRx, InboxWriter<'static>)>>> =
@@ -129,7 +129,7 @@ fn TIM2() {
             timer.clear_flags(Flag::Update);
         }
     });
-    TICKS.fetch_add(1, Ordering::Relaxed);
+    TICKS.begin();
     PROBE.with(|shared| shared.acquire());
 }
 
@@ -154,8 +154,7 @@ fn USART1() {
 /// TIM2's periods for its clock, SysTick for its delay, the independent
 /// watchdog.
 struct Stm32 {
-    delay: SysDelay,
-    watchdog: Iwdg,
+    basics: BoardBasics<SysDelay, Iwdg>,
 }
 
 /// The independent watchdog (started in `board::init`).
@@ -176,12 +175,8 @@ impl main_loop::Board for Stm32 {
     type Watchdog = Iwdg;
     type Stop = Infallible;
 
-    fn delay_and_watchdog(&mut self) -> (&mut SysDelay, &mut Iwdg) {
-        (&mut self.delay, &mut self.watchdog)
-    }
-
-    fn ticks(&self) -> u32 {
-        TICKS.load(Ordering::Relaxed)
+    fn basics(&mut self) -> &mut BoardBasics<SysDelay, Iwdg> {
+        &mut self.basics
     }
 
     fn wait_for_interrupt(&mut self) {
@@ -191,7 +186,7 @@ impl main_loop::Board for Stm32 {
     /// The last byte may still be on the line (the transmitter cannot say):
     /// its 87 us at 115200 baud, then the reset.
     fn reboot(&mut self) -> ! {
-        self.delay.delay_ms(1);
+        self.basics.delay.delay_ms(1);
         cortex_m::peripheral::SCB::sys_reset()
     }
 }
@@ -242,8 +237,7 @@ fn main() -> ! {
     // The watchdog runs since `board::init`; the start-up feeds it after
     // each attempt.
     let mut board = Stm32 {
-        delay,
-        watchdog: Iwdg(watchdog),
+        basics: BoardBasics::new(delay, Iwdg(watchdog), &TICKS),
     };
     // The loop never returns here (`Infallible`).
     match main_loop::run(
