@@ -139,7 +139,9 @@ fn the_bit_is_projected_straight_ahead_with_the_last_stations_errors_over_the_le
     assert!(plain.bit.is_none());
     let out = survey(&stations, &[], &[], &log(), &setup(Some(10.0))).unwrap();
     let bit = out.bit.expect("a projection with a sensor-to-bit distance");
+    // (the log ends at the last station: the projection is the 10 m)
     assert_eq!(bit.sensor_to_bit_m, 10.0);
+    assert_eq!(bit.projected_m, 10.0);
     assert!((bit.row.md_m - 1040.0).abs() < 1e-9);
     assert!((bit.row.east_m - 40.0).abs() < 1e-5 && bit.row.north_m.abs() < 1e-5);
     // the stations themselves are untouched by the projection

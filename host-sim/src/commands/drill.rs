@@ -42,7 +42,11 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let job_path = args.job.clone().unwrap_or_else(|| PathBuf::from(EXAMPLE_JOB));
+    let job_path = args.job.clone().unwrap_or_else(|| {
+        // "/../" read as the folder it names, where it exists
+        let example = PathBuf::from(EXAMPLE_JOB);
+        std::fs::canonicalize(&example).unwrap_or(example)
+    });
     let job = Job::load(&job_path).with_context(|| {
         if args.job.is_none() {
             "the example job ships with the source tree; give --job JOB.json elsewhere".into()

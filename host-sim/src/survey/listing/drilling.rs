@@ -61,14 +61,18 @@ pub struct DrillingSurvey {
     pub bit: Option<BitProjection>,
 }
 
-/// The bit's position projected from the last station: its inclination
-/// and azimuth held straight ahead over the sensor-to-bit distance (the
-/// bit's own angles are not measured), with the last station's angle
-/// errors acting over that distance too.
+/// The bit at the end of the depth log (TD: the log's last MD plus the
+/// sensor-to-bit distance), projected from the last station: its
+/// inclination and azimuth held straight ahead (the hole drilled since
+/// and the bit's own angles are not surveyed), with the last station's
+/// angle errors acting over the whole projection.
 #[derive(Clone, Copy, Debug)]
 pub struct BitProjection {
-    /// From the last station to the bit along the hole, m.
+    /// From the survey sensors to the bit, m.
     pub sensor_to_bit_m: f64,
+    /// From the last station to the bit along the hole, m: what was
+    /// drilled after the station, and the sensor-to-bit distance.
+    pub projected_m: f64,
     /// MD, angles (the last station's) and position; `cov` where the last
     /// station's position is determined.
     pub row: Row,
@@ -277,7 +281,6 @@ pub fn survey(
     let SurveySetup {
         tie, terms, site, ..
     } = setup;
-    let ahead = setup.sensor_to_bit_m;
     let mut skipped = Vec::new();
     let mut kept: Vec<Kept> = Vec::new();
     let (first, last) = depth.span();
@@ -344,6 +347,13 @@ pub fn survey(
             })
             .collect(),
     };
+    // The bit at the log's end: its last MD (the tie-on's shift applied)
+    // plus the sensor-to-bit distance.
+    let log_end_md = depth.md_at(last).map(|md| md + md_offset_m);
+    let ahead = setup
+        .sensor_to_bit_m
+        .zip(log_end_md.zip(file.stations.last()))
+        .map(|(d, (end, station))| (end - station.md).max(0.0) + d);
     if let (Some(d), Some(&last)) = (ahead, file.stations.last()) {
         file.stations.push(InputStation {
             md: last.md + d,
@@ -371,10 +381,11 @@ pub fn survey(
         .collect();
     let mut covs = covariance(&rows, &sigmas, terms, site, ahead)?;
     let bit_cov = (covs.len() > rows.len()).then(|| covs.pop()).flatten();
-    let bit = bit_row.zip(ahead).map(|(mut row, d)| {
+    let bit = bit_row.zip(ahead.zip(setup.sensor_to_bit_m)).map(|(mut row, (d, sensor_to_bit_m))| {
         row.cov = bit_cov.map(|c| c.total);
         BitProjection {
-            sensor_to_bit_m: d,
+            sensor_to_bit_m,
+            projected_m: d,
             row,
             method_cov: bit_cov.map(|c| c.method),
         }

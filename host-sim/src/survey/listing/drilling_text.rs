@@ -49,9 +49,10 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         let _ = writeln!(out, "{}", bit_line(bit, last, confidence));
         let _ = writeln!(
             out,
-            "bit: projected {:.2} m straight ahead of station {} (its inclination and azimuth; \
-             their errors act over the projection too)",
-            bit.sensor_to_bit_m, last.survey.station
+            "bit: at the depth log's end plus {:.2} m from the sensors to the bit, projected \
+             {:.2} m straight ahead of station {} (its inclination and azimuth; their errors act \
+             over the projection too)",
+            bit.sensor_to_bit_m, bit.projected_m, last.survey.station
         );
     }
     if let Some(u) = s.rows.iter().find(|r| !r.position_determined) {

@@ -5,7 +5,8 @@
 //! surveys it (its replay through the probe's navigator gives the station
 //! links; the bit projected from the last station), its outputs written,
 //! and the survey checked against the simulation's truth: each station,
-//! TD and the bit inside their ellipses or not ([`truth`]).
+//! the last station and the bit at TD inside their ellipses or not
+//! ([`truth`]).
 //!
 //! The simulated parts carry the SCC1300's deterministic errors (the MGWD
 //! paper's Table 3) and their random errors; the probe corrects them with

@@ -1,6 +1,6 @@
 //! A simulated run's survey against its truth: each station's position
 //! against where the simulated probe was at the station's last still
-//! sample, TD (the last station) and the bit against the drilled hole
+//! sample, and the bit at TD (the end of the run) against the drilled hole
 //! the sensor-to-bit distance ahead, each inside its ellipse at the
 //! listing's confidence or not: horizontally the NE ellipse (2-D normal,
 //! squared Mahalanobis distance against -2 ln(1 - p)), vertically the
@@ -85,14 +85,12 @@ pub struct TruthChecks {
 
 impl TruthChecks {
     pub fn new(survey: &DrillingSurvey, drilling: &Drilling, confidence: f64) -> Self {
-        let mut last_true_md = None;
         let stations = survey
             .rows
             .iter()
             .map(|r| {
                 let t = (f64::from(r.survey.end_sample) + 1.0) * SAMPLE_INTERVAL_S;
                 let truth = drilling.truth(t);
-                last_true_md = Some(truth.md);
                 check(
                     format!("station {}", r.survey.station),
                     &r.row,
@@ -101,8 +99,11 @@ impl TruthChecks {
                 )
             })
             .collect();
-        let bit = survey.bit.as_ref().zip(last_true_md).map(|(b, md)| {
-            let truth = along_hole(drilling, md + b.sensor_to_bit_m);
+        // The bit at the run's end: the sensors' true MD then, plus the
+        // sensor-to-bit distance.
+        let end_md = drilling.truth(drilling.duration()).md;
+        let bit = survey.bit.as_ref().map(|b| {
+            let truth = along_hole(drilling, end_md + b.sensor_to_bit_m);
             check("bit".into(), &b.row, truth, b.row.cov.is_some())
         });
         Self {
@@ -112,8 +113,8 @@ impl TruthChecks {
         }
     }
 
-    /// TD: the last station.
-    pub fn td(&self) -> Option<&PointCheck> {
+    /// The last station.
+    pub fn last_station(&self) -> Option<&PointCheck> {
         self.stations.last()
     }
 
@@ -140,11 +141,11 @@ impl TruthChecks {
             count(PointCheck::inside_vertical),
             positioned.len()
         );
-        if let Some(td) = self.td() {
-            let _ = writeln!(text, "TD  {}", point_line(td, p));
+        if let Some(last) = self.last_station() {
+            let _ = writeln!(text, "last station {}", point_line(last, p));
         }
         if let Some(bit) = &self.bit {
-            let _ = writeln!(text, "bit {}", point_line(bit, p));
+            let _ = writeln!(text, "bit at TD    {}", point_line(bit, p));
         }
         text
     }
