@@ -1,0 +1,147 @@
+//! `host-sim drill`: the example job run from another directory, end to
+//! end (capture, depth log, survey with the bit, outputs, the summary
+//! against the truth); `survey CAPTURE --job` of its capture lists the
+//! same survey and writes the same exports; jobs that cannot run are
+//! refused by name.
+mod common;
+
+use common::{refused, run, s, scratch};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn example_job() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/lateral-100m/job.json")
+}
+
+#[test]
+fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
+    let dir = scratch("drill", "example");
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .current_dir(&dir)
+        .args(["drill", "--job", s(&example_job()), "--out", "run"])
+        .output()
+        .expect("host-sim runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    let run_dir = dir.join("run");
+    for name in [
+        "capture.bin",
+        "depth.csv",
+        "truth.csv",
+        "stations.csv",
+        "listing.txt",
+        "survey.json",
+        "trajectory.xml",
+        "plan.svg",
+        "plan.png",
+        "section.svg",
+        "section.png",
+    ] {
+        assert!(run_dir.join(name).is_file(), "{name} missing: {stdout}");
+    }
+    // the probe ran with the job's calibration: its stations replay bit
+    // for bit with it, so the survey has the stations' links
+    assert!(
+        stdout.contains("station links: from the capture's replay"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("calibrated by"), "{stdout}");
+    assert!(stdout.contains("positioned beyond the tie-on"), "{stdout}");
+    let bit_line = stdout
+        .lines()
+        .find(|l| l.starts_with("bit at TD"))
+        .unwrap_or_else(|| panic!("no bit line: {stdout}"));
+    assert!(
+        bit_line.contains("95 % ellipse") && bit_line.contains("off the truth by"),
+        "{bit_line}"
+    );
+    // The bit: TD is the depth log's end plus 12 m, ahead of the last station.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("survey.json")).unwrap())
+            .unwrap();
+    let stations = json["stations"].as_array().unwrap();
+    let last_md = stations.last().unwrap()["md_m"].as_f64().unwrap();
+    let bit = &json["bit_projection"];
+    let bit_md = bit["md_m"].as_f64().unwrap();
+    assert!(bit_md > last_md + 12.0, "{bit_md} after {last_md}");
+    let cov = bit["nev_covariance_m2"].as_array().unwrap();
+    assert_eq!(cov.len(), 6);
+    let last_cov = stations.last().unwrap()["nev_covariance_m2"][0].as_f64().unwrap();
+    assert!(cov[0].as_f64().unwrap() > last_cov, "the bit is less certain");
+    let csv = std::fs::read_to_string(run_dir.join("stations.csv")).unwrap();
+    assert!(csv.lines().last().unwrap().starts_with("bit,,"), "{csv}");
+
+    // The same capture surveyed by `survey CAPTURE --job`: the same listing,
+    // and the station-file survey's exports.
+    let (json_out, witsml_out, plots) = (dir.join("s.json"), dir.join("s.xml"), dir.join("plots"));
+    let surveyed = run(&[
+        "survey",
+        s(&run_dir.join("capture.bin")),
+        "--depth",
+        s(&run_dir.join("depth.csv")),
+        "--job",
+        s(&example_job()),
+        "--json",
+        s(&json_out),
+        "--witsml",
+        s(&witsml_out),
+        "--plot",
+        s(&plots),
+    ]);
+    assert_eq!(surveyed.code, Some(0), "{}", surveyed.stderr);
+    let listing = std::fs::read_to_string(run_dir.join("listing.txt")).unwrap();
+    assert!(
+        surveyed.stdout.starts_with(&listing),
+        "{}\n---\n{listing}",
+        surveyed.stdout
+    );
+    assert_eq!(
+        std::fs::read(&json_out).unwrap(),
+        std::fs::read(run_dir.join("survey.json")).unwrap()
+    );
+    assert!(std::fs::read_to_string(&witsml_out)
+        .unwrap()
+        .contains("<trajectoryStation"));
+    assert!(plots.join("plan.png").is_file());
+}
+
+#[test]
+fn a_job_that_cannot_be_drilled_is_refused_by_name() {
+    let dir = scratch("drill", "refused");
+    let job = std::fs::read_to_string(example_job()).unwrap();
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    // no plan; a plan that is not there (paths are the job file's folder's)
+    let no_plan = write(
+        "no-plan.json",
+        &job.replace(
+            "\"plan\": \"../../host-sim/data/plans/lateral-100m.json\",",
+            "",
+        )
+        .replace("\"calibration_file\": \"probe-cal.json\",", ""),
+    );
+    let out = dir.join("out");
+    refused(
+        &run(&["drill", "--job", s(&no_plan), "--out", s(&out)]),
+        "names no plan",
+    );
+    let missing = write(
+        "missing-plan.json",
+        &job.replace("../../host-sim/data/plans/lateral-100m.json", "nowhere.json")
+            .replace("\"calibration_file\": \"probe-cal.json\",", ""),
+    );
+    refused(
+        &run(&["drill", "--job", s(&missing), "--out", s(&out)]),
+        "nowhere.json",
+    );
+    let unknown = write("unknown.json", &job.replace("\"plan\"", "\"plann\""));
+    refused(
+        &run(&["drill", "--job", s(&unknown), "--out", s(&out)]),
+        "plann",
+    );
+    assert!(!out.exists(), "nothing written for a refused job");
+}
