@@ -67,8 +67,13 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
     assert!(bit_md > last_md + 12.0, "{bit_md} after {last_md}");
     let cov = bit["nev_covariance_m2"].as_array().unwrap();
     assert_eq!(cov.len(), 6);
-    let last_cov = stations.last().unwrap()["nev_covariance_m2"][0].as_f64().unwrap();
-    assert!(cov[0].as_f64().unwrap() > last_cov, "the bit is less certain");
+    let last_cov = stations.last().unwrap()["nev_covariance_m2"][0]
+        .as_f64()
+        .unwrap();
+    assert!(
+        cov[0].as_f64().unwrap() > last_cov,
+        "the bit is less certain"
+    );
     let csv = std::fs::read_to_string(run_dir.join("stations.csv")).unwrap();
     assert!(csv.lines().last().unwrap().starts_with("bit,,"), "{csv}");
 
@@ -131,8 +136,11 @@ fn a_job_that_cannot_be_drilled_is_refused_by_name() {
     );
     let missing = write(
         "missing-plan.json",
-        &job.replace("../../host-sim/data/plans/lateral-100m.json", "nowhere.json")
-            .replace("\"calibration_file\": \"probe-cal.json\",", ""),
+        &job.replace(
+            "../../host-sim/data/plans/lateral-100m.json",
+            "nowhere.json",
+        )
+        .replace("\"calibration_file\": \"probe-cal.json\",", ""),
     );
     refused(
         &run(&["drill", "--job", s(&missing), "--out", s(&out)]),

@@ -248,11 +248,13 @@ fn a_coverage_study_stopped_after_its_first_run_is_over_that_run_and_says_so() {
     let stop = std::sync::atomic::AtomicBool::new(false);
     let summary = host_sim::study::drilling_coverage::study(
         &config,
-        3,
-        1,
-        1,
-        &|| stop.store(true, std::sync::atomic::Ordering::Relaxed),
-        &stop,
+        &host_sim::study::StudyRuns {
+            runs: 3,
+            first_seed: 1,
+            threads: 1,
+            progress: &|| stop.store(true, std::sync::atomic::Ordering::Relaxed),
+            stop: &stop,
+        },
     );
     assert_eq!(summary.runs, 1);
     assert_eq!(

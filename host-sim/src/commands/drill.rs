@@ -54,7 +54,11 @@ pub fn run(args: Args) -> Result<()> {
             format!("--job {}", job_path.display())
         }
     })?;
-    eprintln!("drilling {} (job {}) ...", job.well.wellbore, job_path.display());
+    eprintln!(
+        "drilling {} (job {}) ...",
+        job.well.wellbore,
+        job_path.display()
+    );
     let run = SimulatedRun::run(&SimulatedRunInputs {
         job: &job,
         out_dir: &args.out,

@@ -228,16 +228,17 @@ fn replay_live(args: &Args, port: &str, probe: ReplayedProbe) -> anyhow::Result<
         csv: csv.as_mut().map(|w| w as &mut dyn Write),
         stop: Some(&stop),
     };
-    let outcome = live::run(serial, probe.site, options, sinks, |status| {
+    let mut outcome = live::run(serial, probe.site, options, sinks, |status| {
         outln!("{status}")
     });
     outln!("end of stream    {}", outcome.end);
     if let Some(path) = &args.save {
-        let bytes = outcome.capture.stats.bytes;
+        let bytes = outcome.replayed.capture.stats.bytes;
         outln!("saved            {} ({bytes} bytes)", path.display());
     }
     if let live::StreamEnd::OutputFailed(e) = &outcome.end {
         anyhow::bail!("writing the live session's output: {e}");
     }
-    Ok(Replayed::from_live(port, outcome))
+    outcome.replayed.source = port.to_string();
+    Ok(outcome.replayed)
 }

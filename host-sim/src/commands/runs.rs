@@ -24,6 +24,23 @@ impl SeedsAndThreads {
             |t| t as usize,
         )
     }
+
+    /// `runs` seeds from `--first-seed` on [`threads`](Self::threads),
+    /// `progress` after each, until `stop`.
+    pub fn runs<'a>(
+        &self,
+        runs: u64,
+        progress: &'a (dyn Fn() + Sync),
+        stop: &'a std::sync::atomic::AtomicBool,
+    ) -> host_sim::study::StudyRuns<'a> {
+        host_sim::study::StudyRuns {
+            runs: runs as usize,
+            first_seed: self.first_seed,
+            threads: self.threads(),
+            progress,
+            stop,
+        }
+    }
 }
 
 /// A study's results: `table` on standard output and, with `--json`, the

@@ -3,13 +3,13 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use host_sim::analysis::calibration_file::CalibrationFile;
+use host_sim::formats::capture::ProbeSetup;
 use host_sim::sim::outputs::{drill, write_samples, LateralOutputs, SampleSink};
 use host_sim::sim::plan::Vibration;
 use host_sim::sim::{
     DeterministicErrors, Drilling, Motion, Plan, SensorModel, SensorModelFile, SensorSimulator,
     Trajectory,
 };
-use host_sim::formats::capture::ProbeSetup;
 use host_sim::survey::job::Job;
 use mwd_core::conventions::DEG;
 use mwd_core::earth::Position;
@@ -265,7 +265,10 @@ fn sample_sink(args: &Args, site: Position) -> Result<SampleSink<'_>> {
             let tie_in = tie_in(args)?;
             SampleSink::Capture {
                 path: output,
-                probe: ProbeSetup { tie_in, ..ProbeSetup::at(site) },
+                probe: ProbeSetup {
+                    tie_in,
+                    ..ProbeSetup::at(site)
+                },
             }
         }
         OutputFormat::Csv if to_stdout => SampleSink::Stdout,

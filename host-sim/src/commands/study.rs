@@ -84,14 +84,7 @@ fn drilling_coverage(args: CoverageArgs) -> Result<()> {
         "{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
     )?;
     let stop = stop_on_ctrl_c(Some(&bar))?;
-    let summary = study(
-        &config,
-        args.runs as usize,
-        args.seeds.first_seed,
-        threads,
-        &|| bar.inc(1),
-        &stop,
-    );
+    let summary = study(&config, &args.seeds.runs(args.runs, &|| bar.inc(1), &stop));
     bar.finish_and_clear();
     outln!(
         "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads, filter {}{})",
@@ -170,7 +163,7 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     // One bar per grade: the note goes to standard error.
     let stop = stop_on_ctrl_c(None)?;
     for name in grade_names(&args) {
-        summaries.push(rins_probe_grade(&args, &plan, name, threads, &stop)?);
+        summaries.push(rins_probe_grade(&args, &plan, name, &stop)?);
     }
     outln!(
         "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads{})",
@@ -212,7 +205,6 @@ fn rins_probe_grade(
     args: &RinsProbeArgs,
     plan: &host_sim::sim::BuiltPlan,
     name: GradeName,
-    threads: usize,
     stop: &std::sync::atomic::AtomicBool,
 ) -> Result<host_sim::study::rins_probe::GradeSummary> {
     use host_sim::study::rins_probe::{study, ProbeConfig, GRADES};
@@ -234,14 +226,7 @@ fn rins_probe_grade(
         "{msg} {bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
     )?;
     bar.set_message(grade.name);
-    let summary = study(
-        &config,
-        args.runs as usize,
-        args.seeds.first_seed,
-        threads,
-        &|| bar.inc(1),
-        stop,
-    );
+    let summary = study(&config, &args.seeds.runs(args.runs, &|| bar.inc(1), stop));
     bar.finish_and_clear();
     Ok(summary)
 }

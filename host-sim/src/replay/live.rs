@@ -28,11 +28,10 @@ use mwd_core::protocol::{Decoder, DecoderStats, NavSolution};
 
 use crate::formats::capture::CaptureSummary;
 use crate::formats::display;
-use crate::replay::commands::CommandRow;
 use crate::replay::replayer::Replayer;
-use crate::replay::rows::{ReplayRow, ReplaySummary};
+use crate::replay::report::Replayed;
+use crate::replay::rows::ReplaySummary;
 use crate::replay::rows_csv::CSV_HEADER;
-use crate::replay::step_loss::StepLoss;
 
 /// Why a live replay stopped.
 #[derive(Debug)]
@@ -157,19 +156,12 @@ pub struct LiveSinks<'a> {
     pub stop: Option<&'a AtomicBool>,
 }
 
-/// The result of a live replay: as a file replay gives, and why it ended.
-/// A session of any length keeps only this: the rows went to the CSV
-/// sink as they settled.
+/// The result of a live replay: what a file replay gives (its source
+/// the port, its stations listed from the probe's frames only), and why
+/// it ended. A session of any length keeps only this: the rows went to
+/// the CSV sink as they settled.
 pub struct LiveOutcome {
-    pub capture: CaptureSummary,
-    /// How many rows the replay made (one per raw frame replayed).
-    pub rows: usize,
-    /// The newest of them.
-    pub last_row: Option<ReplayRow>,
-    pub summary: ReplaySummary,
-    pub step_losses: Vec<StepLoss>,
-    /// The replies to uplink commands and what the replay did with each.
-    pub commands: Vec<CommandRow>,
+    pub replayed: Replayed,
     pub end: StreamEnd,
 }
 
@@ -268,12 +260,17 @@ fn outcome(
     let last_row = replayer.last_row().copied();
     let (_, summary) = replayer.finish();
     LiveOutcome {
-        capture,
-        rows,
-        last_row,
-        summary,
-        step_losses,
-        commands,
+        replayed: Replayed {
+            // the stream's name is the caller's (a port, a pipe)
+            source: String::new(),
+            capture,
+            rows,
+            last_row,
+            summary,
+            step_losses,
+            commands,
+            stations: None,
+        },
         end,
     }
 }
@@ -358,13 +355,16 @@ mod tests {
             outcome.end
         );
         let whole = crate::formats::capture::decode_bytes(&bytes);
-        assert_eq!(outcome.capture.stats, whole.stats);
-        assert_eq!(outcome.capture.stats.frames[0], 120);
+        assert_eq!(outcome.replayed.capture.stats, whole.stats);
+        assert_eq!(outcome.replayed.capture.stats.frames[0], 120);
         let (rows, summary) = replay::replay(&whole.frames, Position::paper_site());
-        assert_eq!(outcome.summary, summary);
-        assert_eq!(outcome.rows, rows.len());
+        assert_eq!(outcome.replayed.summary, summary);
+        assert_eq!(outcome.replayed.rows, rows.len());
         let last = rows.last().map(|r| r.solution.sample_counter);
-        assert_eq!(outcome.last_row.map(|r| r.solution.sample_counter), last);
+        assert_eq!(
+            outcome.replayed.last_row.map(|r| r.solution.sample_counter),
+            last
+        );
         // Display lines carry the link figures; the last one saw every frame.
         let last = shown.last().expect("a status line");
         assert!(last.contains("frames 120 lost 0 crc 0"), "{last}");
@@ -386,8 +386,8 @@ mod tests {
             |_| {},
         );
         assert!(matches!(outcome.end, StreamEnd::TimeLimit));
-        assert_eq!(outcome.rows, 0);
-        assert!(outcome.capture.stats.bytes > 0);
+        assert_eq!(outcome.replayed.rows, 0);
+        assert!(outcome.replayed.capture.stats.bytes > 0);
     }
 
     /// Hands out `bytes` in pieces, then stays silent (read timeouts) and
@@ -447,7 +447,7 @@ mod tests {
             outcome.end
         );
         assert_eq!(saved, bytes);
-        assert_eq!(outcome.rows, 150);
+        assert_eq!(outcome.replayed.rows, 150);
         let text = String::from_utf8(csv).unwrap();
         assert_eq!(text.lines().count(), 1 + 150);
         assert!(text.starts_with(replay::CSV_HEADER));
@@ -510,7 +510,7 @@ mod tests {
             sinks,
             |_| {},
         );
-        assert_eq!(outcome.rows, 200);
+        assert_eq!(outcome.replayed.rows, 200);
         // Without probe solutions to wait for, a row settles once 64 later
         // samples came: by the last read, all but those were written.
         let before_end = *watching.lines_seen.last().unwrap();
@@ -550,7 +550,7 @@ mod tests {
             "{}",
             outcome.end
         );
-        assert_eq!(outcome.rows, 30);
+        assert_eq!(outcome.replayed.rows, 30);
     }
 
     #[test]

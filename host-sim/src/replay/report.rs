@@ -6,7 +6,6 @@
 use crate::formats::capture::CaptureSummary;
 use crate::formats::display;
 use crate::replay::commands::CommandRow;
-use crate::replay::live::LiveOutcome;
 use crate::replay::{ReplayRow, ReplaySummary, StationRow, StationSummary, StepLoss};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -53,20 +52,6 @@ pub struct ReplayReport {
 }
 
 impl Replayed {
-    /// A live session's outcome, read from `port`.
-    pub fn from_live(port: &str, outcome: LiveOutcome) -> Self {
-        Self {
-            source: port.to_string(),
-            capture: outcome.capture,
-            rows: outcome.rows,
-            last_row: outcome.last_row,
-            summary: outcome.summary,
-            step_losses: outcome.step_losses,
-            commands: outcome.commands,
-            stations: None,
-        }
-    }
-
     /// The summary both modes end with, the CSV written to `csv` (if any)
     /// and the verdict. A replay `post_processed` with another calibration
     /// or site than the probe's is not a parity check: its verdict is

@@ -5,8 +5,8 @@
 //! samples are made (a lateral of a day is millions of samples: none is
 //! kept).
 
-use crate::formats::files::{create_buffered, is_broken_pipe};
 use crate::formats::capture::ProbeSetup;
+use crate::formats::files::{create_buffered, is_broken_pipe};
 use crate::formats::{capture, samples_csv};
 use crate::sim::stream::SensorStreamWriter;
 use crate::sim::{Drilling, DrillingSimulator, SensorModel, SimSample, Truth};

@@ -8,12 +8,11 @@
 
 use super::drilling_run::{failures, outcomes, run, RunConfig, RunOutcome};
 use super::stats::{rms, rms_and_median_sigma};
-use super::Interruption;
+use super::{Interruption, StudyRuns};
 use crate::survey::listing::drilling::station_valid;
 use crate::survey::listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
-use std::sync::atomic::AtomicBool;
 
 /// A fraction and its binomial standard error.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
@@ -102,24 +101,15 @@ pub struct StationCoverage {
     pub median_azimuth_sigma_deg: Option<f64>,
 }
 
-/// Runs seeds `first_seed..first_seed + runs` on `threads` threads;
-/// `progress` is called after each run. Setting `stop` (Ctrl-C) ends it
+/// Runs the seeds of `runs` (on its threads);
+/// `progress` after each run. Setting `stop` (Ctrl-C) ends it
 /// early: the runs under way finish, and the summary is over the runs
 /// done ([`Summary::interrupted`]).
-pub fn study(
-    config: &RunConfig,
-    runs: usize,
-    first_seed: u64,
-    threads: usize,
-    progress: &(dyn Fn() + Sync),
-    stop: &AtomicBool,
-) -> Summary {
+pub fn study(config: &RunConfig, runs: &StudyRuns) -> Summary {
     let started = std::time::Instant::now();
-    let results = super::run_seeds_until(runs, first_seed, threads, progress, stop, |seed| {
-        run(config, seed)
-    });
+    let results = runs.run(|seed| run(config, seed));
     let mut summary = summarise(&results);
-    summary.interrupted = Interruption::of(results.len(), runs);
+    summary.interrupted = Interruption::of(results.len(), runs.runs);
     summary.wall_s = started.elapsed().as_secs_f64();
     summary
 }

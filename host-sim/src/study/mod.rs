@@ -30,6 +30,34 @@ impl Interruption {
     }
 }
 
+/// Which runs a Monte Carlo study makes and how: seeds `first_seed..
+/// first_seed + runs` on `threads` threads, `progress` called after each,
+/// until `stop` is set.
+pub struct StudyRuns<'a> {
+    pub runs: usize,
+    pub first_seed: u64,
+    pub threads: usize,
+    pub progress: &'a (dyn Fn() + Sync),
+    pub stop: &'a AtomicBool,
+}
+
+impl StudyRuns<'_> {
+    /// [`run_seeds_until`] over these runs.
+    pub fn run<T: Send>(
+        &self,
+        run: impl Fn(u64) -> anyhow::Result<T> + Sync,
+    ) -> Vec<(u64, Result<T, String>)> {
+        run_seeds_until(
+            self.runs,
+            self.first_seed,
+            self.threads,
+            self.progress,
+            self.stop,
+            run,
+        )
+    }
+}
+
 /// Runs seeds `first_seed..first_seed + runs` on `threads` threads (each
 /// takes the next seed when done), calling `progress` after each; the
 /// outcomes in seed order, errors as "seed N: ...".

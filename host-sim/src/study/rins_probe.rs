@@ -20,7 +20,7 @@
 use super::drilling_coverage::Fraction;
 use super::drilling_run::{raw, tie_in};
 use super::stats::{percentile, rms};
-use super::Interruption;
+use super::{Interruption, StudyRuns};
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey::listing::drilling::azimuth_usable;
 use anyhow::Result;
@@ -34,7 +34,6 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
-use std::sync::atomic::AtomicBool;
 
 /// A gyro grade: the SCC1300's gyro errors divided by `factor`.
 #[derive(Clone, Copy, Debug, Serialize, PartialEq)]
@@ -336,25 +335,16 @@ fn summarise(
     }
 }
 
-/// Runs seeds `first_seed..first_seed + runs` of `config` on `threads`
-/// threads; `progress` is called after each run. Setting `stop` (Ctrl-C)
+/// Runs the seeds of `runs` of `config` (on its threads; `progress` and
+/// `stop` as there). Setting `stop` (Ctrl-C)
 /// ends it early: the runs under way finish, and the summary is over the
 /// runs done ([`GradeSummary::interrupted`]).
-pub fn study(
-    config: &ProbeConfig,
-    runs: usize,
-    first_seed: u64,
-    threads: usize,
-    progress: &(dyn Fn() + Sync),
-    stop: &AtomicBool,
-) -> GradeSummary {
+pub fn study(config: &ProbeConfig, runs: &StudyRuns) -> GradeSummary {
     let started = std::time::Instant::now();
-    let results = super::run_seeds_until(runs, first_seed, threads, progress, stop, |seed| {
-        run(config, seed)
-    });
+    let results = runs.run(|seed| run(config, seed));
     let outcomes: Vec<_> = results.into_iter().map(|r| r.1).collect();
     let mut summary = summarise(config.grade, config.reference_sigma, &outcomes);
-    summary.interrupted = Interruption::of(outcomes.len(), runs);
+    summary.interrupted = Interruption::of(outcomes.len(), runs.runs);
     summary.wall_s = started.elapsed().as_secs_f64();
     summary
 }

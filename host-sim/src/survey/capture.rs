@@ -14,8 +14,8 @@ use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::listing::drilling::{self, DrillingSurvey, TrajectoryPoint};
 use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
-use crate::survey::well_survey::WellSurvey;
 use crate::survey::stations::{StationCollector, SurveySetup};
+use crate::survey::well_survey::WellSurvey;
 use anyhow::{Context, Result};
 use mwd_core::probe::StationLink;
 use mwd_core::protocol::{DecoderStats, Frame, Payload};
@@ -130,8 +130,9 @@ impl CaptureSurvey {
             .map(|b| b.row)
             .filter(|b| left_out == 0 && b.cov.is_some());
         let direction = vsec_azimuth.unwrap_or_else(|| {
-            rows.last()
-                .map_or(0.0, |r| r.east_m.atan2(r.north_m).rem_euclid(std::f64::consts::TAU))
+            rows.last().map_or(0.0, |r| {
+                r.east_m.atan2(r.north_m).rem_euclid(std::f64::consts::TAU)
+            })
         });
         let (sin, cos) = direction.sin_cos();
         for r in rows.iter_mut() {

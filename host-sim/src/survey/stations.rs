@@ -15,8 +15,8 @@ use mwd_core::protocol::{Frame, NavSolution, Payload, StationSurvey};
 
 use crate::formats::depth_log::DepthLog;
 use crate::survey::job::Job;
-use crate::survey::listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
 pub use crate::survey::listing::drilling::SurveySetup;
+use crate::survey::listing::drilling::{self, AzimuthSigmaTrack, DrillingSurvey, StationStart};
 use crate::survey::listing::{LengthUnit, TieOnInput};
 
 /// The stations of one run as they come, each with its start.

@@ -10,10 +10,10 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;
 use mwd_core::probe::{Navigator, TieIn};
-use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::bytes::OutOfRoom;
 use mwd_core::protocol::frame::{raw_flags, Payload, RawPart, RawSample, NO_PART};
 use mwd_core::protocol::uplink::Reply;
+use mwd_core::protocol::uplink::StillSettings;
 use mwd_core::protocol::{Event, EventKind};
 use mwd_core::protocol::{FrameEncoder, MAX_WIRE_LEN};
 use mwd_core::sensor_units::{

@@ -735,14 +735,21 @@ mod tests {
         let ahead = angle_covariance_ahead(&st, &sig, d).unwrap();
         let plain = angle_covariance(&st, &sig).unwrap();
         assert_eq!(ahead.len(), 3);
-        assert_eq!(&ahead[..2], &plain[..], "the stations keep their covariance");
+        assert_eq!(
+            &ahead[..2],
+            &plain[..],
+            "the stations keep their covariance"
+        );
         let vertical = ((0.5 * l + d) * s_inc).powi(2);
         assert!(
             (ahead[2][2] - vertical).abs() < 1e-12 * vertical.max(1.0),
             "{} against {vertical}",
             ahead[2][2]
         );
-        assert!(ahead[2][2] > plain[1][2], "the bit is less certain than the station");
+        assert!(
+            ahead[2][2] > plain[1][2],
+            "the bit is less certain than the station"
+        );
         // and an azimuth error swings the bit sideways over the same lever
         let sig = [sigma(0.0, 0.0), sigma(0.0, 0.02)];
         let east = angle_covariance_ahead(&st, &sig, d).unwrap()[2][1];

@@ -381,15 +381,18 @@ pub fn survey(
         .collect();
     let mut covs = covariance(&rows, &sigmas, terms, site, ahead)?;
     let bit_cov = (covs.len() > rows.len()).then(|| covs.pop()).flatten();
-    let bit = bit_row.zip(ahead.zip(setup.sensor_to_bit_m)).map(|(mut row, (d, sensor_to_bit_m))| {
-        row.cov = bit_cov.map(|c| c.total);
-        BitProjection {
-            sensor_to_bit_m,
-            projected_m: d,
-            row,
-            method_cov: bit_cov.map(|c| c.method),
-        }
-    });
+    let bit =
+        bit_row
+            .zip(ahead.zip(setup.sensor_to_bit_m))
+            .map(|(mut row, (d, sensor_to_bit_m))| {
+                row.cov = bit_cov.map(|c| c.total);
+                BitProjection {
+                    sensor_to_bit_m,
+                    projected_m: d,
+                    row,
+                    method_cov: bit_cov.map(|c| c.method),
+                }
+            });
     let rows = kept
         .iter()
         .zip(rows)

@@ -103,24 +103,30 @@ fn line(r: &DrillingRow, confidence: f64) -> String {
 
 /// The listing's position columns, or "position undetermined".
 fn position_text(row: &super::Row, determined: bool, confidence: f64) -> String {
-    match (determined, row.cov, row.ellipse()) {
-        (true, Some(c), Some(e)) => {
-            let (a, b) = e.scaled(confidence);
-            format!(
-                " {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2} {:>7.2} {:>5.1}",
-                row.tvd_m,
-                row.north_m,
-                row.east_m,
-                c[0].max(0.0).sqrt(),
-                c[1].max(0.0).sqrt(),
-                e.sigma_vert,
-                a,
-                b,
-                e.azimuth_deg
-            )
-        }
-        _ => "  position undetermined".into(),
+    match position_numbers(row, determined, confidence) {
+        Some([tvd, n, e, sn, se, sv, a, b, az]) => format!(
+            " {tvd:>9.2} {n:>9.2} {e:>9.2} {sn:>6.2} {se:>6.2} {sv:>6.2} {a:>7.2} {b:>7.2} {az:>5.1}"
+        ),
+        None => "  position undetermined".into(),
     }
+}
+
+/// TVD, north, east, their sigmas (north, east, vertical), the ellipse's
+/// semi-axes at `confidence` and its azimuth; `None` where undetermined.
+fn position_numbers(row: &super::Row, determined: bool, confidence: f64) -> Option<[f64; 9]> {
+    let (c, e) = (row.cov.filter(|_| determined)?, row.ellipse()?);
+    let (a, b) = e.scaled(confidence);
+    Some([
+        row.tvd_m,
+        row.north_m,
+        row.east_m,
+        c[0].max(0.0).sqrt(),
+        c[1].max(0.0).sqrt(),
+        e.sigma_vert,
+        a,
+        b,
+        e.azimuth_deg,
+    ])
 }
 
 /// The bit's line: the last station's angles (and sigmas) held straight
@@ -149,21 +155,9 @@ fn opt(v: Option<f64>) -> String {
 
 /// Position columns, empty where undetermined.
 fn position_cells(row: &super::Row, determined: bool, confidence: f64) -> String {
-    match (determined, row.cov, row.ellipse()) {
-        (true, Some(c), Some(e)) => {
-            let (a, b) = e.scaled(confidence);
-            format!(
-                "{},{},{},{},{},{},{a},{b},{}",
-                row.tvd_m,
-                row.north_m,
-                row.east_m,
-                c[0].max(0.0).sqrt(),
-                c[1].max(0.0).sqrt(),
-                e.sigma_vert,
-                e.azimuth_deg
-            )
-        }
-        _ => ",,,,,,,,".into(),
+    match position_numbers(row, determined, confidence) {
+        Some(v) => v.map(|x| x.to_string()).join(","),
+        None => ",,,,,,,,".into(),
     }
 }
 

@@ -125,11 +125,7 @@ impl RunFiles {
 
     /// What the simulation wrote.
     fn simulation(&self) -> Vec<PathBuf> {
-        vec![
-            self.capture.clone(),
-            self.depth.clone(),
-            self.truth.clone(),
-        ]
+        vec![self.capture.clone(), self.depth.clone(), self.truth.clone()]
     }
 }
 

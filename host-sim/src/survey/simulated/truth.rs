@@ -151,7 +151,12 @@ impl TruthChecks {
     }
 }
 
-fn check(label: String, row: &crate::survey::listing::Row, truth: Vector3<f64>, determined: bool) -> PointCheck {
+fn check(
+    label: String,
+    row: &crate::survey::listing::Row,
+    truth: Vector3<f64>,
+    determined: bool,
+) -> PointCheck {
     PointCheck {
         label,
         md_m: row.md_m,
@@ -193,9 +198,9 @@ fn point_line(c: &PointCheck, p: f64) -> String {
     let ellipse = Ellipse::from_cov(&cov);
     let (a, b) = ellipse.scaled(p);
     let z = normal_two_sided(p);
-    let horizontal = c
-        .d2_horizontal()
-        .map_or("undetermined".into(), |d2| format!("{:.2}", d2.sqrt() / scale_2d(p)));
+    let horizontal = c.d2_horizontal().map_or("undetermined".into(), |d2| {
+        format!("{:.2}", d2.sqrt() / scale_2d(p))
+    });
     let verdict = match (c.inside_horizontal(p), c.inside_vertical(p)) {
         (Some(true), Some(true)) => "inside",
         (Some(false), _) | (_, Some(false)) => "OUTSIDE",
@@ -241,12 +246,27 @@ mod tests {
         // 95 % ellipse (2.45 sigma); 2.4 m north is 2.4 sigma: also inside;
         // 2.6 m north is outside
         let cov = [1.0, 4.0, 0.25, 0.0, 0.0, 0.0];
-        assert_eq!(point([0.0, 2.4, 0.0], cov).inside_horizontal(0.95), Some(true));
-        assert_eq!(point([2.4, 0.0, 0.0], cov).inside_horizontal(0.95), Some(true));
-        assert_eq!(point([2.6, 0.0, 0.0], cov).inside_horizontal(0.95), Some(false));
+        assert_eq!(
+            point([0.0, 2.4, 0.0], cov).inside_horizontal(0.95),
+            Some(true)
+        );
+        assert_eq!(
+            point([2.4, 0.0, 0.0], cov).inside_horizontal(0.95),
+            Some(true)
+        );
+        assert_eq!(
+            point([2.6, 0.0, 0.0], cov).inside_horizontal(0.95),
+            Some(false)
+        );
         // vertical: 0.5 m sigma, 1.0 m is 2 sigma: outside the 95 % interval
-        assert_eq!(point([0.0, 0.0, 0.9], cov).inside_vertical(0.95), Some(true));
-        assert_eq!(point([0.0, 0.0, 1.0], cov).inside_vertical(0.95), Some(false));
+        assert_eq!(
+            point([0.0, 0.0, 0.9], cov).inside_vertical(0.95),
+            Some(true)
+        );
+        assert_eq!(
+            point([0.0, 0.0, 1.0], cov).inside_vertical(0.95),
+            Some(false)
+        );
         let undetermined = PointCheck {
             cov: None,
             ..point([0.0; 3], cov)
