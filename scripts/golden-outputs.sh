@@ -120,7 +120,7 @@ run() {
 
 # --- the command line itself: every subcommand's help ------------------
 run help 0 --help
-for sub in demo simulate decode replay align allan arfit calibrate observability survey \
+for sub in drill demo simulate decode replay align allan arfit calibrate observability survey \
   dashboard study paper probe "study drilling-coverage" "study rins-probe" "study lateral" \
   "paper tls" "paper mgwd" "paper rins" "probe configure" "probe status"; do
   # shellcheck disable=SC2086 # the subcommand's words
@@ -150,7 +150,10 @@ run simulate-calibrated 0 simulate --calibration-file "$R/calibration/six.cal.js
 run align-calibrated 0 align "$R/calibration/calibrated.csv" \
   --calibration-file "$R/calibration/six.cal.json"
 
-# --- the papers (the README's main job `paper mgwd` as it is) ----------
+# --- README's main job: the example lateral drilled and surveyed -------
+run drill 0 drill --out "$R/drill"
+
+# --- the papers (`paper mgwd` as it is) -------------------------------
 run paper-mgwd 0 paper mgwd
 run paper-mgwd-plots 0 paper mgwd --plots "$R/paper/mgwd-plots"
 run paper-mgwd-ar-models 0 paper mgwd --ar-models "$R/noise/long.ar.json" --paper-derived-rate
@@ -200,9 +203,12 @@ run tiein-decode 0 decode "$T/run.bin" --csv "$T/frames.csv"
 run tiein-survey 0 survey "$T/run.bin" --depth "$T/depth.csv" --job "$T/job.json" \
   --csv "$T/stations.csv" --trajectory "$T/trajectory.csv"
 run tiein-survey-unlinked 0 survey "$T/run.bin" --depth "$T/depth.csv" --tie-on-md 3000
-# a capture survey has the probe's own uncertainty: --json is refused, exit 1
-run tiein-survey-json-refused 1 survey "$T/run.bin" --depth "$T/depth.csv" --job "$T/job.json" \
-  --json "$T/refused.json"
+# a capture survey's exports through the station-file writers; another
+# error model is refused (the capture's uncertainty is the probe's own)
+run tiein-survey-exports 0 survey "$T/run.bin" --depth "$T/depth.csv" --job "$T/job.json" \
+  --json "$T/survey.json" --witsml "$T/survey.xml" --plot "$T/plots"
+run tiein-survey-model-refused 1 survey "$T/run.bin" --depth "$T/depth.csv" --job "$T/job.json" \
+  --error-model "GYRO-MWD"
 
 # --- station surveys: README's ISCWSA well #1, the probe's model with an offset
 S="$R/survey"
