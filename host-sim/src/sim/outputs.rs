@@ -18,6 +18,8 @@ use std::path::{Path, PathBuf};
 
 /// Where the samples go.
 #[derive(Clone, Copy, Debug)]
+// One per run: the capture's probe configuration inline costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum SampleSink<'a> {
     /// A capture (`.bin`) of a probe at `site` (tied in to `tie_in`): a
     /// boot event, then raw-sample and navigation frames.

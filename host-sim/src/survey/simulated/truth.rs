@@ -35,8 +35,7 @@ impl PointCheck {
         let (nn, ee, ne) = (c[0], c[1], c[3]);
         let [n, e, _] = self.error_nev;
         let det = nn * ee - ne * ne;
-        // (also false for NaN)
-        if !(det > 0.0) {
+        if det.is_nan() || det <= 0.0 {
             return None;
         }
         Some((ee * n * n - 2.0 * ne * n * e + nn * e * e) / det)
