@@ -10,7 +10,7 @@ use super::site::SiteArgs;
 use anyhow::{bail, Result};
 use host_sim::survey::capture::{CaptureSurveyInputs, ProbeSetup};
 use host_sim::survey::iscwsa::Site;
-use host_sim::survey::job::{Job, SurveyJob};
+use host_sim::survey::job::{Job, SurveyJob, WellNames};
 use host_sim::survey::listing::separation as sep;
 use host_sim::survey::listing::{
     self as listing, drilling, AzimuthReference, KnownModel, LengthUnit, TieOnInput,
@@ -190,6 +190,9 @@ struct Resolved {
     /// Latitude of the site, rad.
     latitude: f64,
     job: SurveyJob,
+    /// The well's and wellbore's names and uids (the WITSML output's):
+    /// the job's, else placeholders.
+    well: WellNames,
     /// The probe's configuration for a capture's replay (`survey_capture`):
     /// the site, the job's calibration, still settings and tie-in (else
     /// none, the probe's defaults, none).
@@ -216,9 +219,11 @@ impl Resolved {
                 .unwrap_or_else(default_still_settings),
             tie_in: job.as_ref().and_then(|j| j.tie_in),
         };
+        let (job, well) = job.map_or_else(Default::default, |j| (j.survey, j.well));
         Ok(Self {
             latitude: site.lat,
-            job: job.map(|j| j.survey).unwrap_or_default(),
+            job,
+            well,
             probe,
         })
     }
@@ -268,6 +273,7 @@ pub fn run(args: Args) -> Result<()> {
             confidence: args.confidence,
             vsec_azimuth: args.vsec_azimuth_deg.map(f64::to_radians),
             offset: offset.map(|p| offset_inputs(&args, p)).transpose()?,
+            well: &resolved.well,
         };
         return super::survey_capture::run(&args.capture, &inputs, &outputs, &site_for);
     }
@@ -280,6 +286,7 @@ pub fn run(args: Args) -> Result<()> {
         confidence: args.confidence,
     };
     let mut survey = WellSurvey::compute(&file, &inputs, &site_for)?;
+    survey.well = resolved.well.clone();
     if let Some(path) = &args.sep.offset {
         survey.add_offset(&offset_inputs(&args, path)?, &site_for)?;
     }

@@ -11,6 +11,7 @@ use super::limits::number_in;
 use anyhow::Result;
 use host_sim::formats::files::write_text;
 use host_sim::survey::capture::{trajectory_csv, CaptureSurvey, CaptureSurveyInputs};
+use host_sim::survey::job::WellNames;
 use host_sim::survey::outputs::{write_outputs, OutputPaths};
 use host_sim::survey::well_survey::{OffsetInputs, SiteFor};
 use std::path::PathBuf;
@@ -48,6 +49,8 @@ pub struct CaptureOutputs<'a> {
     /// Vertical-section azimuth, rad (`None`: the closure).
     pub vsec_azimuth: Option<f64>,
     pub offset: Option<OffsetInputs<'a>>,
+    /// The well's names and uids (the WITSML trajectory's).
+    pub well: &'a WellNames,
 }
 
 /// Surveys the capture, prints the listing and writes the outputs asked
@@ -61,6 +64,7 @@ pub fn run(
     let confidence = outputs.confidence;
     let survey = CaptureSurvey::run(inputs)?;
     let mut exported = survey.well_survey(confidence, outputs.vsec_azimuth)?;
+    exported.well = outputs.well.clone();
     if let Some(offset) = &outputs.offset {
         exported.add_offset(offset, site_for)?;
     }

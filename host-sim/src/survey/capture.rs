@@ -160,6 +160,7 @@ impl CaptureSurvey {
             offset: None,
             bit,
             header_note: (!notes.is_empty()).then(|| notes.join("; ")),
+            well: crate::survey::job::WellNames::default(),
         })
     }
 

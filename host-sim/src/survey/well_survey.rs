@@ -10,6 +10,7 @@
 //! gives (and refuses to go without).
 
 use crate::survey::iscwsa::Site;
+use crate::survey::job::WellNames;
 use crate::survey::listing::separation as sep;
 use crate::survey::listing::{
     self as listing, AzimuthReference, Invalid, KnownModel, LengthUnit, Row, StationFile,
@@ -96,6 +97,9 @@ pub struct WellSurvey {
     /// are placed, what they are not (a capture survey without a
     /// tie-on); the listing, the JSON and the figures carry it.
     pub header_note: Option<String>,
+    /// The well's and wellbore's names and uids (the WITSML trajectory
+    /// carries them): the job's, else placeholders.
+    pub well: WellNames,
 }
 
 impl WellSurvey {
@@ -125,6 +129,7 @@ impl WellSurvey {
             offset: None,
             bit: None,
             header_note: None,
+            well: WellNames::default(),
         })
     }
 

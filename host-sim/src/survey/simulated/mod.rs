@@ -206,7 +206,8 @@ fn write_survey(
 ) -> Result<Vec<PathBuf>> {
     write_text(&files.stations, &survey.stations_csv(confidence))?;
     write_text(&files.listing, &survey.report(confidence))?;
-    let exported = survey.well_survey(confidence, None)?;
+    let mut exported = survey.well_survey(confidence, None)?;
+    exported.well = job.well.clone();
     let paths = OutputPaths {
         csv: None,
         json: Some(&files.json),

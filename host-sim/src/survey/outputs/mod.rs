@@ -11,6 +11,9 @@ use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod witsml;
+pub use witsml::witsml_text;
+
 /// Where the outputs go (each one only when given).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct OutputPaths<'a> {
@@ -276,45 +279,4 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         });
     }
     Ok(serde_json::to_string_pretty(&doc)? + "\n")
-}
-
-pub fn witsml_text(s: &WellSurvey) -> String {
-    let mut x = String::from(
-        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n\
-         <trajectorys xmlns=\"http://www.witsml.org/schemas/1series\" version=\"1.4.1.1\">\n\
-         \x20 <trajectory uidWell=\"well\" uidWellbore=\"wellbore\" uid=\"survey\">\n\
-         \x20   <nameWell>well</nameWell>\n\
-         \x20   <nameWellbore>wellbore</nameWellbore>\n\
-         \x20   <name>host-sim survey</name>\n",
-    );
-    if let (Some(first), Some(last)) = (s.rows.first(), s.rows.last()) {
-        let _ = writeln!(x, "    <mdMn uom=\"m\">{}</mdMn>", first.md_m);
-        let _ = writeln!(x, "    <mdMx uom=\"m\">{}</mdMx>", last.md_m);
-    }
-    let _ = writeln!(
-        x,
-        "    <aziVertSect uom=\"dega\">{}</aziVertSect>",
-        s.vsec_azimuth_deg
-    );
-    x += "    <aziRef>true north</aziRef>\n";
-    for (k, r) in s.rows.iter().enumerate() {
-        let kind = if k == 0 { "tie in point" } else { "unknown" };
-        let _ = write!(
-            x,
-            "    <trajectoryStation uid=\"st{k}\">\n\
-             \x20     <typeTrajStation>{kind}</typeTrajStation>\n\
-             \x20     <md uom=\"m\">{}</md>\n\
-             \x20     <tvd uom=\"m\">{}</tvd>\n\
-             \x20     <incl uom=\"dega\">{}</incl>\n\
-             \x20     <azi uom=\"dega\">{}</azi>\n\
-             \x20     <dispNs uom=\"m\">{}</dispNs>\n\
-             \x20     <dispEw uom=\"m\">{}</dispEw>\n\
-             \x20     <vertSect uom=\"m\">{}</vertSect>\n\
-             \x20     <dls uom=\"dega/30m\">{}</dls>\n\
-             \x20   </trajectoryStation>\n",
-            r.md_m, r.tvd_m, r.inc_deg, r.azi_deg, r.north_m, r.east_m, r.vsec_m, r.dls_deg_per_30m
-        );
-    }
-    x += "  </trajectory>\n</trajectorys>\n";
-    x
 }
