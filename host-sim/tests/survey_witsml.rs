@@ -119,7 +119,10 @@ fn well1_trajectory_reads_back() {
         let at = |name: &str| names.iter().position(|n| *n == name);
         assert!(at("md") < at("tvd") && at("tvd") < at("dls"), "{names:?}");
         let Some(cov) = js["nev_covariance_m2"].as_array() else {
-            assert!(at("matrixCov").is_none(), "a matrixCov without a covariance");
+            assert!(
+                at("matrixCov").is_none(),
+                "a matrixCov without a covariance"
+            );
             continue;
         };
         assert_eq!(at("matrixCov"), Some(names.len() - 1), "{names:?}");
