@@ -330,6 +330,25 @@ mod tests {
     }
 
     #[test]
+    fn tab_aware_tables_keep_spaces_and_empty_fields() {
+        let mut out = Vec::new();
+        for_each_record_tab_aware(&b"MD (m)\tInc (deg)\n1\t\t2\n"[..], |_, f| {
+            out.push(f.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(out, [vec!["MD (m)", "Inc (deg)"], vec!["1", "", "2"]]);
+        // without a tab, as before: runs of blanks
+        let mut out = Vec::new();
+        for_each_record_tab_aware(&b"a  b\n1 2\n"[..], |_, f| {
+            out.push(f.len());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(out, [2, 2]);
+    }
+
+    #[test]
     fn long_lines_and_binary_are_refused_with_a_short_message() {
         let long = vec![b'1'; MAX_LINE_BYTES + 10];
         let e = rows(&long).unwrap_err().to_string();
