@@ -1,12 +1,31 @@
 //! The station file of `host-sim survey` (CSV): a header line, then one
-//! station a line. Columns (any order): `md_m` or `md_ft` (one of them:
-//! feet and metres are never mixed, and every length column of the file
-//! must be in the same unit), `inc_deg`, `azi_deg` required;
-//! `toolface_deg`, `time_s` optional (carried to the outputs). Read and
-//! checked here (finite numbers, MD increasing, inclination in 0..=180
-//! deg, at least one station), lengths left in the file's unit.
+//! station a line. Columns (any order, names matched case-insensitively,
+//! blanks around them ignored):
+//!
+//! - MD, required: `md`, `depth` or `measured depth` with its length unit
+//!   (`md_m`, `MD (m)`, `Depth [ft]`, `md ft`...; metres: `m`; feet: `ft`,
+//!   `feet`, `usft`). US survey feet are read as international feet: the
+//!   two differ by 2 ppm (6 mm in 3000 m), far below any survey's
+//!   uncertainty. A MD column without a unit is refused: the tool does not
+//!   guess between feet and metres.
+//! - inclination, required: `inc`, `incl`, `inclination`; azimuth,
+//!   required: `azi`, `az`, `azimuth` (also `azi_true`: the azimuths' north
+//!   is the command line's `--azimuth-reference`); toolface, optional:
+//!   `toolface`, `tf`, `tool face`. Angles are in degrees: no unit, or
+//!   `_deg`, `(deg)`, `[deg]`; any other unit is refused.
+//! - time, optional: `time_s`, `time (s)`.
+//!
+//! Other columns (TVD, N, E, DLS of another tool's listing) are ignored;
+//! two columns giving the same quantity are refused, and so is a header
+//! with lengths in both feet and metres. Separators: comma, semicolon or
+//! tab (else runs of spaces), from the header line. A row whose `station`
+//! column holds `bit` (the bit's projection ending a capture survey's
+//! stations CSV) is skipped: it repeats the last station's angles at the
+//! bit's depth, it is no survey station. Read and checked here (finite
+//! numbers, MD increasing, inclination in 0..=180 deg, at least one
+//! station), lengths left in the file's unit.
 
-use crate::formats::text_records::{excerpt, for_each_record};
+use crate::formats::text_records::{excerpt, for_each_record_tab_aware};
 use anyhow::{anyhow, bail, Result};
 use std::io::Read;
 
@@ -47,27 +66,130 @@ pub struct StationFile {
     pub stations: Vec<InputStation>,
 }
 
+/// What a column gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Quantity {
+    Md,
+    Inc,
+    Azi,
+    Toolface,
+    Time,
+}
+
+impl Quantity {
+    /// Its name in the errors (that of the tool's own header).
+    fn name(self) -> &'static str {
+        match self {
+            Self::Md => "MD",
+            Self::Inc => "inclination",
+            Self::Azi => "azimuth",
+            Self::Toolface => "toolface",
+            Self::Time => "time",
+        }
+    }
+}
+
+/// A header name cut into its quantity's name and its unit, both lower
+/// case: `MD (m)`, `md_m`, `Md [m]` and `md m` all give ("md", "m").
+/// The name's underscores and runs of blanks become one space.
+fn name_and_unit(header: &str) -> (String, Option<String>) {
+    let lower = header.trim().to_ascii_lowercase();
+    let normal = |s: &str| {
+        s.split([' ', '_', '\t'])
+            .filter(|w| !w.is_empty())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    for (open, close) in [('(', ')'), ('[', ']')] {
+        if let Some(inner) = lower.strip_suffix(close) {
+            if let Some(at) = inner.rfind(open) {
+                let unit = inner[at + 1..].trim().to_string();
+                return (normal(&inner[..at]), Some(unit));
+            }
+        }
+    }
+    let name = normal(&lower);
+    if let Some((head, tail)) = name.rsplit_once(' ') {
+        if is_unit(tail) {
+            return (head.to_string(), Some(tail.to_string()));
+        }
+    }
+    (name, None)
+}
+
+const METRE_UNITS: [&str; 5] = ["m", "metre", "metres", "meter", "meters"];
+/// US survey feet are taken as international feet (see the module's doc).
+const FOOT_UNITS: [&str; 4] = ["ft", "feet", "foot", "usft"];
+const DEGREE_UNITS: [&str; 4] = ["deg", "degree", "degrees", "°"];
+/// Angle units refused by name rather than left as part of a name.
+const OTHER_ANGLE_UNITS: [&str; 6] = ["rad", "radian", "radians", "mrad", "grad", "gon"];
+const SECOND_UNITS: [&str; 2] = ["s", "sec"];
+
+/// Whether a name's last word is a unit (`md_m`, `inc_deg`), not part
+/// of the name (`measured depth`).
+fn is_unit(word: &str) -> bool {
+    [
+        &METRE_UNITS[..],
+        &FOOT_UNITS,
+        &DEGREE_UNITS,
+        &OTHER_ANGLE_UNITS,
+        &SECOND_UNITS,
+    ]
+    .iter()
+    .any(|units| units.contains(&word))
+}
+
+fn length_unit(unit: &str) -> Option<LengthUnit> {
+    if METRE_UNITS.contains(&unit) {
+        Some(LengthUnit::Metre)
+    } else if FOOT_UNITS.contains(&unit) {
+        Some(LengthUnit::Foot)
+    } else {
+        None
+    }
+}
+
+/// The quantity a column's name gives, if any of the five.
+fn quantity(name: &str, unit: Option<&str>) -> Option<Quantity> {
+    let q = match name {
+        "md" | "depth" | "measured depth" => Quantity::Md,
+        "inc" | "incl" | "inclination" => Quantity::Inc,
+        "azi" | "az" | "azimuth" | "azi true" | "az true" | "azimuth true" => Quantity::Azi,
+        "toolface" | "tf" | "tool face" => Quantity::Toolface,
+        // a time without a unit may be a clock time: left alone
+        "time" if unit.is_some_and(|u| SECOND_UNITS.contains(&u)) => Quantity::Time,
+        _ => return None,
+    };
+    Some(q)
+}
+
+/// The required columns, for the errors.
+const REQUIRED: &str = "required: md_m or md_ft, inc_deg, azi_deg";
+
 struct Columns {
     md: usize,
     inc: usize,
     azi: usize,
     toolface: Option<usize>,
     time: Option<usize>,
+    /// Of the `station` column, if any: its `bit` row is skipped.
+    station: Option<usize>,
     unit: LengthUnit,
+    /// The header's names of the MD, inclination... columns, for the errors.
+    names: [String; 5],
 }
 
-fn columns(header: &[&str]) -> Result<Columns> {
-    let find = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
-    let metres: Vec<&str> = header
-        .iter()
-        .copied()
-        .filter(|h| h.ends_with("_m"))
-        .collect();
-    let feet: Vec<&str> = header
-        .iter()
-        .copied()
-        .filter(|h| h.ends_with("_ft"))
-        .collect();
+fn columns(header: &[&str], line: u64) -> Result<Columns> {
+    let parsed: Vec<(String, Option<String>)> = header.iter().map(|h| name_and_unit(h)).collect();
+    let with_unit = |unit: LengthUnit| -> Vec<&str> {
+        header
+            .iter()
+            .zip(&parsed)
+            .filter(|(_, (_, u))| u.as_deref().and_then(length_unit) == Some(unit))
+            .map(|(h, _)| *h)
+            .collect()
+    };
+    let (metres, feet) = (with_unit(LengthUnit::Metre), with_unit(LengthUnit::Foot));
     if !metres.is_empty() && !feet.is_empty() {
         bail!(
             "the header mixes feet and metres ({} and {}): give every length in one unit",
@@ -75,29 +197,80 @@ fn columns(header: &[&str]) -> Result<Columns> {
             feet.join(", ")
         );
     }
-    let (md, unit) = match (find("md_m"), find("md_ft")) {
-        (Some(c), None) => (c, LengthUnit::Metre),
-        (None, Some(c)) => (c, LengthUnit::Foot),
-        _ => bail!(
-            "no column md_m or md_ft in the header `{}` (required: md_m or md_ft, inc_deg, azi_deg)",
-            excerpt(&header.join(","))
-        ),
+    let mut found: [Option<usize>; 5] = [None; 5];
+    let all = [
+        Quantity::Md,
+        Quantity::Inc,
+        Quantity::Azi,
+        Quantity::Toolface,
+        Quantity::Time,
+    ];
+    for (col, (name, unit)) in parsed.iter().enumerate() {
+        let Some(q) = quantity(name, unit.as_deref()) else {
+            continue;
+        };
+        let slot = &mut found[q as usize];
+        if let Some(first) = *slot {
+            bail!(
+                "line {line}: columns `{}` and `{}` both give the {}: keep one",
+                excerpt(header[first]),
+                excerpt(header[col]),
+                q.name()
+            );
+        }
+        *slot = Some(col);
+        let angle = matches!(q, Quantity::Inc | Quantity::Azi | Quantity::Toolface);
+        if let (true, Some(u)) = (angle, unit.as_deref()) {
+            if !DEGREE_UNITS.contains(&u) {
+                bail!(
+                    "line {line}: column `{}`: the {} is in `{}`, not degrees: give angles in degrees",
+                    excerpt(header[col]),
+                    q.name(),
+                    excerpt(u)
+                );
+            }
+        }
+    }
+    let header_text = || excerpt(&header.join(","));
+    let Some(md) = found[Quantity::Md as usize] else {
+        bail!(
+            "no column md_m or md_ft in the header `{}` ({REQUIRED})",
+            header_text()
+        );
     };
-    let need = |name: &str| {
-        find(name).ok_or_else(|| {
+    let unit = match parsed[md].1.as_deref() {
+        None => bail!(
+            "line {line}: the MD column `{}` has no unit: name it with one, e.g. \"MD (m)\" or \"md_ft\"",
+            excerpt(header[md])
+        ),
+        Some(u) => length_unit(u).ok_or_else(|| {
             anyhow!(
-                "no column {name} in the header `{}` (required: md_m or md_ft, inc_deg, azi_deg)",
-                excerpt(&header.join(","))
+                "line {line}: the MD column `{}` is in `{}`: give MD in m or ft",
+                excerpt(header[md]),
+                excerpt(u)
+            )
+        })?,
+    };
+    let need = |q: Quantity, name: &str| {
+        found[q as usize].ok_or_else(|| {
+            anyhow!(
+                "no column {name} in the header `{}` ({REQUIRED})",
+                header_text()
             )
         })
     };
+    let names = all.map(|q| found[q as usize].map_or_else(String::new, |c| excerpt(header[c])));
     Ok(Columns {
         md,
-        inc: need("inc_deg")?,
-        azi: need("azi_deg")?,
-        toolface: find("toolface_deg"),
-        time: find("time_s"),
+        inc: need(Quantity::Inc, "inc_deg")?,
+        azi: need(Quantity::Azi, "azi_deg")?,
+        toolface: found[Quantity::Toolface as usize],
+        time: found[Quantity::Time as usize],
+        station: parsed
+            .iter()
+            .position(|(n, u)| n == "station" && u.is_none()),
         unit,
+        names,
     })
 }
 
@@ -127,22 +300,23 @@ fn optional(fields: &[&str], col: Option<usize>, name: &str, line: u64) -> Resul
 pub fn read_stations<R: Read>(input: R) -> Result<StationFile> {
     let mut cols: Option<Columns> = None;
     let mut stations: Vec<InputStation> = Vec::new();
-    for_each_record(input, |line, fields| {
+    for_each_record_tab_aware(input, |line, fields| {
         let Some(c) = &cols else {
-            cols = Some(columns(fields)?);
+            cols = Some(columns(fields, line)?);
             return Ok(());
         };
-        let unit = if c.unit == LengthUnit::Metre {
-            "md_m"
-        } else {
-            "md_ft"
-        };
+        if c.station
+            .is_some_and(|k| fields.get(k).is_some_and(|f| f.eq_ignore_ascii_case("bit")))
+        {
+            return Ok(());
+        }
+        let [md, inc, azi, toolface, time] = &c.names;
         let s = InputStation {
-            md: number(fields, c.md, unit, line)?,
-            inc_deg: number(fields, c.inc, "inc_deg", line)?,
-            azi_deg: number(fields, c.azi, "azi_deg", line)?,
-            toolface_deg: optional(fields, c.toolface, "toolface_deg", line)?,
-            time_s: optional(fields, c.time, "time_s", line)?,
+            md: number(fields, c.md, md, line)?,
+            inc_deg: number(fields, c.inc, inc, line)?,
+            azi_deg: number(fields, c.azi, azi, line)?,
+            toolface_deg: optional(fields, c.toolface, toolface, line)?,
+            time_s: optional(fields, c.time, time, line)?,
         };
         if !(0.0..=180.0).contains(&s.inc_deg) {
             bail!("line {line}: inclination {} deg outside 0..180", s.inc_deg);
@@ -171,4 +345,189 @@ pub fn read_stations<R: Read>(input: R) -> Result<StationFile> {
         unit: c.unit,
         stations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str) -> Result<StationFile> {
+        read_stations(text.as_bytes())
+    }
+
+    fn refused(text: &str, needle: &str) {
+        let e = format!("{:#}", read(text).unwrap_err());
+        assert!(e.contains(needle), "`{e}` lacks `{needle}`");
+    }
+
+    /// MD, inclination and azimuth of every station.
+    fn angles(f: &StationFile) -> Vec<[f64; 3]> {
+        f.stations
+            .iter()
+            .map(|s| [s.md, s.inc_deg, s.azi_deg])
+            .collect()
+    }
+
+    const ROWS: &str = "0,0,0\n30,1.5,10\n";
+
+    fn expect_rows(f: &StationFile) {
+        assert_eq!(angles(f), [[0.0, 0.0, 0.0], [30.0, 1.5, 10.0]]);
+    }
+
+    #[test]
+    fn md_spellings_and_their_units() {
+        for (md, unit) in [
+            ("md_m", LengthUnit::Metre),
+            ("MD (m)", LengthUnit::Metre),
+            (" Depth[m] ", LengthUnit::Metre),
+            ("measured depth m", LengthUnit::Metre),
+            ("Measured_Depth_M", LengthUnit::Metre),
+            ("md_ft", LengthUnit::Foot),
+            ("MD [ft]", LengthUnit::Foot),
+            ("Depth(ft)", LengthUnit::Foot),
+            ("depth feet", LengthUnit::Foot),
+            ("MD (usft)", LengthUnit::Foot),
+        ] {
+            let f = read(&format!("{md},inc_deg,azi_deg\n{ROWS}")).unwrap();
+            assert_eq!(f.unit, unit, "{md}");
+            expect_rows(&f);
+        }
+    }
+
+    #[test]
+    fn angle_spellings() {
+        for inc in [
+            "inc",
+            "INCL",
+            "Inclination",
+            "inc_deg",
+            "Inc (deg)",
+            "incl [deg]",
+        ] {
+            for azi in [
+                "azi",
+                "Az",
+                "AZIMUTH",
+                "azi_deg",
+                "Azimuth (deg)",
+                "azi_true_deg",
+            ] {
+                let f = read(&format!("md_m,{inc},{azi}\n{ROWS}")).unwrap();
+                expect_rows(&f);
+            }
+        }
+    }
+
+    #[test]
+    fn toolface_and_time_spellings() {
+        for tf in ["toolface_deg", "toolface", "TF", "Toolface (deg)"] {
+            for time in ["time_s", "Time (s)", "TIME [s]"] {
+                let f = read(&format!(
+                    "md_m,inc,azi,{tf},{time}\n0,0,0,5,1\n30,1,10,,2\n"
+                ))
+                .unwrap();
+                assert_eq!(f.stations[0].toolface_deg, Some(5.0), "{tf}");
+                assert_eq!(f.stations[1].toolface_deg, None);
+                assert_eq!(f.stations[1].time_s, Some(2.0), "{time}");
+            }
+        }
+        // a time without a unit (maybe a clock time) is not read
+        let f = read("md_m,inc,azi,time\n0,0,0,12:00\n30,1,10,12:05\n").unwrap();
+        assert_eq!(f.stations[0].time_s, None);
+    }
+
+    #[test]
+    fn separators_and_other_columns() {
+        for text in [
+            "MD (m);Inc (deg);TVD (m);Azi (deg)\n0;0;0;0\n30;1.5;30;10\n",
+            "MD (m)\tInc (deg)\tTVD (m)\tAzi (deg)\n0\t0\t0\t0\n30\t1.5\t30\t10\n",
+            "md_m inc_deg tvd_m azi_deg\n0 0 0 0\n30 1.5 30 10\n",
+            "MD [m],Inc,Azi,TVD [m],N [m],E [m],DLS [deg/30m]\n0,0,0,0,0,0,0\n30,1.5,10,30,0,0,1.5\n",
+        ] {
+            expect_rows(&read(text).unwrap());
+        }
+    }
+
+    #[test]
+    fn refusals() {
+        refused(
+            "MD,inc,azi\n0,0,0\n",
+            "line 1: the MD column `MD` has no unit: name it with one, e.g. \"MD (m)\" or \"md_ft\"",
+        );
+        refused(
+            "# made by X\nDepth,inc,azi\n0,0,0\n",
+            "line 2: the MD column `Depth` has no unit",
+        );
+        refused(
+            "MD (km),inc,azi\n0,0,0\n",
+            "the MD column `MD (km)` is in `km`",
+        );
+        refused(
+            "md_m,Inc (rad),azi\n0,0,0\n",
+            "column `Inc (rad)`: the inclination is in `rad`, not degrees",
+        );
+        refused(
+            "md_m,inc,azi_grad\n0,0,0\n",
+            "column `azi_grad`: the azimuth is in `grad`",
+        );
+        refused(
+            "md_m,inc,azi,tf (rad)\n0,0,0,0\n",
+            "column `tf (rad)`: the toolface",
+        );
+        refused(
+            "md_m,Depth (m),inc,azi\n0,0,0,0\n",
+            "columns `md_m` and `Depth (m)` both give the MD",
+        );
+        refused(
+            "md_m,inc,incl,azi\n0,0,0,0\n",
+            "columns `inc` and `incl` both give the inclination",
+        );
+        refused(
+            "md_m,inc,az,azimuth\n0,0,0,0\n",
+            "columns `az` and `azimuth` both give the azimuth",
+        );
+        refused(
+            "MD (ft),inc,azi,TVD (m)\n0,0,0,0\n",
+            "mixes feet and metres (TVD (m) and MD (ft))",
+        );
+        refused("md_m,inc,azi_grid_deg\n0,0,0\n", "no column azi_deg");
+        refused(
+            "depth_m,inc,azi\n0,x,0\n",
+            "line 2: inc `x` is not a number",
+        );
+    }
+
+    /// The stations CSV of a capture survey (`stations_csv`): its `bit`
+    /// row is skipped.
+    #[test]
+    fn capture_stations_csv_and_its_bit_row() {
+        let text = "station,time_s,md_m,inc_deg,sigma_inc_deg,azi_deg,sigma_azi_deg,toolface_deg,\
+            sigma_toolface_deg,corr_inc_azi,tvd_m,north_m,east_m,sigma_north_m,sigma_east_m,\
+            sigma_vert_m,ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg,confidence\n\
+            1,10,0,0,0.1,0,0.5,20,1,0.1,0,0,0,0,0,0,0,0,0,0.95\n\
+            2,80,30,1.5,0.1,10,0.5,,1,0.1,30,0,0,0,0,0,0,0,0,0.95\n\
+            bit,,42,1.5,0.1,10,0.5,,,0.1,42,0,0,0,0,0,0,0,0,0.95\n";
+        let f = read(text).unwrap();
+        expect_rows(&f);
+        assert_eq!(f.stations[0].toolface_deg, Some(20.0));
+        assert_eq!(f.stations[1].time_s, Some(80.0));
+    }
+
+    /// Every station-like file of tests/data/iscwsa is read, in its unit.
+    #[test]
+    fn iscwsa_station_files() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa");
+        for (name, unit) in [
+            ("well1_stations.csv", LengthUnit::Metre),
+            ("well1_survey.csv", LengthUnit::Metre),
+            ("well2_survey.csv", LengthUnit::Foot),
+            ("well3_survey.csv", LengthUnit::Metre),
+        ] {
+            let text = std::fs::read_to_string(dir.join(name)).unwrap();
+            let f = read(&text).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+            assert_eq!(f.unit, unit, "{name}");
+            let rows = text.lines().filter(|l| !l.trim().is_empty()).count() - 1;
+            assert_eq!(f.stations.len(), rows, "{name}");
+        }
+    }
 }

@@ -8,7 +8,8 @@
 //! - a NUL byte means binary data, refused at once;
 //! - a UTF-8 byte-order mark is skipped; quoted fields are unquoted;
 //! - the separator is that of the first line that is not a `#` comment:
-//!   comma, else semicolon, else runs of spaces and tabs.
+//!   comma, else semicolon, else runs of spaces and tabs
+//!   ([`for_each_record_tab_aware`]: else tab, else runs of spaces).
 //!
 //! Errors quote at most [`EXCERPT_CHARS`] characters of the input.
 
@@ -177,9 +178,13 @@ enum Separator {
 }
 
 impl Separator {
-    fn of(line: &[u8]) -> Self {
-        [b',', b';']
-            .into_iter()
+    /// The separator of `line`; with `tab_aware`, a tab (after comma and
+    /// semicolon) is one too, so that fields may hold spaces.
+    fn of(line: &[u8], tab_aware: bool) -> Self {
+        let bytes: &[u8] = if tab_aware { b",;\t" } else { b",;" };
+        bytes
+            .iter()
+            .copied()
             .find(|s| line.contains(s))
             .map_or(Self::Whitespace, Self::Byte)
     }
@@ -188,7 +193,10 @@ impl Separator {
 /// Reads the lines up to and including the first that has content (not
 /// blank, not a `#` comment); returns those bytes, BOM removed, and that
 /// line's separator.
-fn first_content<R: Read>(input: &mut LineLimit<R>) -> io::Result<(Vec<u8>, Separator)> {
+fn first_content<R: Read>(
+    input: &mut LineLimit<R>,
+    tab_aware: bool,
+) -> io::Result<(Vec<u8>, Separator)> {
     let mut prefix = Vec::new();
     let mut byte = [0u8; 1];
     let mut line_start = 0;
@@ -203,7 +211,7 @@ fn first_content<R: Read>(input: &mut LineLimit<R>) -> io::Result<(Vec<u8>, Sepa
         if byte[0] == b'\n' {
             let line = prefix[line_start..].trim_ascii();
             if line != SKIPPED_LINE.as_bytes() {
-                let separator = Separator::of(line);
+                let separator = Separator::of(line, tab_aware);
                 return Ok((prefix, separator));
             }
             line_start = prefix.len();
@@ -215,10 +223,28 @@ fn first_content<R: Read>(input: &mut LineLimit<R>) -> io::Result<(Vec<u8>, Sepa
 /// `#` comments skipped, fields trimmed), stopping at the first error.
 pub fn for_each_record<R: Read>(
     input: R,
+    row: impl FnMut(u64, &[&str]) -> Result<()>,
+) -> Result<()> {
+    records(input, false, row)
+}
+
+/// As [`for_each_record`], but a first line with a tab (and no comma or
+/// semicolon) makes the tab the separator: a table whose header names
+/// hold spaces (`MD (m)`), as spreadsheets export them.
+pub fn for_each_record_tab_aware<R: Read>(
+    input: R,
+    row: impl FnMut(u64, &[&str]) -> Result<()>,
+) -> Result<()> {
+    records(input, true, row)
+}
+
+fn records<R: Read>(
+    input: R,
+    tab_aware: bool,
     mut row: impl FnMut(u64, &[&str]) -> Result<()>,
 ) -> Result<()> {
     let mut limited = LineLimit::new(io::BufReader::new(input));
-    let (prefix, separator) = first_content(&mut limited)?;
+    let (prefix, separator) = first_content(&mut limited, tab_aware)?;
     let delimiter = match separator {
         Separator::Byte(b) => b,
         Separator::Whitespace => b' ',
@@ -301,6 +327,25 @@ mod tests {
         assert_eq!(r[1].1, ["1", "2"]);
         let r = rows(b"a\tb\n1\t2\n").unwrap();
         assert_eq!(r[1], (2, vec!["1".into(), "2".into()]));
+    }
+
+    #[test]
+    fn tab_aware_tables_keep_spaces_and_empty_fields() {
+        let mut out = Vec::new();
+        for_each_record_tab_aware(&b"MD (m)\tInc (deg)\n1\t\t2\n"[..], |_, f| {
+            out.push(f.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(out, [vec!["MD (m)", "Inc (deg)"], vec!["1", "", "2"]]);
+        // without a tab, as before: runs of blanks
+        let mut out = Vec::new();
+        for_each_record_tab_aware(&b"a  b\n1 2\n"[..], |_, f| {
+            out.push(f.len());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(out, [2, 2]);
     }
 
     #[test]

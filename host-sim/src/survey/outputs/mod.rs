@@ -280,3 +280,53 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
     }
     Ok(serde_json::to_string_pretty(&doc)? + "\n")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::survey::listing::{read_stations, AzimuthReference, KnownModel, TieOnInput};
+    use crate::survey::well_survey::{ModelChoice, SurveyInputs};
+
+    /// The `--csv` output is a station file: read back, it gives the same
+    /// stations (MD in metres, whatever the input's unit).
+    #[test]
+    fn csv_output_reads_back_as_the_same_stations() {
+        for (text, to_m) in [
+            (
+                "MD (m);Inc;Azi (deg);tf;Time (s)\n0;0;0;;\n30;1.5;10;20;5\n530.25;45.125;123.5;;9\n",
+                1.0,
+            ),
+            (
+                "md_ft,inc_deg,azi_deg\n0,0,0\n100,3,350\n1000,60,12.5\n",
+                0.3048,
+            ),
+        ] {
+            let file = read_stations(text.as_bytes()).unwrap();
+            let inputs = SurveyInputs {
+                reference: AzimuthReference::True,
+                tie: TieOnInput {
+                    md: None,
+                    tvd: 0.0,
+                    north: 0.0,
+                    east: 0.0,
+                },
+                vsec_azimuth: None,
+                model: ModelChoice::None,
+                confidence: 0.95,
+            };
+            let no_site = |_: &KnownModel| anyhow::bail!("no model, no site");
+            let survey = WellSurvey::compute(&file, &inputs, &no_site).unwrap();
+            let back = read_stations(csv_text(&survey).as_bytes()).unwrap();
+            assert_eq!(back.unit, crate::survey::listing::LengthUnit::Metre);
+            assert_eq!(back.stations.len(), file.stations.len());
+            for (a, b) in file.stations.iter().zip(&back.stations) {
+                // the survey keeps angles in radians: equal to rounding
+                let close = |x: f64, y: f64| (x - y).abs() < 1e-9;
+                assert!(close(a.md * to_m, b.md), "{a:?} {b:?}");
+                assert!(close(a.inc_deg, b.inc_deg), "{a:?} {b:?}");
+                assert!(close(a.azi_deg, b.azi_deg), "{a:?} {b:?}");
+                assert_eq!((a.toolface_deg, a.time_s), (b.toolface_deg, b.time_s));
+            }
+        }
+    }
+}
