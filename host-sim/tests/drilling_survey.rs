@@ -68,6 +68,23 @@ const TIE: TieOnInput = TieOnInput {
     east: 0.0,
 };
 
+/// The across-hole variance of an azimuth random walk (each station's
+/// error carried on): sum_jk h_j h_k min(s_j^2, s_k^2), `h` the length
+/// each station's error acts over, `s2` the azimuth variances.
+fn random_walk_variance(h: &[f64], s2: &[f64]) -> f64 {
+    let mut v = 0.0;
+    for (hj, sj) in h.iter().zip(s2) {
+        for (hk, sk) in h.iter().zip(s2) {
+            v += hj * hk * sj.min(*sk);
+        }
+    }
+    v
+}
+
+/// One 10 m leg's long-course-length term (XCLA or XCLH) at the
+/// tortuosity floor: 0.167 L (1 deg / 100 ft) L.
+const XCL_10M_LEG: f64 = 0.167 * 10.0 * (1.0f64.to_radians() / 30.48) * 10.0;
+
 /// The probe's survey tied on at `TIE`, the bit `sensor_to_bit` m ahead.
 fn setup(sensor_to_bit: Option<f64>) -> SurveySetup {
     SurveySetup {
@@ -94,21 +111,15 @@ fn synthetic_stations_are_positioned_with_the_random_walk_depth_and_method_uncer
         assert!(r.row.north_m.abs() < 1e-5 && (r.row.tvd_m - 2000.0).abs() < 1e-5);
         assert!(r.position_determined);
     }
-    // north (across the hole): the azimuth random walk, by hand:
-    // sum_jk h_j h_k min(s_j^2, s_k^2), h = half the legs around each
+    // north (across the hole): the azimuth random walk, by hand,
+    // h = half the legs around each station
     let h = [5.0, 10.0, 10.0, 5.0];
     let s2 = sig.map(|s: f64| s.to_radians().powi(2));
-    let mut var_n = 0.0;
-    for j in 0..4 {
-        for k in 0..4 {
-            var_n += h[j] * h[k] * s2[j].min(s2[k]);
-        }
-    }
+    let mut var_n = random_walk_variance(&h, &s2);
     // the method's long-course-length terms (XCLA across the hole, XCLH
     // vertical, random per leg): the legs do not turn, so each weighs the
     // tortuosity floor, 0.167 L (1 deg / 100 ft) L, on the three 10 m legs
-    let xcl_leg = 0.167 * 10.0 * (1.0f64.to_radians() / 30.48) * 10.0;
-    let var_xcl = 3.0 * xcl_leg * xcl_leg;
+    let var_xcl = 3.0 * XCL_10M_LEG * XCL_10M_LEG;
     var_n += var_xcl;
     let c = out.rows[3].row.cov.unwrap();
     // (the frame's sigmas are f32: 1e-7 relative)
@@ -153,14 +164,7 @@ fn the_bit_is_projected_straight_ahead_with_the_last_stations_errors_over_the_le
     // to the bit; the method's terms on four 10 m legs
     let h = [5.0, 10.0, 10.0, 15.0];
     let s2 = sig.map(|s: f64| s.to_radians().powi(2));
-    let mut var_n = 0.0;
-    for j in 0..4 {
-        for k in 0..4 {
-            var_n += h[j] * h[k] * s2[j].min(s2[k]);
-        }
-    }
-    let xcl_leg = 0.167 * 10.0 * (1.0f64.to_radians() / 30.48) * 10.0;
-    var_n += 4.0 * xcl_leg * xcl_leg;
+    let var_n = random_walk_variance(&h, &s2) + 4.0 * XCL_10M_LEG * XCL_10M_LEG;
     let c = bit.row.cov.expect("the bit's position is determined");
     assert!((c[0] - var_n).abs() < 1e-6 * var_n, "{} vs {var_n}", c[0]);
     assert!(c[0] > plain.rows[3].row.cov.unwrap()[0]);
