@@ -442,6 +442,32 @@ fn a_tied_in_capture_is_surveyed_with_the_links_of_its_replay() {
 }
 
 #[test]
+fn the_coverage_study_finds_its_built_in_plan_from_any_directory() {
+    let dir = scratch("drilling-survey", "elsewhere");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .current_dir(&dir)
+        .args([
+            "study",
+            "drilling-coverage",
+            "--runs",
+            "1",
+            "--threads",
+            "1",
+        ])
+        .output()
+        .expect("host-sim runs");
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("drilling coverage: the built-in 100 m lateral (1 runs"),
+        "{stdout}"
+    );
+}
+
+#[test]
 fn the_coverage_study_harness_runs_a_short_plan() {
     let dir = scratch("drilling-survey", "study");
     let json = dir.join("study.json");

@@ -8,6 +8,7 @@ use host_sim::sim::Plan;
 use host_sim::study::drilling_coverage::{study, table};
 use host_sim::study::drilling_run::{RunConfig, Scalar};
 use host_sim::study::grade::Grade;
+use host_sim::study::lateral::wells::Well;
 use std::path::PathBuf;
 
 #[derive(clap::Subcommand, Debug)]
@@ -31,9 +32,10 @@ pub use super::study_lateral::LateralArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct CoverageArgs {
-    /// Well plan (JSON, docs/drilling-simulation.md).
-    #[arg(long, default_value = "host-sim/data/plans/lateral-100m.json")]
-    pub plan: PathBuf,
+    /// Well plan (JSON, docs/drilling-simulation.md); default: the
+    /// built-in 100 m lateral (host-sim/data/plans/lateral-100m.json).
+    #[arg(long)]
+    pub plan: Option<PathBuf>,
     /// Number of runs (seeds first-seed, first-seed + 1, ...).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub runs: u64,
@@ -67,7 +69,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
 }
 
 fn drilling_coverage(args: CoverageArgs) -> Result<()> {
-    let mut plan = Plan::load(&args.plan)?;
+    let mut plan = study_plan(args.plan.as_deref())?;
     if let Some(level) = args.vibration {
         plan.drilling.vibration = level.vibration();
     }
@@ -88,7 +90,7 @@ fn drilling_coverage(args: CoverageArgs) -> Result<()> {
     bar.finish_and_clear();
     outln!(
         "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads, filter {}{})",
-        args.plan.display(),
+        plan_name(args.plan.as_deref()),
         args.runs,
         args.seeds.first_seed,
         args.tie_in_azimuth_sigma_deg,
@@ -124,9 +126,10 @@ fn reference_sigma_deg(text: &str) -> Result<f64, String> {
 
 #[derive(clap::Args, Debug)]
 pub struct RinsProbeArgs {
-    /// Well plan (JSON, docs/drilling-simulation.md).
-    #[arg(long, default_value = "host-sim/data/plans/lateral-100m.json")]
-    pub plan: PathBuf,
+    /// Well plan (JSON, docs/drilling-simulation.md); default: the
+    /// built-in 100 m lateral (host-sim/data/plans/lateral-100m.json).
+    #[arg(long)]
+    pub plan: Option<PathBuf>,
     /// Runs per grade (seeds first-seed, first-seed + 1, ...).
     #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub runs: u64,
@@ -157,7 +160,7 @@ pub struct RinsProbeArgs {
 
 fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     use host_sim::study::rins_probe::table;
-    let plan = Plan::load(&args.plan)?;
+    let plan = study_plan(args.plan.as_deref())?;
     let threads = args.seeds.threads();
     let mut summaries = Vec::new();
     // One bar per grade: the note goes to standard error.
@@ -167,7 +170,7 @@ fn rins_probe(args: RinsProbeArgs) -> Result<()> {
     }
     outln!(
         "rins-probe: {} ({} runs per grade from seed {}; reference sigma {} deg at the first {} stations, then lost; tie-in azimuth sigma {} deg; {} threads{})",
-        args.plan.display(),
+        plan_name(args.plan.as_deref()),
         args.runs,
         args.seeds.first_seed,
         args.reference_sigma_deg,
@@ -229,4 +232,21 @@ fn rins_probe_grade(
     let summary = study(&config, &args.seeds.runs(args.runs, &|| bar.inc(1), stop));
     bar.finish_and_clear();
     Ok(summary)
+}
+
+/// `--plan`'s plan, or the built-in 100 m lateral (the binary carries it,
+/// so a study runs from any directory).
+fn study_plan(path: Option<&std::path::Path>) -> Result<host_sim::sim::BuiltPlan> {
+    match path {
+        Some(path) => Plan::load(path),
+        None => Ok(Well::builtin("100m", &Default::default())?.plan),
+    }
+}
+
+/// How the header names the plan.
+fn plan_name(path: Option<&std::path::Path>) -> String {
+    path.map_or_else(
+        || "the built-in 100 m lateral".to_string(),
+        |p| p.display().to_string(),
+    )
 }
