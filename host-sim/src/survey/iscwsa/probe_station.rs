@@ -124,30 +124,27 @@ pub fn angle_covariance(
     Ok(propagate(stations, sigmas, None))
 }
 
-/// [`angle_covariance`] at every station and, last, at a point `ahead`
-/// (m, > 0) beyond the last station along its own inclination and azimuth:
-/// the projection to the bit. The projection's angles are the last
-/// station's, so are their errors: every source's error at the last
-/// station acts over the whole projected leg too.
-pub fn angle_covariance_ahead(
+/// [`angle_covariance`] at every station and, last, at the projection to
+/// the bit: `stations` ends with it (beyond the last station, along that
+/// station's inclination and azimuth), `sigmas` has one per station
+/// before it. The projection's angles are the last station's, so are
+/// their errors: every source's error at the last station acts over the
+/// whole projected leg too.
+pub fn angle_covariance_projected(
     stations: &[Station],
     sigmas: &[AngleSigma],
-    ahead: f64,
 ) -> Result<Vec<Cov6>, PropagationError> {
-    checked(stations, sigmas)?;
-    let Some(last) = stations.last() else {
-        return Ok(Vec::new());
+    let Some((bit, surveyed)) = stations.split_last() else {
+        return Err(PropagationError::LengthMismatch);
     };
-    if !(ahead.is_finite() && ahead > 0.0) {
-        return Err(PropagationError::MdNotIncreasing(stations.len()));
+    checked(surveyed, sigmas)?;
+    if surveyed
+        .last()
+        .is_some_and(|last| bit.md.is_nan() || bit.md <= last.md)
+    {
+        return Err(PropagationError::MdNotIncreasing(surveyed.len()));
     }
-    let mut extended = stations.to_vec();
-    extended.push(Station {
-        md: last.md + ahead,
-        toolface: None,
-        ..*last
-    });
-    Ok(propagate(&extended, sigmas, Some(stations.len())))
+    Ok(propagate(stations, sigmas, Some(surveyed.len())))
 }
 
 /// One sigma per station, each a finite number >= 0, MD increasing.
@@ -723,6 +720,17 @@ mod tests {
         );
     }
 
+    /// `stations` and the last one held `ahead` m further.
+    fn projected(stations: &[Station], ahead: f64) -> Vec<Station> {
+        let last = *stations.last().unwrap();
+        let mut out = stations.to_vec();
+        out.push(Station {
+            md: last.md + ahead,
+            ..last
+        });
+        out
+    }
+
     #[test]
     fn the_bit_carries_the_last_stations_angle_errors_over_the_projected_leg() {
         // Tie-on (exact) and one station L = 28 m on, horizontal, due
@@ -732,7 +740,7 @@ mod tests {
         let (l, d, s_inc) = (28.0, 12.0, 0.01);
         let st = straight(2, l, 90.0, 0.0);
         let sig = [sigma(0.0, 0.0), sigma(s_inc, 0.0)];
-        let ahead = angle_covariance_ahead(&st, &sig, d).unwrap();
+        let ahead = angle_covariance_projected(&projected(&st, d), &sig).unwrap();
         let plain = angle_covariance(&st, &sig).unwrap();
         assert_eq!(ahead.len(), 3);
         assert_eq!(
@@ -752,9 +760,9 @@ mod tests {
         );
         // and an azimuth error swings the bit sideways over the same lever
         let sig = [sigma(0.0, 0.0), sigma(0.0, 0.02)];
-        let east = angle_covariance_ahead(&st, &sig, d).unwrap()[2][1];
+        let east = angle_covariance_projected(&projected(&st, d), &sig).unwrap()[2][1];
         let want = ((0.5 * l + d) * 0.02).powi(2);
         assert!((east - want).abs() < 1e-12, "{east} against {want}");
-        assert!(angle_covariance_ahead(&st, &sig, 0.0).is_err());
+        assert!(angle_covariance_projected(&projected(&st, 0.0), &sig).is_err());
     }
 }

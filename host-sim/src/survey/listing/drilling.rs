@@ -16,7 +16,7 @@
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
 use crate::formats::depth_log::DepthLog;
 use crate::survey::iscwsa::probe_station::{
-    angle_covariance, angle_covariance_ahead, links_in_order, AngleSigma,
+    angle_covariance, angle_covariance_projected, links_in_order, AngleSigma,
 };
 use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site, Station};
 use anyhow::{anyhow, bail, Result};
@@ -453,11 +453,8 @@ pub fn covariance(
     let md0 = rows[0].md_m;
     let mut stations: Vec<Station> = rows[..valid].iter().map(Row::iscwsa_station).collect();
     let sig: Vec<AngleSigma> = sigmas[..valid].iter().flatten().copied().collect();
-    let angles = match ahead {
-        Some(d) => angle_covariance_ahead(&stations, &sig, d),
-        None => angle_covariance(&stations, &sig),
-    }
-    .map_err(|e| anyhow!("{e}"))?;
+    // The bit: the last station held straight ahead (its TVD too, for the
+    // depth terms).
     if let (Some(d), Some(&last)) = (ahead, stations.last()) {
         stations.push(Station {
             md: last.md + d,
@@ -465,6 +462,11 @@ pub fn covariance(
             ..last
         });
     }
+    let angles = match ahead {
+        Some(_) => angle_covariance_projected(&stations, &sig),
+        None => angle_covariance(&stations, &sig),
+    }
+    .map_err(|e| anyhow!("{e}"))?;
     let valid = stations.len();
     let from_tie_on: Vec<Station> = stations
         .iter()
