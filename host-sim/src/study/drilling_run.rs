@@ -13,6 +13,7 @@ use crate::formats::depth_log::DepthLog;
 use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
 use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::listing::drilling::{self, DrillingSurvey, StationStart};
+use crate::survey::listing::ellipse::ne_mahalanobis2;
 use crate::survey::listing::{
     compute, AzimuthReference, InputStation, LengthUnit, StationFile, TieOnInput,
 };
@@ -143,14 +144,7 @@ impl PositionCheck {
     /// The error's squared Mahalanobis distance in the covariance;
     /// `None` where the covariance is singular or not a number.
     pub fn mahalanobis2(&self) -> Option<f64> {
-        let [nn, ee, ne] = self.cov_ne;
-        let [n, e] = self.error_ne;
-        let det = nn * ee - ne * ne;
-        // also catches NaN
-        if det.is_nan() || det <= 0.0 {
-            return None;
-        }
-        Some((ee * n * n - 2.0 * ne * n * e + nn * e * e) / det)
+        ne_mahalanobis2(self.cov_ne, self.error_ne)
     }
 }
 

@@ -54,6 +54,20 @@ impl Ellipse {
     }
 }
 
+/// The squared Mahalanobis distance of a north-east error `[n, e]` (m) in
+/// the north-east covariance `[nn, ee, ne]` (m^2): inside the ellipse
+/// holding `p` when at most `scale_2d(p)^2`. `None` where the covariance
+/// is singular or not a number.
+pub fn ne_mahalanobis2(cov_ne: [f64; 3], error_ne: [f64; 2]) -> Option<f64> {
+    let [nn, ee, ne] = cov_ne;
+    let [n, e] = error_ne;
+    let det = nn * ee - ne * ne;
+    if det.is_nan() || det <= 0.0 {
+        return None;
+    }
+    Some((ee * n * n - 2.0 * ne * n * e + nn * e * e) / det)
+}
+
 /// `k = sqrt(-2 ln(1 - p))`: the ellipse of a 2-D normal holding
 /// probability `p` is the 1-sigma ellipse times `k`.
 pub fn scale_2d(p: f64) -> f64 {

@@ -9,7 +9,7 @@
 use crate::sim::Drilling;
 use crate::survey::iscwsa::Cov6;
 use crate::survey::listing::drilling::DrillingSurvey;
-use crate::survey::listing::ellipse::{scale_2d, Ellipse};
+use crate::survey::listing::ellipse::{ne_mahalanobis2, scale_2d, Ellipse};
 use mwd_core::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
 use std::fmt::Write as _;
@@ -32,13 +32,8 @@ impl PointCheck {
     /// the covariance is undetermined or singular.
     pub fn d2_horizontal(&self) -> Option<f64> {
         let c = self.cov?;
-        let (nn, ee, ne) = (c[0], c[1], c[3]);
         let [n, e, _] = self.error_nev;
-        let det = nn * ee - ne * ne;
-        if det.is_nan() || det <= 0.0 {
-            return None;
-        }
-        Some((ee * n * n - 2.0 * ne * n * e + nn * e * e) / det)
+        ne_mahalanobis2([c[0], c[1], c[3]], [n, e])
     }
 
     /// The truth inside the horizontal ellipse holding `p`.
