@@ -6,6 +6,7 @@ pub mod grade;
 pub mod lateral;
 pub mod owsg;
 pub mod rins_probe;
+pub mod run_checks;
 pub mod stats;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
