@@ -66,6 +66,7 @@ const TIE: TieOnInput = TieOnInput {
     tvd: 2000.0,
     north: 0.0,
     east: 0.0,
+    covariance: None,
 };
 
 /// The across-hole variance of an azimuth random walk (each station's

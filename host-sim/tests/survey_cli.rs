@@ -309,3 +309,91 @@ fn feet_input_is_converted() {
     assert!((last[0].parse::<f64>().unwrap() - 304.8).abs() < 1e-9);
     assert!((last[3].parse::<f64>().unwrap() - 304.8).abs() < 1e-9);
 }
+
+/// Each station's NEV covariance (m^2) from a `--json` output.
+fn json_covariances(path: &Path) -> Vec<Vec<f64>> {
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    doc["stations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|st| {
+            st["nev_covariance_m2"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+/// The parent well's uncertainty at the tie-on (`--tie-on-sigma`, or a
+/// job's full covariance) adds whole to every station's covariance, and
+/// the listing and the JSON say so; without it the listing says the
+/// tie-on is taken as exact.
+#[test]
+fn the_tie_ons_uncertainty_adds_to_every_station() {
+    let dir = scratch("tie-on-sigma");
+    let well = well1();
+    let survey = |name: &str, extra: &[&str]| {
+        let json = dir.join(name);
+        let mut args = vec![s(&well), "--error-model", "ISCWSA MWD Rev5"];
+        args.extend_from_slice(&WELL1_SITE);
+        args.extend_from_slice(&["--json", s(&json)]);
+        args.extend_from_slice(extra);
+        let run = host_sim(&args);
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        (run.stdout, json_covariances(&json))
+    };
+    let (exact_text, exact) = survey("exact.json", &[]);
+    assert!(exact_text.contains("tie-on taken as exact"), "{exact_text}");
+    let (text, with) = survey("sigma.json", &["--tie-on-sigma", "3", "4", "2"]);
+    assert!(
+        text.contains("tie-on position 1-sigma N 3.00 m, E 4.00 m, TVD 2.00 m"),
+        "{text}"
+    );
+    assert_eq!(exact.len(), with.len());
+    for (a, b) in exact.iter().zip(&with) {
+        let added: Vec<f64> = b.iter().zip(a).map(|(b, a)| b - a).collect();
+        for (got, want) in added.iter().zip([9.0, 16.0, 4.0, 0.0, 0.0, 0.0]) {
+            assert!((got - want).abs() < 1e-9, "{added:?}");
+        }
+    }
+    // a job's full covariance, in feet: converted to m^2 (well 1 is in m)
+    let job = dir.join("job.json");
+    std::fs::write(
+        &job,
+        r#"{"format": "mwd-job", "version": 1,
+            "site": {"latitude_deg": 60.0, "longitude_deg": 0.0, "height_m": 0.0},
+            "survey": {"length_unit": "ft", "error_model": "ISCWSA MWD Rev5",
+                       "tie_on": {"covariance": {"nn": 100.0, "ne": 20.0, "nv": 5.0,
+                                                 "ee": 50.0, "ev": -3.0, "vv": 10.0}}}}"#,
+    )
+    .unwrap();
+    let json = dir.join("job-out.json");
+    let run = host_sim(&[
+        s(&well),
+        "--job",
+        s(&job),
+        "--b-total-nt",
+        "50000",
+        "--dip-deg",
+        "72",
+        "--declination-deg",
+        "-4",
+        "--json",
+        s(&json),
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let ft2 = 0.3048f64.powi(2);
+    for (a, b) in exact.iter().zip(&json_covariances(&json)) {
+        for ((b, a), want) in b.iter().zip(a).zip([100.0, 50.0, 10.0, 20.0, 5.0, -3.0]) {
+            assert!(
+                (b - a - want * ft2).abs() < 1e-9,
+                "{b} - {a} vs {want} ft^2"
+            );
+        }
+    }
+}

@@ -34,6 +34,9 @@ pub enum Reference {
 fn tie_on(text: &str) -> Result<f64, String> {
     number_in(text, "a tie-on value", (-1e6, 1e6), "(file's length unit)")
 }
+fn tie_on_sigma(text: &str) -> Result<f64, String> {
+    number_in(text, "a tie-on sigma", (0.0, 1e3), "(file's length unit)")
+}
 fn convergence_deg(text: &str) -> Result<f64, String> {
     number_in(text, "the grid convergence", (-90.0, 90.0), "deg")
 }
@@ -79,7 +82,7 @@ pub struct Args {
     #[arg(long = "site", num_args = 3, value_names = ["LAT", "LON", "HEIGHT"],
           allow_negative_numbers = true, conflicts_with_all = ["lat", "lon", "height"])]
     pub site_numbers: Option<Vec<f64>>,
-    /// A job file (host-sim/src/job.rs): its site, survey tie-on (in its
+    /// A job file (examples/lateral-100m/job.json is one): its site, survey tie-on (in its
     /// length unit, converted to the file's) and error model; the flags
     /// given override it (its site: with --site, not --lat/--lon/--height).
     #[arg(long, value_name = "JOB.json", conflicts_with_all = ["lat", "lon", "height"])]
@@ -102,6 +105,12 @@ pub struct Args {
     /// East of the tie-on (file's unit, true north).
     #[arg(long, allow_hyphen_values = true, value_parser = tie_on)]
     pub tie_on_east: Option<f64>,
+    /// 1-sigma of the tie-on's position, north, east and TVD (file's
+    /// unit): the parent well's uncertainty where this well leaves it,
+    /// added to every station's covariance (a job gives it, or a full
+    /// covariance, as survey.tie_on.sigma / .covariance).
+    #[arg(long, num_args = 3, value_names = ["NORTH", "EAST", "TVD"], value_parser = tie_on_sigma)]
+    pub tie_on_sigma: Option<Vec<f64>>,
     /// Error model: "ISCWSA MWD Rev5" (Rev 5.10), "GYRO-MWD", "GYRO-NS",
     /// "PROBE-SCC1300" (this probe, through 90 deg; at the SCC1300's noise
     /// every station is beyond its first-order limit: docs/probe-tool-model.md).
@@ -233,11 +242,16 @@ impl Resolved {
     /// station's).
     fn tie_on(&self, args: &Args, unit: LengthUnit) -> TieOnInput {
         let job = self.job.tie_on.in_unit(unit);
+        let flag = args.tie_on_sigma.as_deref().and_then(|s| match *s {
+            [n, e, v] => Some([n * n, e * e, v * v, 0.0, 0.0, 0.0]),
+            _ => None,
+        });
         TieOnInput {
             md: args.tie_on_md.or(job.md),
             tvd: args.tie_on_tvd.or(job.tvd).unwrap_or(0.0),
             north: args.tie_on_north.or(job.north).unwrap_or(0.0),
             east: args.tie_on_east.or(job.east).unwrap_or(0.0),
+            covariance: flag.or(job.covariance),
         }
     }
 
@@ -405,6 +419,7 @@ fn offset_inputs<'a>(args: &'a Args, path: &'a Path) -> Result<OffsetInputs<'a>>
             tvd: args.sep.offset_tie_on_tvd,
             north: args.sep.offset_tie_on_north,
             east: args.sep.offset_tie_on_east,
+            covariance: None,
         },
         model_name: args.sep.offset_error_model.as_deref(),
         rule: sep::Rule {

@@ -452,6 +452,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         tvd: tie_on.nev().z,
         north: tie_on.nev().x,
         east: tie_on.nev().y,
+        covariance: None,
     };
     let setup = SurveySetup {
         tie,
@@ -519,6 +520,7 @@ fn method_td_error(survey: &DrillingSurvey, drilling: &Drilling) -> Option<[f64;
         tvd: first.point.nev.z,
         north: first.point.nev.x,
         east: first.point.nev.y,
+        covariance: None,
     };
     let (rows, _) = compute(&file, AzimuthReference::True, tie, None).ok()?;
     let end = rows.last()?;

@@ -161,6 +161,7 @@ impl CaptureSurvey {
             bit,
             header_note: (!notes.is_empty()).then(|| notes.join("; ")),
             well: crate::survey::job::WellNames::default(),
+            tie_on_cov_m2: self.survey.tie_on_cov_m2,
         })
     }
 
@@ -208,13 +209,7 @@ impl CaptureSurvey {
 /// How the stations are placed when no tie-on was given (all zero: the
 /// survey's default), as the listing and the exports say on top.
 fn placement_note(tie: &TieOnInput) -> Option<String> {
-    let surface = TieOnInput {
-        md: None,
-        tvd: 0.0,
-        north: 0.0,
-        east: 0.0,
-    };
-    (*tie == surface).then(|| {
+    tie.is_surface().then(|| {
         "no tie-on given: the stations are placed from N 0, E 0, TVD 0 at the first station's \
          MD, not where the well is (give the job's survey.tie_on or --tie-on-*)"
             .to_string()

@@ -109,6 +109,7 @@ pub fn job_tie_on(job: Option<&Job>) -> TieOnInput {
         tvd: t.and_then(|t| t.tvd).unwrap_or(0.0),
         north: t.and_then(|t| t.north).unwrap_or(0.0),
         east: t.and_then(|t| t.east).unwrap_or(0.0),
+        covariance: t.and_then(|t| t.covariance),
     }
 }
 

@@ -9,7 +9,7 @@
 //! is known: a magnetic model needs the field, which the command line
 //! gives (and refuses to go without).
 
-use crate::survey::iscwsa::Site;
+use crate::survey::iscwsa::{Cov6, Site};
 use crate::survey::job::WellNames;
 use crate::survey::listing::separation as sep;
 use crate::survey::listing::{
@@ -100,6 +100,9 @@ pub struct WellSurvey {
     /// The well's and wellbore's names and uids (the WITSML trajectory
     /// carries them): the job's, else placeholders.
     pub well: WellNames,
+    /// The tie-on's position covariance (m^2) in every station's; `None`:
+    /// the tie-on is taken as exact.
+    pub tie_on_cov_m2: Option<Cov6>,
 }
 
 impl WellSurvey {
@@ -114,10 +117,16 @@ impl WellSurvey {
             ModelChoice::None => None,
         };
         let mut invalid_from = None;
+        let tie_on_cov_m2 = inputs.tie.covariance_m2(file.unit);
         if let Some(m) = model {
             let terms = listing::terms(m)?;
             let site = site_for(m)?;
             invalid_from = listing::apply_model(&mut rows, m, &terms, &site)?;
+            for row in rows.iter_mut() {
+                row.cov = row
+                    .cov
+                    .map(|c| listing::plus_tie_on(c, tie_on_cov_m2.as_ref()));
+            }
         }
         Ok(Self {
             rows,
@@ -130,6 +139,7 @@ impl WellSurvey {
             bit: None,
             header_note: None,
             well: WellNames::default(),
+            tie_on_cov_m2,
         })
     }
 

@@ -87,12 +87,16 @@ pub enum Section {
 impl Plan {
     /// Reads and checks a plan file.
     pub fn load(path: &Path) -> Result<BuiltPlan> {
+        Self::read(path)?
+            .build()
+            .with_context(|| format!("{}: invalid plan", path.display()))
+    }
+
+    /// Reads a plan file without building it.
+    pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("reading the plan {}", path.display()))?;
-        let plan: Plan = serde_json::from_str(&text)
-            .with_context(|| format!("{}: not a well plan", path.display()))?;
-        plan.build()
-            .with_context(|| format!("{}: invalid plan", path.display()))
+        serde_json::from_str(&text).with_context(|| format!("{}: not a well plan", path.display()))
     }
 
     /// Checks the plan and builds its stations.

@@ -18,7 +18,8 @@
 //!   "still": { "z_enter": 3.09, "z_stay": 5.199, "enter_epochs": 20,
 //!              "max_station_samples": 6000, "zupt_velocity_sigma": 0.01 },
 //!   "survey": { "length_unit": "ft", "error_model": "PROBE-SCC1300",
-//!               "tie_on": { "md": 1500.0, "tvd": 1480.0, "north": 12.0, "east": -3.5 },
+//!               "tie_on": { "md": 1500.0, "tvd": 1480.0, "north": 12.0, "east": -3.5,
+//!                           "sigma": { "north": 1.5, "east": 1.5, "tvd": 0.8 } },
 //!               "sensor_to_bit": 40.0 }
 //! }
 //! ```
@@ -34,7 +35,11 @@
 //! (`host-sim drill`, `sim::plan`). `survey` only the host reads: the
 //! tie-on (the well's position where the survey starts, in `length_unit`,
 //! "m" or "ft", default "m"; every part optional, as the `--tie-on-*`
-//! flags), the tool's error model (a name `survey --error-model` takes) and
+//! flags; its position uncertainty, the parent well's where the lateral
+//! leaves it, as `sigma` (1-sigma north, east, tvd, uncorrelated) or as
+//! `covariance` (nn, ne, nv, ee, ev, vv in the unit squared, as the parent
+//! well's survey lists it at the tie-on), added to every station's), the
+//! tool's error model (a name `survey --error-model` takes) and
 //! the distance from the survey sensors to the bit (in `length_unit`),
 //! for the projection to the bit.
 //!
@@ -58,6 +63,7 @@
 
 use crate::analysis::calibration_file::CalibrationFile;
 use crate::formats::text_records::read_small_file;
+use crate::survey::iscwsa::Cov6;
 use crate::survey::listing::{self, LengthUnit};
 use anyhow::{bail, Context, Result};
 use mwd_core::calibration::ProbeCalibration;
@@ -127,6 +133,30 @@ struct TieOnEntry {
     tvd: Option<f64>,
     north: Option<f64>,
     east: Option<f64>,
+    /// 1-sigma of the tie-on's position, uncorrelated (length unit).
+    sigma: Option<TieOnSigmaEntry>,
+    /// The tie-on's NEV position covariance (length unit squared), as a
+    /// parent well's survey gives it at the tie-on.
+    covariance: Option<TieOnCovarianceEntry>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TieOnSigmaEntry {
+    north: f64,
+    east: f64,
+    tvd: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TieOnCovarianceEntry {
+    nn: f64,
+    ne: f64,
+    nv: f64,
+    ee: f64,
+    ev: f64,
+    vv: f64,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -170,6 +200,10 @@ pub struct JobTieOn {
     pub tvd: Option<f64>,
     pub north: Option<f64>,
     pub east: Option<f64>,
+    /// The tie-on's NEV position covariance in `unit` squared (`Cov6`:
+    /// nn, ee, vv, ne, nv, ev): the parent well's uncertainty where the lateral
+    /// leaves it, common to every station of the lateral.
+    pub covariance: Option<Cov6>,
 }
 
 impl Default for JobTieOn {
@@ -180,6 +214,7 @@ impl Default for JobTieOn {
             tvd: None,
             north: None,
             east: None,
+            covariance: None,
         }
     }
 }
@@ -203,6 +238,14 @@ impl JobTieOn {
             tvd: convert(self.tvd),
             north: convert(self.north),
             east: convert(self.east),
+            covariance: self.covariance.map(|c| {
+                let k = if unit == self.unit {
+                    1.0
+                } else {
+                    (self.unit.to_m() / unit.to_m()).powi(2)
+                };
+                c.map(|v| v * k)
+            }),
         }
     }
 }
@@ -312,6 +355,7 @@ impl SurveyEntry {
             tvd: checked("tvd", t.tvd)?,
             north: checked("north", t.north)?,
             east: checked("east", t.east)?,
+            covariance: tie_on_covariance(t.sigma, t.covariance)?,
         };
         if let Some(name) = &self.error_model {
             listing::model(name).context("survey.error_model")?;
@@ -328,6 +372,67 @@ impl SurveyEntry {
             sensor_to_bit: self.sensor_to_bit,
         })
     }
+}
+
+/// The largest tie-on position sigma taken (length unit): a parent well's
+/// position is known to metres or tens of metres, not kilometres.
+const TIE_ON_SIGMA_LIMIT: f64 = 1e3;
+
+/// The tie-on's covariance from `sigma` (uncorrelated) or `covariance`
+/// (one of them), checked: finite, variances within the limit, and
+/// positive semi-definite (no direction with a negative variance).
+fn tie_on_covariance(
+    sigma: Option<TieOnSigmaEntry>,
+    covariance: Option<TieOnCovarianceEntry>,
+) -> Result<Option<Cov6>> {
+    let cov = match (sigma, covariance) {
+        (Some(_), Some(_)) => {
+            bail!("survey.tie_on: give sigma or covariance, not both")
+        }
+        (None, None) => return Ok(None),
+        (Some(s), None) => {
+            for (name, v) in [("north", s.north), ("east", s.east), ("tvd", s.tvd)] {
+                if !(v.is_finite() && (0.0..=TIE_ON_SIGMA_LIMIT).contains(&v)) {
+                    bail!(
+                        "survey.tie_on.sigma.{name} = {v}: expected 0 to {TIE_ON_SIGMA_LIMIT} \
+                         (the survey's length unit)"
+                    );
+                }
+            }
+            [
+                s.north.powi(2),
+                s.east.powi(2),
+                s.tvd.powi(2),
+                0.0,
+                0.0,
+                0.0,
+            ]
+        }
+        (None, Some(c)) => {
+            let cov = [c.nn, c.ee, c.vv, c.ne, c.nv, c.ev];
+            let limit = TIE_ON_SIGMA_LIMIT.powi(2);
+            for (name, v) in ["nn", "ee", "vv", "ne", "nv", "ev"].iter().zip(cov) {
+                if !(v.is_finite() && v.abs() <= limit) {
+                    bail!(
+                        "survey.tie_on.covariance.{name} = {v}: expected a finite number within \
+                         +-{limit} (the survey's length unit squared)"
+                    );
+                }
+            }
+            let m = nalgebra::Matrix3::new(c.nn, c.ne, c.nv, c.ne, c.ee, c.ev, c.nv, c.ev, c.vv);
+            let least = m.symmetric_eigenvalues().min();
+            // a rounding below the matrix's own scale is not a negative
+            // variance
+            if least < -1e-9 * m.trace().max(f64::MIN_POSITIVE) {
+                bail!(
+                    "survey.tie_on.covariance is not a covariance: it has a direction with \
+                     variance {least:.3e} (negative)"
+                );
+            }
+            cov
+        }
+    };
+    Ok(Some(cov))
 }
 
 /// Longitude in (-180, 180] deg, as the uplink carries it (the host also

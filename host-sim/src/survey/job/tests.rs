@@ -151,3 +151,77 @@ fn the_survey_part_is_read_in_its_unit_and_converted() {
     let plain = Job::parse(JOB, Path::new(".")).unwrap();
     assert_eq!(plain.survey, SurveyJob::default());
 }
+
+fn with_tie_on(tie_on: &str) -> String {
+    JOB.replace(
+        "}}",
+        &format!(r#"}}, "survey": {{"length_unit": "ft", "tie_on": {tie_on}}}}}"#),
+    )
+}
+
+#[test]
+fn the_tie_ons_uncertainty_is_read_as_sigmas_or_a_covariance_and_converted() {
+    let job = Job::parse(
+        &with_tie_on(r#"{"md": 1000.0, "sigma": {"north": 10.0, "east": 5.0, "tvd": 2.0}}"#),
+        Path::new("."),
+    )
+    .unwrap();
+    // [nn, ee, vv, ne, nv, ev] in ft^2
+    assert_eq!(
+        job.survey.tie_on.covariance,
+        Some([100.0, 25.0, 4.0, 0.0, 0.0, 0.0])
+    );
+    let m = job
+        .survey
+        .tie_on
+        .in_unit(LengthUnit::Metre)
+        .covariance
+        .unwrap();
+    let ft2 = 0.3048f64.powi(2);
+    for (got, want) in m.iter().zip([100.0, 25.0, 4.0, 0.0, 0.0, 0.0]) {
+        assert!((got - want * ft2).abs() < 1e-12, "{m:?}");
+    }
+    let full = Job::parse(
+        &with_tie_on(
+            r#"{"covariance": {"nn": 4.0, "ne": 1.0, "nv": 0.5, "ee": 2.0, "ev": -0.25, "vv": 1.0}}"#,
+        ),
+        Path::new("."),
+    )
+    .unwrap();
+    assert_eq!(
+        full.survey.tie_on.covariance,
+        Some([4.0, 2.0, 1.0, 1.0, 0.5, -0.25])
+    );
+    let plain = Job::parse(&with_tie_on(r#"{"md": 1000.0}"#), Path::new(".")).unwrap();
+    assert_eq!(plain.survey.tie_on.covariance, None);
+}
+
+#[test]
+fn a_tie_on_uncertainty_that_is_not_one_is_refused_by_name() {
+    let refused = |tie_on: &str, needle: &str| {
+        let e = format!(
+            "{:#}",
+            Job::parse(&with_tie_on(tie_on), Path::new(".")).unwrap_err()
+        );
+        assert!(e.contains(needle), "{tie_on}: {e}");
+    };
+    refused(
+        r#"{"sigma": {"north": -1.0, "east": 1.0, "tvd": 1.0}}"#,
+        "sigma.north",
+    );
+    refused(r#"{"sigma": {"north": 1.0, "east": 1.0}}"#, "tvd");
+    refused(
+        r#"{"sigma": {"north": 1.0, "east": 1.0, "tvd": 1.0},
+            "covariance": {"nn": 1.0, "ne": 0.0, "nv": 0.0, "ee": 1.0, "ev": 0.0, "vv": 1.0}}"#,
+        "not both",
+    );
+    // |ne| > sqrt(nn ee): a direction with a negative variance
+    refused(
+        r#"{"covariance": {"nn": 1.0, "ne": 2.0, "nv": 0.0, "ee": 1.0, "ev": 0.0, "vv": 1.0}}"#,
+        "not a covariance",
+    );
+    refused(
+        r#"{"covariance": {"nn": 1e300, "ne": 0.0, "nv": 0.0, "ee": 1.0, "ev": 0.0, "vv": 1.0}}"#,
+        "covariance.nn",
+    );
+}

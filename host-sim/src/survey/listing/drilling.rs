@@ -59,6 +59,9 @@ pub struct DrillingSurvey {
     pub md_offset_m: f64,
     /// The bit, projected from the last station ([`SurveySetup::sensor_to_bit_m`]).
     pub bit: Option<BitProjection>,
+    /// The tie-on's position covariance (m^2) in every position's;
+    /// `None`: the tie-on is taken as exact.
+    pub tie_on_cov_m2: Option<Cov6>,
 }
 
 /// The bit at the end of the depth log (TD: the log's last MD plus the
@@ -380,6 +383,7 @@ pub fn survey(
         })
         .collect();
     let mut covs = covariance(&rows, &sigmas, terms, site, ahead)?;
+    with_tie_on(&mut covs, tie);
     let bit_cov = (covs.len() > rows.len()).then(|| covs.pop()).flatten();
     let bit =
         bit_row
@@ -414,7 +418,17 @@ pub fn survey(
         skipped,
         md_offset_m,
         bit,
+        tie_on_cov_m2: tie.covariance_m2(LengthUnit::Metre),
     })
+}
+
+/// The tie-on's covariance (metres: a drilling survey's unit) added to
+/// every position's total (`listing::plus_tie_on`).
+fn with_tie_on(covs: &mut [PositionCovariance], tie: &TieOnInput) {
+    let tie_m2 = tie.covariance_m2(LengthUnit::Metre);
+    for c in covs.iter_mut() {
+        c.total = super::plus_tie_on(c.total, tie_m2.as_ref());
+    }
 }
 
 /// A position's NEV covariance, and the survey method's part of it.
@@ -604,7 +618,8 @@ pub fn trajectory(
             })
         })
         .collect();
-    let covs = covariance(&rows, &sigmas, terms, site, None)?;
+    let mut covs = covariance(&rows, &sigmas, terms, site, None)?;
+    with_tie_on(&mut covs, &tie);
     Ok(rows
         .into_iter()
         .enumerate()

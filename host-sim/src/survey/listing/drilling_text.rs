@@ -35,6 +35,7 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         100.0 * confidence,
         scale_2d(confidence)
     );
+    let _ = writeln!(out, "{}", super::tie_on_note(s.tie_on_cov_m2.as_ref()));
     let _ =
         writeln!(
         out,

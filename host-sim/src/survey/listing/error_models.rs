@@ -337,6 +337,7 @@ mod tests {
             tvd: 0.0,
             north: 0.0,
             east: 0.0,
+            covariance: None,
         };
         let site = Site {
             gravity: 9.80665,

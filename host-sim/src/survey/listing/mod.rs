@@ -25,4 +25,4 @@ pub use error_models::{
     apply_model, file_validity, model, model_from_file, terms, Invalid, KnownModel, Validity,
     MODELS,
 };
-pub use positions::{compute, AzimuthReference, Row, TieOnInput};
+pub use positions::{compute, plus_tie_on, tie_on_note, AzimuthReference, Row, TieOnInput};

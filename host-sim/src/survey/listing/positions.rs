@@ -4,7 +4,7 @@
 //! vertical section, and a place for its NEV covariance.
 
 use super::ellipse::Ellipse;
-use crate::formats::station_csv::{InputStation, StationFile};
+use crate::formats::station_csv::{InputStation, LengthUnit, StationFile};
 use crate::survey::iscwsa::{self, Cov6};
 use anyhow::{anyhow, bail, Context, Result};
 use mwd_core::survey::{positions, GridConvergence, Station, TieOn, TrueNorth};
@@ -25,6 +25,53 @@ pub struct TieOnInput {
     pub tvd: f64,
     pub north: f64,
     pub east: f64,
+    /// Its NEV position covariance in the file's unit squared (`Cov6`:
+    /// nn, ee, vv, ne, nv, ev); `None`: exact.
+    pub covariance: Option<Cov6>,
+}
+
+impl TieOnInput {
+    /// The tie-on's position covariance in m^2, from the file's `unit`
+    /// squared.
+    pub fn covariance_m2(&self, unit: LengthUnit) -> Option<Cov6> {
+        let k2 = unit.to_m().powi(2);
+        self.covariance.map(|c| c.map(|v| v * k2))
+    }
+
+    /// Whether this places the stations as the surface default does: N 0,
+    /// E 0, TVD 0 at the first station's MD (whatever its uncertainty).
+    pub fn is_surface(&self) -> bool {
+        self.md.is_none() && self.tvd == 0.0 && self.north == 0.0 && self.east == 0.0
+    }
+}
+
+/// What the listings and the JSON say of the tie-on's uncertainty.
+pub fn tie_on_note(tie_m2: Option<&Cov6>) -> String {
+    match tie_m2 {
+        Some(c) => format!(
+            "tie-on position 1-sigma N {:.2} m, E {:.2} m, TVD {:.2} m (the parent well's where \
+             this well leaves it; in every station's covariance)",
+            c[0].max(0.0).sqrt(),
+            c[1].max(0.0).sqrt(),
+            c[2].max(0.0).sqrt()
+        ),
+        None => "tie-on taken as exact: no parent-well uncertainty given (the job's \
+                 survey.tie_on.sigma or covariance, or --tie-on-sigma); the sigmas are this \
+                 survey's alone"
+            .into(),
+    }
+}
+
+/// A station's covariance with the tie-on's added (m^2). The parent well's
+/// error where the lateral leaves it moves every station of the lateral by
+/// the same vector, so it adds whole to each station's own covariance
+/// (fully correlated between stations); the lateral's own errors are
+/// independent of the parent's survey.
+pub fn plus_tie_on(cov: Cov6, tie_m2: Option<&Cov6>) -> Cov6 {
+    match tie_m2 {
+        Some(t) => std::array::from_fn(|j| cov[j] + t[j]),
+        None => cov,
+    }
 }
 
 /// A station with its position (metres, true north) and, with a model, its
@@ -81,14 +128,14 @@ pub fn compute(
             );
         }
     }
-    let tie_on = TieOn::<TrueNorth>::new(
-        first * k,
-        tie.tvd * k,
-        tie.north * k,
-        tie.east * k,
-        Matrix3::zeros(),
-    )
-    .map_err(|e| anyhow!("tie-on: {e:?}"))?;
+    let tie_cov = tie
+        .covariance_m2(file.unit)
+        .map_or_else(Matrix3::zeros, |c| {
+            Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2])
+        });
+    let tie_on =
+        TieOn::<TrueNorth>::new(first * k, tie.tvd * k, tie.north * k, tie.east * k, tie_cov)
+            .map_err(|e| anyhow!("tie-on: {e:?}"))?;
     let stations = file
         .stations
         .iter()
@@ -154,6 +201,7 @@ mod tests {
             tvd: 50.0,
             north: 10.0,
             east: -5.0,
+            covariance: None,
         };
         let grid = AzimuthReference::Grid(2f64.to_radians());
         let (rows, vsec) = compute(&f, grid, tie, None).unwrap();

@@ -4,8 +4,8 @@
 //! metres, azimuths along true north, whatever the input.
 
 use crate::survey::listing::ellipse::scale_2d;
-use crate::survey::listing::plot;
 use crate::survey::listing::separation as sep;
+use crate::survey::listing::{plot, tie_on_note};
 use crate::survey::well_survey::{sf_status, WellSurvey};
 use anyhow::Result;
 use std::fmt::Write as _;
@@ -75,6 +75,7 @@ pub fn listing_text(s: &WellSurvey) -> String {
             100.0 * s.confidence,
             scale_2d(s.confidence)
         );
+        let _ = writeln!(text, "{}", tie_on_note(s.tie_on_cov_m2.as_ref()));
     }
     let mut head = format!(
         "{:>9} {:>7} {:>7} {:>9} {:>9} {:>9} {:>6} {:>9}",
@@ -254,6 +255,10 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         "stations": stations,
     });
     let mut doc = doc;
+    if s.model.is_some() {
+        doc["tie_on_covariance_m2"] = serde_json::json!(s.tie_on_cov_m2);
+        doc["tie_on_note"] = serde_json::json!(tie_on_note(s.tie_on_cov_m2.as_ref()));
+    }
     if let Some(note) = &s.header_note {
         doc["placement_note"] = serde_json::json!(note);
     }
@@ -309,6 +314,7 @@ mod tests {
                     tvd: 0.0,
                     north: 0.0,
                     east: 0.0,
+                    covariance: None,
                 },
                 vsec_azimuth: None,
                 model: ModelChoice::None,

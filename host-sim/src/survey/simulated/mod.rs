@@ -24,6 +24,10 @@ use crate::survey::outputs::{write_outputs, OutputPaths};
 use crate::survey::stations::job_tie_on;
 use anyhow::{bail, Context, Result};
 use mwd_core::config::default_still_settings;
+use nalgebra::{Matrix3, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 use std::path::{Path, PathBuf};
 use truth::TruthChecks;
 
@@ -58,7 +62,18 @@ impl SimulatedRun {
         let Some(plan_path) = &job.plan else {
             bail!("the job names no plan (\"plan\": a well plan file, relative to the job file)");
         };
-        let plan = Plan::load(plan_path)?;
+        let mut plan = Plan::read(plan_path)?;
+        let parent_error = parent_survey_error(job, inputs.seed);
+        if let Some(e) = parent_error {
+            // the job's tie-on is the parent well's survey; the well is
+            // where that survey is off by `e`
+            plan.tie_on.north_m -= e[0];
+            plan.tie_on.east_m -= e[1];
+            plan.tie_on.tvd_m -= e[2];
+        }
+        let plan = plan
+            .build()
+            .with_context(|| format!("{}: invalid plan", plan_path.display()))?;
         check_site(job, &plan.site, plan_path)?;
         let out = inputs.out_dir;
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -78,6 +93,14 @@ impl SimulatedRun {
                 .map(|d| d * job.survey.tie_on.unit.to_m()),
         })?;
         let checks = TruthChecks::new(&survey.survey, &drilling, inputs.confidence);
+        let mut drilled = drilled;
+        if let Some(e) = parent_error {
+            drilled += &format!(
+                "\nthe job's tie-on, the parent well's survey, is off the well's true position \
+                 there by N {:+.2} m, E {:+.2} m, TVD {:+.2} m (drawn from its covariance)",
+                e[0], e[1], e[2]
+            );
+        }
         let mut written = files.simulation();
         written.extend(write_survey(&survey, job, &files, inputs.confidence)?);
         Ok(Self {
@@ -156,6 +179,24 @@ fn check_site(job: &Job, plan_site: &mwd_core::earth::Position, plan_path: &Path
         );
     }
     Ok(())
+}
+
+/// The parent well survey's error at the tie-on (north, east, TVD, m),
+/// drawn from the job's tie-on covariance when it has one: the job's
+/// tie-on is where the parent's survey places the window, and the
+/// simulated well starts where the window truly is.
+fn parent_survey_error(job: &Job, seed: u64) -> Option<[f64; 3]> {
+    let c = job_tie_on(Some(job)).covariance?;
+    let m = Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2]);
+    // a square root by the eigenvectors: the job's covariance may be
+    // singular (a sigma of 0), where Cholesky fails
+    let eigen = m.symmetric_eigen();
+    let root =
+        eigen.eigenvectors * Matrix3::from_diagonal(&eigen.eigenvalues.map(|v| v.max(0.0).sqrt()));
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x7E0E_0000_0000_0043);
+    let z = Vector3::from_fn(|_, _| StandardNormal.sample(&mut rng));
+    let e = root * z;
+    Some([e.x, e.y, e.z])
 }
 
 /// Drills the plan with the SCC1300's simulated parts: the capture (a
