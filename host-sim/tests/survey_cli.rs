@@ -397,3 +397,112 @@ fn the_tie_ons_uncertainty_adds_to_every_station() {
         }
     }
 }
+
+/// `--units ft`: every output in feet with its unit in the header (DLS
+/// per 100 ft), and the feet CSV read back gives the same well; an MD
+/// column without a unit takes `--units`, and without it is refused.
+#[test]
+fn feet_output_reads_back_as_the_same_well() {
+    let dir = scratch("units-ft");
+    let well = well1();
+    let (metres_csv, feet_csv, feet_json, feet_xml) = (
+        dir.join("m.csv"),
+        dir.join("ft.csv"),
+        dir.join("ft.json"),
+        dir.join("ft.xml"),
+    );
+    let survey = |station_file: &Path, extra: &[&str]| {
+        let mut args = vec![s(station_file), "--error-model", "ISCWSA MWD Rev5"];
+        args.extend_from_slice(&WELL1_SITE);
+        args.extend_from_slice(extra);
+        host_sim(&args)
+    };
+    let metres = survey(&well, &["--csv", s(&metres_csv)]);
+    assert_eq!(metres.code, Some(0), "{}", metres.stderr);
+    let feet = survey(
+        &well,
+        &[
+            "--units",
+            "ft",
+            "--csv",
+            s(&feet_csv),
+            "--json",
+            s(&feet_json),
+            "--witsml",
+            s(&feet_xml),
+        ],
+    );
+    assert_eq!(feet.code, Some(0), "{}", feet.stderr);
+    assert!(feet.stdout.contains("lengths in ft"), "{}", feet.stdout);
+    assert!(feet.stdout.contains("DLS in deg/100ft"), "{}", feet.stdout);
+    assert!(feet.stdout.contains("MD ft"), "{}", feet.stdout);
+    let table = |path: &Path| -> (Vec<String>, Vec<Vec<f64>>) {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| {
+                l.split(',')
+                    .map(|f| f.parse().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        (header, rows)
+    };
+    let (mh, m) = table(&metres_csv);
+    let (fh, f) = table(&feet_csv);
+    let col = |h: &[String], name: &str| h.iter().position(|c| c == name).unwrap();
+    for (metre_name, foot_name, factor) in [
+        ("md_m", "md_ft", 1.0 / 0.3048),
+        ("tvd_m", "tvd_ft", 1.0 / 0.3048),
+        ("north_m", "north_ft", 1.0 / 0.3048),
+        ("sigma_east_m", "sigma_east_ft", 1.0 / 0.3048),
+        (
+            "ellipse_semi_major_m",
+            "ellipse_semi_major_ft",
+            1.0 / 0.3048,
+        ),
+        ("dls_deg_per_30m", "dls_deg_per_100ft", 30.48 / 30.0),
+        ("inc_deg", "inc_deg", 1.0),
+    ] {
+        let (a, b) = (col(&mh, metre_name), col(&fh, foot_name));
+        for (rm, rf) in m.iter().zip(&f) {
+            let want = rm[a] * factor;
+            assert!(
+                (rf[b] - want).abs() <= 1e-9 * want.abs().max(1.0),
+                "{foot_name}: {} vs {want}",
+                rf[b]
+            );
+        }
+    }
+    let xml = std::fs::read_to_string(&feet_xml).unwrap();
+    assert!(xml.contains("<md uom=\"ft\">") && xml.contains("uom=\"dega/100ft\""));
+    assert!(xml.contains("<varianceNN uom=\"ft2\">") && !xml.contains("uom=\"m\""));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&feet_json).unwrap()).unwrap();
+    assert_eq!(json["length_unit"], "ft");
+    assert!(json["stations"][1]["md_ft"].as_f64().is_some());
+    // the feet CSV as a station file, listed in metres: the same positions
+    let back_csv = dir.join("back.csv");
+    let back = survey(&feet_csv, &["--csv", s(&back_csv)]);
+    assert_eq!(back.code, Some(0), "{}", back.stderr);
+    let (bh, b) = table(&back_csv);
+    for name in ["md_m", "tvd_m", "north_m", "east_m", "sigma_north_m"] {
+        let (i, j) = (col(&mh, name), col(&bh, name));
+        for (rm, rb) in m.iter().zip(&b) {
+            assert!(
+                (rm[i] - rb[j]).abs() <= 1e-9 * rm[i].abs().max(1.0),
+                "{name}: {} vs {}",
+                rm[i],
+                rb[j]
+            );
+        }
+    }
+    // an MD column without a unit: refused, or taken in --units
+    let unitless = dir.join("unitless.csv");
+    std::fs::write(&unitless, "MD,Inc,Azi\n0,0,0\n1000,10,45\n2000,20,45\n").unwrap();
+    refused(&survey(&unitless, &[]), "--units");
+    let taken = survey(&unitless, &["--units", "ft"]);
+    assert_eq!(taken.code, Some(0), "{}", taken.stderr);
+    assert!(taken.stdout.contains("  2000.00"), "{}", taken.stdout);
+}

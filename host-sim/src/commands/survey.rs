@@ -23,6 +23,22 @@ use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use std::path::{Path, PathBuf};
 
+/// A length unit on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Units {
+    M,
+    Ft,
+}
+
+impl Units {
+    fn unit(self) -> LengthUnit {
+        match self {
+            Self::M => LengthUnit::Metre,
+            Self::Ft => LengthUnit::Foot,
+        }
+    }
+}
+
 /// North reference of the file's azimuths.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Reference {
@@ -135,6 +151,12 @@ pub struct Args {
     /// Probability held by the scaled horizontal ellipse (2-D normal).
     #[arg(long, default_value_t = 0.95, value_parser = confidence)]
     pub confidence: f64,
+    /// Length unit of the outputs (listing, CSV, JSON, WITSML, figures;
+    /// DLS per 30 m or per 100 ft), and of a station file's MD column that
+    /// names no unit (a header's own unit stands). Default: metres, the
+    /// figures in the file's unit.
+    #[arg(long, value_enum)]
+    pub units: Option<Units>,
     /// Vertical-section azimuth, deg (default: closure of the last station).
     #[arg(long, value_parser = azimuth_deg)]
     pub vsec_azimuth_deg: Option<f64>,
@@ -280,6 +302,13 @@ pub fn run(args: Args) -> Result<()> {
         plot: args.plot.as_deref(),
     };
     if args.capture.depth.is_some() {
+        if args.units == Some(Units::Ft) {
+            bail!(
+                "--units ft: a capture's survey is listed in metres, the depth log's unit (its \
+                 --json and --witsml carry their units); survey its stations CSV with --units ft \
+                 for feet"
+            );
+        }
         let inputs = capture_inputs(&args, &resolved)?;
         let offset = args.sep.offset.as_deref();
         let outputs = super::survey_capture::CaptureOutputs {
@@ -291,7 +320,8 @@ pub fn run(args: Args) -> Result<()> {
         };
         return super::survey_capture::run(&args.capture, &inputs, &outputs, &site_for);
     }
-    let file = read_station_file(&args.stations)?;
+    let units = args.units.map(Units::unit);
+    let file = read_station_file(&args.stations, units)?;
     let inputs = SurveyInputs {
         reference: azimuth_reference(&args)?,
         tie: resolved.tie_on(&args, file.unit),
@@ -303,6 +333,11 @@ pub fn run(args: Args) -> Result<()> {
     survey.well = resolved.well.clone();
     if let Some(path) = &args.sep.offset {
         survey.add_offset(&offset_inputs(&args, path)?, &site_for)?;
+    }
+    if let Some(unit) = units {
+        // the figures too (by default in the file's unit)
+        survey.output_unit = unit;
+        survey.unit = unit;
     }
     out!("{}", listing_text(&survey));
     let well = args
@@ -422,6 +457,7 @@ fn offset_inputs<'a>(args: &'a Args, path: &'a Path) -> Result<OffsetInputs<'a>>
             covariance: None,
         },
         model_name: args.sep.offset_error_model.as_deref(),
+        declared_unit: args.units.map(Units::unit),
         rule: sep::Rule {
             k: sep::K,
             surface_margin_m: args.sep.surface_margin_m,

@@ -46,6 +46,48 @@ impl LengthUnit {
             Self::Foot => FOOT_M,
         }
     }
+
+    /// The unit's symbol in headers, column names and WITSML `uom`s.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Self::Metre => "m",
+            Self::Foot => "ft",
+        }
+    }
+
+    /// A length given in metres, in this unit.
+    pub fn from_m(self, metres: f64) -> f64 {
+        match self {
+            Self::Metre => metres,
+            Self::Foot => metres / FOOT_M,
+        }
+    }
+
+    /// A variance or covariance given in m^2, in this unit squared.
+    pub fn from_m2(self, square_metres: f64) -> f64 {
+        match self {
+            Self::Metre => square_metres,
+            Self::Foot => square_metres / (FOOT_M * FOOT_M),
+        }
+    }
+
+    /// The dogleg-severity course length of this unit's practice: 30 m,
+    /// or 100 ft.
+    pub fn dls_course(self) -> (f64, &'static str) {
+        match self {
+            Self::Metre => (30.0, "30m"),
+            Self::Foot => (100.0, "100ft"),
+        }
+    }
+
+    /// A dogleg severity per 30 m, per this unit's course length.
+    pub fn dls_from_per_30m(self, per_30m: f64) -> f64 {
+        match self {
+            Self::Metre => per_30m,
+            // 100 ft is 30.48 m
+            Self::Foot => per_30m * (100.0 * FOOT_M / 30.0),
+        }
+    }
 }
 
 /// One row of a station file, as read (lengths in the file's unit).
@@ -179,7 +221,7 @@ struct Columns {
     names: [String; 5],
 }
 
-fn columns(header: &[&str], line: u64) -> Result<Columns> {
+fn columns(header: &[&str], line: u64, declared: Option<LengthUnit>) -> Result<Columns> {
     let parsed: Vec<(String, Option<String>)> = header.iter().map(|h| name_and_unit(h)).collect();
     let with_unit = |unit: LengthUnit| -> Vec<&str> {
         header
@@ -238,12 +280,26 @@ fn columns(header: &[&str], line: u64) -> Result<Columns> {
             header_text()
         );
     };
-    let unit = match parsed[md].1.as_deref() {
-        None => bail!(
-            "line {line}: the MD column `{}` has no unit: name it with one, e.g. \"MD (m)\" or \"md_ft\"",
+    let unit = match (parsed[md].1.as_deref(), declared) {
+        (None, Some(unit)) => {
+            let others = if unit == LengthUnit::Metre { &feet } else { &metres };
+            if let Some(other) = others.first() {
+                bail!(
+                    "line {line}: the MD column `{}` has no unit and is taken in {} (--units), \
+                     but `{}` is in the other unit: name the MD column with its unit",
+                    excerpt(header[md]),
+                    unit.symbol(),
+                    excerpt(other)
+                );
+            }
+            unit
+        }
+        (None, None) => bail!(
+            "line {line}: the MD column `{}` has no unit: name it with one, e.g. \"MD (m)\" or \"md_ft\", \
+             or give the file's unit with --units",
             excerpt(header[md])
         ),
-        Some(u) => length_unit(u).ok_or_else(|| {
+        (Some(u), _) => length_unit(u).ok_or_else(|| {
             anyhow!(
                 "line {line}: the MD column `{}` is in `{}`: give MD in m or ft",
                 excerpt(header[md]),
@@ -296,13 +352,19 @@ fn optional(fields: &[&str], col: Option<usize>, name: &str, line: u64) -> Resul
     }
 }
 
-/// Reads and checks a station file.
+/// Reads and checks a station file; its MD column names its unit.
 pub fn read_stations<R: Read>(input: R) -> Result<StationFile> {
+    read_stations_in(input, None)
+}
+
+/// Reads and checks a station file whose MD column may leave its unit to
+/// `declared` (a header's own unit stands).
+pub fn read_stations_in<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<StationFile> {
     let mut cols: Option<Columns> = None;
     let mut stations: Vec<InputStation> = Vec::new();
     for_each_record_tab_aware(input, |line, fields| {
         let Some(c) = &cols else {
-            cols = Some(columns(fields, line)?);
+            cols = Some(columns(fields, line, declared)?);
             return Ok(());
         };
         if c.station
@@ -529,5 +591,33 @@ mod tests {
             let rows = text.lines().filter(|l| !l.trim().is_empty()).count() - 1;
             assert_eq!(f.stations.len(), rows, "{name}");
         }
+    }
+
+    #[test]
+    fn lengths_variances_and_dogleg_severity_convert_to_feet() {
+        let ft = LengthUnit::Foot;
+        assert!((ft.from_m(30.48) - 100.0).abs() < 1e-12);
+        assert!((ft.from_m2(0.3048 * 0.3048 * 4.0) - 4.0).abs() < 1e-12);
+        // 3 deg over 30 m is 3.048 deg over 100 ft (30.48 m)
+        assert!((ft.dls_from_per_30m(3.0) - 3.048).abs() < 1e-12);
+        assert_eq!(LengthUnit::Metre.dls_from_per_30m(3.0), 3.0);
+        assert_eq!((ft.symbol(), ft.dls_course().1), ("ft", "100ft"));
+    }
+
+    #[test]
+    fn an_md_column_without_a_unit_takes_the_declared_one() {
+        let text = "MD;Inc;Azi\n0;0;0\n100;3;10\n";
+        let f = read_stations_in(text.as_bytes(), Some(LengthUnit::Foot)).unwrap();
+        assert_eq!(f.unit, LengthUnit::Foot);
+        // the header's own unit stands
+        let f = read_stations_in("md_m,inc,azi\n0,0,0\n".as_bytes(), Some(LengthUnit::Foot));
+        assert_eq!(f.unwrap().unit, LengthUnit::Metre);
+        let e = read_stations_in(
+            "MD,Inc,Azi,TVD (m)\n0,0,0,0\n".as_bytes(),
+            Some(LengthUnit::Foot),
+        )
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("other unit"), "{e:#}");
+        refused(text, "--units");
     }
 }

@@ -162,6 +162,7 @@ impl CaptureSurvey {
             header_note: (!notes.is_empty()).then(|| notes.join("; ")),
             well: crate::survey::job::WellNames::default(),
             tie_on_cov_m2: self.survey.tie_on_cov_m2,
+            output_unit: LengthUnit::Metre,
         })
     }
 

@@ -22,10 +22,12 @@ use std::path::Path;
 /// The site a model runs at, given the model (see the module's doc).
 pub type SiteFor<'a> = &'a dyn Fn(&KnownModel) -> Result<Site>;
 
-/// Reads a station file (CSV), its path in the errors.
-pub fn read_station_file(path: &Path) -> Result<StationFile> {
+/// Reads a station file (CSV), its path in the errors; an MD column
+/// without a unit is in `declared` (`--units`), if given.
+pub fn read_station_file(path: &Path, declared: Option<LengthUnit>) -> Result<StationFile> {
     let input = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    listing::read_stations(input).with_context(|| format!("{}", path.display()))
+    crate::formats::station_csv::read_stations_in(input, declared)
+        .with_context(|| format!("{}", path.display()))
 }
 
 /// Which error model gives the stations their covariance.
@@ -65,6 +67,8 @@ pub struct OffsetInputs<'a> {
     pub tie: TieOnInput,
     /// Its error model by name; `None`: the reference well's.
     pub model_name: Option<&'a str>,
+    /// The unit of an MD column without one (`--units`).
+    pub declared_unit: Option<LengthUnit>,
     pub rule: sep::Rule,
 }
 
@@ -103,6 +107,9 @@ pub struct WellSurvey {
     /// The tie-on's position covariance (m^2) in every station's; `None`:
     /// the tie-on is taken as exact.
     pub tie_on_cov_m2: Option<Cov6>,
+    /// The length unit of the listing, CSV, JSON and WITSML (the rows are
+    /// kept in metres; the writers convert): metres unless asked.
+    pub output_unit: LengthUnit,
 }
 
 impl WellSurvey {
@@ -140,6 +147,7 @@ impl WellSurvey {
             header_note: None,
             well: WellNames::default(),
             tie_on_cov_m2,
+            output_unit: LengthUnit::Metre,
         })
     }
 
@@ -147,7 +155,7 @@ impl WellSurvey {
     /// separation from every station of this survey.
     pub fn add_offset(&mut self, inputs: &OffsetInputs, site_for: SiteFor) -> Result<()> {
         let path = inputs.path;
-        let file = read_station_file(path).context("the offset well")?;
+        let file = read_station_file(path, inputs.declared_unit).context("the offset well")?;
         if file.unit != self.unit {
             bail!(
                 "{}: the offset well's length unit differs from the reference well's (give both in m or both in ft)",
@@ -183,9 +191,14 @@ impl WellSurvey {
     /// Where the model stops being valid, as a sentence.
     pub fn validity_note(&self) -> Option<String> {
         let (m, inv) = (self.model?, self.invalid_from.as_ref()?);
+        let u = self.output_unit;
         Some(format!(
-            "{} {}: no uncertainty from MD {:.2} m (station {}) on, not extrapolated",
-            m.name, inv.reason, self.rows[inv.station].md_m, inv.station
+            "{} {}: no uncertainty from MD {:.2} {} (station {}) on, not extrapolated",
+            m.name,
+            inv.reason,
+            u.from_m(self.rows[inv.station].md_m),
+            u.symbol(),
+            inv.station
         ))
     }
 
@@ -194,6 +207,8 @@ impl WellSurvey {
         let Some(o) = &self.offset else {
             return Vec::new();
         };
+        let u = self.output_unit;
+        let (len, sym) = (|m: f64| u.from_m(m), u.symbol());
         let mut out = vec![format!(
             "offset {}: model {}; ISCWSA separation rule (Sawaryn et al. 2019, SPE-187073-PA): k {}, S_m {} m, sigma_pa {} m, hole radii {} m / {} m",
             o.name,
@@ -206,12 +221,13 @@ impl WellSurvey {
         )];
         match sep::minimum(&o.seps) {
             Some((i, f)) => out.push(format!(
-                "minimum SF {:.3} at MD {:.2} m (offset MD {:.2} m, centre to centre {:.2} m +- {:.2} m 1-sigma)",
+                "minimum SF {:.3} at MD {:.2} {sym} (offset MD {:.2} {sym}, centre to centre {:.2} {sym} +- {:.2} {sym} 1-sigma)",
                 f,
-                self.rows[i].md_m,
-                o.seps[i].closest.md_m,
-                o.seps[i].ctc_m,
-                o.seps[i].sigma_s_m.unwrap_or(f64::NAN)
+                len(self.rows[i].md_m),
+                len(o.seps[i].closest.md_m),
+                len(o.seps[i].ctc_m),
+                // a minimum SF has its sigma (`sep::minimum`)
+                o.seps[i].sigma_s_m.map_or(f64::NAN, len)
             )),
             None => {
                 out.push("minimum SF undetermined: no station has both wells' covariance".into())
@@ -222,10 +238,10 @@ impl WellSurvey {
             .collect();
         if let (Some(&a), Some(&b)) = (bad.first(), bad.last()) {
             out.push(format!(
-                "VIOLATION of the separation rule (SF < 1) at {} stations, MD {:.2} to {:.2} m",
+                "VIOLATION of the separation rule (SF < 1) at {} stations, MD {:.2} to {:.2} {sym}",
                 bad.len(),
-                self.rows[a].md_m,
-                self.rows[b].md_m
+                len(self.rows[a].md_m),
+                len(self.rows[b].md_m)
             ));
         }
         let undetermined = o.seps.iter().filter(|x| x.sf.is_none()).count();

@@ -4,6 +4,7 @@
 
 use super::drilling::{BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint};
 use super::ellipse::scale_2d;
+use super::LengthUnit;
 use mwd_core::probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD;
 use mwd_core::protocol::frame::station_flags;
 use std::fmt::Write as _;
@@ -35,7 +36,11 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         100.0 * confidence,
         scale_2d(confidence)
     );
-    let _ = writeln!(out, "{}", super::tie_on_note(s.tie_on_cov_m2.as_ref()));
+    let _ = writeln!(
+        out,
+        "{}",
+        super::tie_on_note(s.tie_on_cov_m2.as_ref(), LengthUnit::Metre)
+    );
     let _ =
         writeln!(
         out,

@@ -46,14 +46,16 @@ impl TieOnInput {
 }
 
 /// What the listings and the JSON say of the tie-on's uncertainty.
-pub fn tie_on_note(tie_m2: Option<&Cov6>) -> String {
+pub fn tie_on_note(tie_m2: Option<&Cov6>, unit: LengthUnit) -> String {
+    let sigma = |v: f64| unit.from_m(v.max(0.0).sqrt());
     match tie_m2 {
         Some(c) => format!(
-            "tie-on position 1-sigma N {:.2} m, E {:.2} m, TVD {:.2} m (the parent well's where \
-             this well leaves it; in every station's covariance)",
-            c[0].max(0.0).sqrt(),
-            c[1].max(0.0).sqrt(),
-            c[2].max(0.0).sqrt()
+            "tie-on position 1-sigma N {:.2} {u}, E {:.2} {u}, TVD {:.2} {u} (the parent well's \
+             where this well leaves it; in every station's covariance)",
+            sigma(c[0]),
+            sigma(c[1]),
+            sigma(c[2]),
+            u = unit.symbol()
         ),
         None => "tie-on taken as exact: no parent-well uncertainty given (the job's \
                  survey.tie_on.sigma or covariance, or --tie-on-sigma); the sigmas are this \

@@ -60,11 +60,14 @@ pub fn write_outputs(s: &WellSurvey, paths: &OutputPaths, well: &str) -> Result<
 /// separation with an offset well), the model's validity note and the
 /// separation summary.
 pub fn listing_text(s: &WellSurvey) -> String {
+    let u = s.output_unit;
+    let sym = u.symbol();
     let mut text = String::new();
     let _ = writeln!(
         text,
-        "{} stations; N/E along true north, m; vertical section along {:.2} deg",
+        "{} stations; lengths in {sym}, N/E along true north; DLS in deg/{}; vertical section along {:.2} deg",
         s.rows.len(),
+        u.dls_course().1,
         s.vsec_azimuth_deg
     );
     if let Some(m) = s.model {
@@ -75,26 +78,47 @@ pub fn listing_text(s: &WellSurvey) -> String {
             100.0 * s.confidence,
             scale_2d(s.confidence)
         );
-        let _ = writeln!(text, "{}", tie_on_note(s.tie_on_cov_m2.as_ref()));
+        let _ = writeln!(text, "{}", tie_on_note(s.tie_on_cov_m2.as_ref(), u));
     }
+    let unit = |name: &str| format!("{name} {sym}");
     let mut head = format!(
         "{:>9} {:>7} {:>7} {:>9} {:>9} {:>9} {:>6} {:>9}",
-        "MD m", "inc", "azi", "TVD m", "N m", "E m", "DLS", "VS m"
+        unit("MD"),
+        "inc",
+        "azi",
+        unit("TVD"),
+        unit("N"),
+        unit("E"),
+        "DLS",
+        unit("VS")
     );
     if s.model.is_some() {
         head += &format!(
             " {:>7} {:>7} {:>7} {:>8} {:>8} {:>6}",
-            "sN m", "sE m", "sV m", "major m", "minor m", "az"
+            unit("sN"),
+            unit("sE"),
+            unit("sV"),
+            unit("major"),
+            unit("minor"),
+            "az"
         );
     }
     if s.offset.is_some() {
-        head += &format!(" {:>9} {:>7} {:>8}", "ctc m", "sS m", "SF");
+        head += &format!(" {:>9} {:>7} {:>8}", unit("ctc"), unit("sS"), "SF");
     }
     let _ = writeln!(text, "{head}");
+    let len = |m: f64| u.from_m(m);
     for (k, r) in s.rows.iter().enumerate() {
         let mut line = format!(
             "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
-            r.md_m, r.inc_deg, r.azi_deg, r.tvd_m, r.north_m, r.east_m, r.dls_deg_per_30m, r.vsec_m
+            len(r.md_m),
+            r.inc_deg,
+            r.azi_deg,
+            len(r.tvd_m),
+            len(r.north_m),
+            len(r.east_m),
+            u.dls_from_per_30m(r.dls_deg_per_30m),
+            len(r.vsec_m)
         );
         if s.model.is_some() {
             match (r.cov, r.ellipse()) {
@@ -103,11 +127,11 @@ pub fn listing_text(s: &WellSurvey) -> String {
                     let _ = write!(
                         line,
                         " {:>7.2} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>6.1}",
-                        c[0].max(0.0).sqrt(),
-                        c[1].max(0.0).sqrt(),
-                        e.sigma_vert,
-                        a,
-                        b,
+                        len(c[0].max(0.0).sqrt()),
+                        len(c[1].max(0.0).sqrt()),
+                        len(e.sigma_vert),
+                        len(a),
+                        len(b),
                         e.azimuth_deg
                     );
                 }
@@ -115,11 +139,11 @@ pub fn listing_text(s: &WellSurvey) -> String {
             }
         }
         if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
-            let _ = write!(line, " {:>9.2}", x.ctc_m);
+            let _ = write!(line, " {:>9.2}", len(x.ctc_m));
             match (x.sigma_s_m, x.sf) {
                 (Some(sig), Some(f)) => {
                     let flag = if f < 1.0 { " SF<1" } else { "" };
-                    let _ = write!(line, " {sig:>7.2} {f:>8.3}{flag}");
+                    let _ = write!(line, " {:>7.2} {f:>8.3}{flag}", len(sig));
                 }
                 _ => line += "  SF undetermined",
             }
@@ -140,28 +164,35 @@ fn opt(v: Option<f64>) -> String {
 }
 
 pub fn csv_text(s: &WellSurvey) -> String {
-    let mut out = String::from(
-        "md_m,inc_deg,azi_deg,tvd_m,north_m,east_m,dls_deg_per_30m,vsec_m,toolface_deg,time_s",
+    let u = s.output_unit;
+    let sym = u.symbol();
+    let len = |m: f64| u.from_m(m);
+    let mut out = format!(
+        "md_{sym},inc_deg,azi_deg,tvd_{sym},north_{sym},east_{sym},dls_deg_per_{},vsec_{sym},toolface_deg,time_s",
+        u.dls_course().1
     );
     if s.model.is_some() {
-        out += ",sigma_north_m,sigma_east_m,sigma_vert_m,ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg,confidence,error_model_valid";
+        let _ = write!(
+            out,
+            ",sigma_north_{sym},sigma_east_{sym},sigma_vert_{sym},ellipse_semi_major_{sym},ellipse_semi_minor_{sym},ellipse_azimuth_deg,confidence,error_model_valid"
+        );
     }
     if s.offset.is_some() {
-        out += ",offset_md_m,ctc_m,sigma_s_m,sf,sf_status";
+        let _ = write!(out, ",offset_md_{sym},ctc_{sym},sigma_s_{sym},sf,sf_status");
     }
     out += "\n";
     for (k, r) in s.rows.iter().enumerate() {
         let _ = write!(
             out,
             "{},{},{},{},{},{},{},{},{},{}",
-            r.md_m,
+            len(r.md_m),
             r.inc_deg,
             r.azi_deg,
-            r.tvd_m,
-            r.north_m,
-            r.east_m,
-            r.dls_deg_per_30m,
-            r.vsec_m,
+            len(r.tvd_m),
+            len(r.north_m),
+            len(r.east_m),
+            u.dls_from_per_30m(r.dls_deg_per_30m),
+            len(r.vsec_m),
             opt(r.input.toolface_deg),
             opt(r.input.time_s)
         );
@@ -171,10 +202,12 @@ pub fn csv_text(s: &WellSurvey) -> String {
                     let (a, b) = e.scaled(s.confidence);
                     let _ = write!(
                         out,
-                        ",{},{},{},{a},{b},{},{},true",
-                        c[0].max(0.0).sqrt(),
-                        c[1].max(0.0).sqrt(),
-                        e.sigma_vert,
+                        ",{},{},{},{},{},{},{},true",
+                        len(c[0].max(0.0).sqrt()),
+                        len(c[1].max(0.0).sqrt()),
+                        len(e.sigma_vert),
+                        len(a),
+                        len(b),
                         e.azimuth_deg,
                         s.confidence
                     );
@@ -188,9 +221,9 @@ pub fn csv_text(s: &WellSurvey) -> String {
             let _ = write!(
                 out,
                 ",{},{},{},{},{}",
-                x.closest.md_m,
-                x.ctc_m,
-                opt(x.sigma_s_m),
+                len(x.closest.md_m),
+                len(x.ctc_m),
+                opt(x.sigma_s_m.map(len)),
                 opt(x.sf),
                 sf_status(x)
             );
@@ -201,30 +234,70 @@ pub fn csv_text(s: &WellSurvey) -> String {
 }
 
 /// One station of the JSON: position, and with a model its covariance and
-/// ellipse at `s.confidence`.
+/// ellipse at `s.confidence`; lengths in `s.output_unit`, each key named
+/// with its unit.
 fn json_station(s: &WellSurvey, r: &crate::survey::listing::Row) -> serde_json::Value {
-    let mut v = serde_json::json!({
-        "md_m": r.md_m, "inc_deg": r.inc_deg, "azi_deg": r.azi_deg,
-        "tvd_m": r.tvd_m, "north_m": r.north_m, "east_m": r.east_m,
-        "dls_deg_per_30m": r.dls_deg_per_30m, "vsec_m": r.vsec_m,
-        "toolface_deg": r.input.toolface_deg, "time_s": r.input.time_s,
-    });
+    use serde_json::json;
+    let u = s.output_unit;
+    let sym = u.symbol();
+    let len = |m: f64| u.from_m(m);
+    let mut v = serde_json::Map::new();
+    let mut put = |key: String, value: serde_json::Value| {
+        v.insert(key, value);
+    };
+    put(format!("md_{sym}"), json!(len(r.md_m)));
+    put("inc_deg".into(), json!(r.inc_deg));
+    put("azi_deg".into(), json!(r.azi_deg));
+    put(format!("tvd_{sym}"), json!(len(r.tvd_m)));
+    put(format!("north_{sym}"), json!(len(r.north_m)));
+    put(format!("east_{sym}"), json!(len(r.east_m)));
+    put(
+        format!("dls_deg_per_{}", u.dls_course().1),
+        json!(u.dls_from_per_30m(r.dls_deg_per_30m)),
+    );
+    put(format!("vsec_{sym}"), json!(len(r.vsec_m)));
+    put("toolface_deg".into(), json!(r.input.toolface_deg));
+    put("time_s".into(), json!(r.input.time_s));
     if s.model.is_some() {
         let e = r.ellipse();
         let scaled = e.map(|e| e.scaled(s.confidence));
-        v["nev_covariance_m2"] = serde_json::json!(r.cov);
-        v["sigma_north_m"] = serde_json::json!(r.cov.map(|c| c[0].max(0.0).sqrt()));
-        v["sigma_east_m"] = serde_json::json!(r.cov.map(|c| c[1].max(0.0).sqrt()));
-        v["sigma_vert_m"] = serde_json::json!(e.map(|e| e.sigma_vert));
-        v["ellipse_semi_major_m"] = serde_json::json!(scaled.map(|x| x.0));
-        v["ellipse_semi_minor_m"] = serde_json::json!(scaled.map(|x| x.1));
-        v["ellipse_azimuth_deg"] = serde_json::json!(e.map(|e| e.azimuth_deg));
-        v["error_model_valid"] = serde_json::json!(r.cov.is_some());
+        put(
+            format!("nev_covariance_{sym}2"),
+            json!(r.cov.map(|c| c.map(|x| u.from_m2(x)))),
+        );
+        put(
+            format!("sigma_north_{sym}"),
+            json!(r.cov.map(|c| len(c[0].max(0.0).sqrt()))),
+        );
+        put(
+            format!("sigma_east_{sym}"),
+            json!(r.cov.map(|c| len(c[1].max(0.0).sqrt()))),
+        );
+        put(
+            format!("sigma_vert_{sym}"),
+            json!(e.map(|e| len(e.sigma_vert))),
+        );
+        put(
+            format!("ellipse_semi_major_{sym}"),
+            json!(scaled.map(|x| len(x.0))),
+        );
+        put(
+            format!("ellipse_semi_minor_{sym}"),
+            json!(scaled.map(|x| len(x.1))),
+        );
+        put(
+            "ellipse_azimuth_deg".into(),
+            json!(e.map(|e| e.azimuth_deg)),
+        );
+        put("error_model_valid".into(), json!(r.cov.is_some()));
     }
-    v
+    serde_json::Value::Object(v)
 }
 
 pub fn json_text(s: &WellSurvey) -> Result<String> {
+    let u = s.output_unit;
+    let sym = u.symbol();
+    let len = |m: f64| u.from_m(m);
     let stations: Vec<serde_json::Value> = s
         .rows
         .iter()
@@ -233,11 +306,13 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
             let mut v = json_station(s, r);
             if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
                 let c = &x.closest;
-                v["offset_md_m"] = serde_json::json!(c.md_m);
-                v["offset_nev_m"] = serde_json::json!([c.nev.x, c.nev.y, c.nev.z]);
-                v["offset_nev_covariance_m2"] = serde_json::json!(c.cov);
-                v["ctc_m"] = serde_json::json!(x.ctc_m);
-                v["sigma_s_m"] = serde_json::json!(x.sigma_s_m);
+                v[format!("offset_md_{sym}")] = serde_json::json!(len(c.md_m));
+                v[format!("offset_nev_{sym}")] =
+                    serde_json::json!([len(c.nev.x), len(c.nev.y), len(c.nev.z)]);
+                v[format!("offset_nev_covariance_{sym}2")] =
+                    serde_json::json!(c.cov.map(|c| c.map(|x| u.from_m2(x))));
+                v[format!("ctc_{sym}")] = serde_json::json!(len(x.ctc_m));
+                v[format!("sigma_s_{sym}")] = serde_json::json!(x.sigma_s_m.map(len));
                 v["sf"] = serde_json::json!(x.sf);
                 v["sf_status"] = serde_json::json!(sf_status(x));
             }
@@ -246,18 +321,19 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         .collect();
     let doc = serde_json::json!({
         "north_reference": "true",
-        "length_unit": "m",
+        "length_unit": sym,
         "vsec_azimuth_deg": s.vsec_azimuth_deg,
         "error_model": s.model.map(|m| m.name),
         "confidence": s.model.map(|_| s.confidence),
-        "ellipse_convention": s.model.map(|_| "semi-axes: 1-sigma of the NE covariance times sqrt(-2 ln(1 - confidence)); azimuth of the major axis in [0, 180) deg; covariance [nn, ee, vv, ne, nv, ev] m^2"),
+        "ellipse_convention": s.model.map(|_| format!("semi-axes: 1-sigma of the NE covariance times sqrt(-2 ln(1 - confidence)); azimuth of the major axis in [0, 180) deg; covariance [nn, ee, vv, ne, nv, ev] {sym}^2")),
         "note": s.validity_note(),
         "stations": stations,
     });
     let mut doc = doc;
     if s.model.is_some() {
-        doc["tie_on_covariance_m2"] = serde_json::json!(s.tie_on_cov_m2);
-        doc["tie_on_note"] = serde_json::json!(tie_on_note(s.tie_on_cov_m2.as_ref()));
+        doc[format!("tie_on_covariance_{sym}2")] =
+            serde_json::json!(s.tie_on_cov_m2.map(|c| c.map(|x| u.from_m2(x))));
+        doc["tie_on_note"] = serde_json::json!(tie_on_note(s.tie_on_cov_m2.as_ref(), u));
     }
     if let Some(note) = &s.header_note {
         doc["placement_note"] = serde_json::json!(note);
@@ -278,10 +354,11 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
             "hole_radius_m": o.rule.ref_radius_m,
             "offset_hole_radius_m": o.rule.offset_radius_m,
             "min_sf": min.map(|m| m.1),
-            "min_sf_md_m": min.map(|m| s.rows[m.0].md_m),
             "violation": o.seps.iter().any(|x| x.sf.is_some_and(|f| f < 1.0)),
             "summary": s.separation_summary(),
         });
+        doc["separation"][format!("min_sf_md_{sym}")] =
+            serde_json::json!(min.map(|m| len(s.rows[m.0].md_m)));
     }
     Ok(serde_json::to_string_pretty(&doc)? + "\n")
 }

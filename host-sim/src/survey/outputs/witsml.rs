@@ -7,7 +7,7 @@
 //! The output is not validated against the XSD: Energistics publishes it
 //! on its site only, through no package registry.
 
-use crate::survey::listing::Row;
+use crate::survey::listing::{LengthUnit, Row};
 use crate::survey::well_survey::WellSurvey;
 use std::fmt::Write as _;
 
@@ -31,10 +31,11 @@ fn escaped(text: &str) -> String {
 /// The station's NEV covariance (`Row::cov`, m^2, [nn, ee, vv, ne, nv, ev])
 /// in `cs_stnTrajMatrixCov`'s order: NN, NE, NVert, EE, EVert, VertVert.
 /// Nothing for a station the model leaves undetermined.
-fn matrix_cov(r: &Row) -> String {
+fn matrix_cov(r: &Row, unit: LengthUnit) -> String {
     let Some([nn, ee, vv, ne, nv, ev]) = r.cov else {
         return String::new();
     };
+    let sym = unit.symbol();
     let mut x = String::from("      <matrixCov>\n");
     for (name, value) in [
         ("varianceNN", nn),
@@ -44,7 +45,11 @@ fn matrix_cov(r: &Row) -> String {
         ("varianceEVert", ev),
         ("varianceVertVert", vv),
     ] {
-        let _ = writeln!(x, "        <{name} uom=\"m2\">{value}</{name}>");
+        let _ = writeln!(
+            x,
+            "        <{name} uom=\"{sym}2\">{}</{name}>",
+            unit.from_m2(value)
+        );
     }
     x += "      </matrixCov>\n";
     x
@@ -67,9 +72,11 @@ pub fn witsml_text(s: &WellSurvey) -> String {
         escaped(&names.well),
         escaped(&names.wellbore),
     );
+    let u = s.output_unit;
+    let (sym, len) = (u.symbol(), |m: f64| u.from_m(m));
     if let (Some(first), Some(last)) = (s.rows.first(), s.rows.last()) {
-        let _ = writeln!(x, "    <mdMn uom=\"m\">{}</mdMn>", first.md_m);
-        let _ = writeln!(x, "    <mdMx uom=\"m\">{}</mdMx>", last.md_m);
+        let _ = writeln!(x, "    <mdMn uom=\"{sym}\">{}</mdMn>", len(first.md_m));
+        let _ = writeln!(x, "    <mdMx uom=\"{sym}\">{}</mdMx>", len(last.md_m));
     }
     let _ = writeln!(
         x,
@@ -86,17 +93,25 @@ pub fn witsml_text(s: &WellSurvey) -> String {
             x,
             "    <trajectoryStation uid=\"st{k}\">\n\
              \x20     <typeTrajStation>{kind}</typeTrajStation>\n\
-             \x20     <md uom=\"m\">{}</md>\n\
-             \x20     <tvd uom=\"m\">{}</tvd>\n\
+             \x20     <md uom=\"{sym}\">{}</md>\n\
+             \x20     <tvd uom=\"{sym}\">{}</tvd>\n\
              \x20     <incl uom=\"dega\">{}</incl>\n\
              \x20     <azi uom=\"dega\">{}</azi>\n\
-             \x20     <dispNs uom=\"m\">{}</dispNs>\n\
-             \x20     <dispEw uom=\"m\">{}</dispEw>\n\
-             \x20     <vertSect uom=\"m\">{}</vertSect>\n\
-             \x20     <dls uom=\"dega/30m\">{}</dls>\n",
-            r.md_m, r.tvd_m, r.inc_deg, r.azi_deg, r.north_m, r.east_m, r.vsec_m, r.dls_deg_per_30m
+             \x20     <dispNs uom=\"{sym}\">{}</dispNs>\n\
+             \x20     <dispEw uom=\"{sym}\">{}</dispEw>\n\
+             \x20     <vertSect uom=\"{sym}\">{}</vertSect>\n\
+             \x20     <dls uom=\"dega/{}\">{}</dls>\n",
+            len(r.md_m),
+            len(r.tvd_m),
+            r.inc_deg,
+            r.azi_deg,
+            len(r.north_m),
+            len(r.east_m),
+            len(r.vsec_m),
+            u.dls_course().1,
+            u.dls_from_per_30m(r.dls_deg_per_30m)
         );
-        x += &matrix_cov(r);
+        x += &matrix_cov(r, u);
         x += "    </trajectoryStation>\n";
     }
     x += "  </trajectory>\n</trajectorys>\n";
