@@ -54,25 +54,24 @@ struct Leg {
 }
 
 impl Leg {
-    /// Station `k` (>= 1) of `stations`, from the trigonometry of stations
-    /// k-1, k and k+1 (`next`: `None` at the last station).
+    /// Station `w.cur` from the trigonometry of the stations before it, at
+    /// it and after it (`next`: `None` at the last station).
     fn at(
-        stations: &[Station],
-        k: usize,
+        w: &Window,
         prev: &StationTrig,
         cur: &StationTrig,
         next: Option<&StationTrig>,
         opts: Options,
     ) -> Self {
-        let s = &stations[k];
-        let course = s.md - stations[k - 1].md;
-        let len_b = if k == 1 && opts.tie_on == TieOn::CarriedByFirstStation {
+        let s = w.cur;
+        let course = s.md - w.prev.md;
+        let len_b = if w.k == 1 && opts.tie_on == TieOn::CarriedByFirstStation {
             // the tie-on's inclination/azimuth error is carried here
-            2.0 * (s.md - stations[0].md)
+            2.0 * (s.md - w.first_md)
         } else {
             course
         };
-        let len_a = stations.get(k + 1).map_or(0.0, |n| n.md - s.md);
+        let len_a = w.next.map_or(0.0, |n| n.md - s.md);
         let t = tangent(cur);
         let tp = tangent(prev);
         let tn = next.map_or(t, tangent);
@@ -139,26 +138,37 @@ impl Options {
     };
 }
 
-/// Error vectors of one source at station `k` (>= 1): (as an interior
+/// The stations around station `k` (>= 1) of a survey, as the
+/// propagation at `k` needs them.
+#[derive(Clone, Copy, Debug)]
+struct Window<'s> {
+    k: usize,
+    /// MD of the survey's first station (the tie-on).
+    first_md: f64,
+    prev: &'s Station,
+    cur: &'s Station,
+    next: Option<&'s Station>,
+}
+
+/// Error vectors of one source at station `w.cur`: (as an interior
 /// station, as the station of interest); `None`: weighting function not
 /// implemented.
 #[inline]
 fn error_vector(
     term: &ErrorTerm,
-    stations: &[Station],
+    w: &Window,
     trig: &StationTrig,
     leg: &Leg,
-    k: usize,
     site: &SiteTerms,
     opts: Options,
 ) -> Option<([f64; 3], [f64; 3])> {
     let sig = term.magnitude_si;
-    let s = &stations[k];
+    let s = w.cur;
     if term.weighting.starts_with("XCL") {
         let v = xcl_vector(
             &term.weighting,
             s,
-            &stations[k - 1],
+            w.prev,
             trig,
             sig,
             site,
@@ -181,73 +191,124 @@ fn error_vector(
 
 /// One implemented source while the stations are walked: its running sum
 /// (SPE 67616: random sources add their covariances, the others their
-/// error vectors) and its covariance at the stations so far.
+/// error vectors) and its covariance at the last station propagated.
 struct Source<'a> {
     term: &'a ErrorTerm,
     random: bool,
     /// Random: the covariance sum `[nn, ee, vv, ne, nv, ev]`; otherwise the
     /// vector sum in the first three.
     sum: [f64; 6],
-    covs: Vec<Cov6>,
+    last: Cov6,
 }
 
-/// Runs the model over a survey (first station = tie-on), with the Rev
-/// 5.10 conventions.
-pub fn run(terms: &[ErrorTerm], stations: &[Station], site: &Site) -> ModelResult {
-    run_with(terms, stations, site, Options::REV5_10)
-}
-
-/// Runs the model with explicit conventions.
-pub fn run_with(
-    terms: &[ErrorTerm],
-    stations: &[Station],
-    site: &Site,
+/// The model run one station at a time, holding only the sources' running
+/// sums and the last two stations: a survey of any length in constant
+/// memory. Each station's covariance is known once the station after it
+/// is (the balanced-tangential legs reach one station ahead), so
+/// [`Propagator::push`] gives the covariance of the station before the one
+/// pushed, and [`Propagator::finish`] the last one's.
+pub struct Propagator<'a> {
+    sources: Vec<Source<'a>>,
+    missing: Vec<String>,
+    site: SiteTerms,
     opts: Options,
-) -> ModelResult {
-    let n = stations.len();
-    let mut per_source = BTreeMap::new();
-    let mut missing = Vec::new();
-    if n == 0 {
-        return ModelResult {
-            per_source,
-            total: Vec::new(),
-            missing,
-        };
-    }
-    let site = &SiteTerms::of(site);
-    // Stations outside, sources inside: each station's trigonometry and leg
-    // geometry is computed once for all sources and kept only while it is
-    // needed (no per-station tables), and the sources' running sums lie
-    // together in one small array.
-    let mut prev = StationTrig::of(&stations[0], site);
-    let mut sources: Vec<Source> = Vec::with_capacity(terms.len());
-    for term in terms {
-        if !implemented(term, &stations[0], &prev, site) {
-            missing.push(term.code.clone());
-            continue;
+    first_md: f64,
+    /// Stations k-1 and k (k the next to propagate), with their trigonometry.
+    prev: (Station, StationTrig),
+    cur: Option<(Station, StationTrig)>,
+    k: usize,
+}
+
+impl<'a> Propagator<'a> {
+    /// Starts at the survey's first station (the tie-on: no error).
+    pub fn new(terms: &'a [ErrorTerm], first: Station, site: &Site, opts: Options) -> Self {
+        let site = SiteTerms::of(site);
+        let trig = StationTrig::of(&first, &site);
+        let mut sources = Vec::with_capacity(terms.len());
+        let mut missing = Vec::new();
+        for term in terms {
+            if !implemented(term, &first, &trig, &site) {
+                missing.push(term.code.clone());
+                continue;
+            }
+            sources.push(Source {
+                term,
+                random: term.propagation == Propagation::Random,
+                sum: [0.0; 6],
+                // the tie-on carries no error
+                last: [0.0; 6],
+            });
         }
-        let mut covs = Vec::with_capacity(n);
-        // the tie-on carries no error
-        covs.push([0.0; 6]);
-        sources.push(Source {
-            term,
-            random: term.propagation == Propagation::Random,
-            sum: [0.0; 6],
-            covs,
-        });
+        Self {
+            sources,
+            missing,
+            site,
+            opts,
+            first_md: first.md,
+            prev: (first, trig),
+            cur: None,
+            k: 1,
+        }
     }
-    let mut total = Vec::with_capacity(n);
-    total.push([0.0; 6]);
-    let mut cur = stations.get(1).map(|s| StationTrig::of(s, site));
-    for k in 1..n {
-        let Some(trig) = cur else { break };
-        let next = stations.get(k + 1).map(|s| StationTrig::of(s, site));
-        let leg = Leg::at(stations, k, &prev, &trig, next.as_ref(), opts);
+
+    /// Codes of the sources whose weighting function is not implemented
+    /// (left out of every covariance).
+    pub fn missing(&self) -> &[String] {
+        &self.missing
+    }
+
+    /// The sources' codes, in the order of [`Propagator::source_covariances`].
+    pub fn source_codes(&self) -> impl Iterator<Item = &str> {
+        self.sources.iter().map(|s| s.term.code.as_str())
+    }
+
+    /// Each source's covariance at the last station propagated.
+    pub fn source_covariances(&self) -> impl Iterator<Item = &Cov6> {
+        self.sources.iter().map(|s| &s.last)
+    }
+
+    /// Takes the next station; returns the covariance of the station
+    /// before it, if that one is not the first.
+    pub fn push(&mut self, station: Station) -> Option<Cov6> {
+        let trig = StationTrig::of(&station, &self.site);
+        let done = self.cur.map(|(cur, cur_trig)| {
+            let c = self.step(&cur, &cur_trig, Some((&station, &trig)));
+            self.prev = (cur, cur_trig);
+            c
+        });
+        self.cur = Some((station, trig));
+        done
+    }
+
+    /// The covariance of the last station pushed (none if only the first
+    /// was given).
+    pub fn finish(&mut self) -> Option<Cov6> {
+        let (cur, cur_trig) = self.cur.take()?;
+        let c = self.step(&cur, &cur_trig, None);
+        self.prev = (cur, cur_trig);
+        Some(c)
+    }
+
+    fn step(
+        &mut self,
+        cur: &Station,
+        trig: &StationTrig,
+        next: Option<(&Station, &StationTrig)>,
+    ) -> Cov6 {
+        let (site, opts) = (&self.site, self.opts);
+        let w = Window {
+            k: self.k,
+            first_md: self.first_md,
+            prev: &self.prev.0,
+            cur,
+            next: next.map(|n| n.0),
+        };
+        let leg = Leg::at(&w, &self.prev.1, trig, next.map(|n| n.1), opts);
         let mut tot = [0.0; 6];
-        for src in &mut sources {
+        for src in &mut self.sources {
             // `implemented` said the name is known: a station cannot change
             // that (the dispatch is by name)
-            let (interior, last) = error_vector(src.term, stations, &trig, &leg, k, site, opts)
+            let (interior, last) = error_vector(src.term, &w, trig, &leg, site, opts)
                 .unwrap_or(([0.0; 3], [0.0; 3]));
             let c = if src.random {
                 let c = outer(last);
@@ -263,21 +324,71 @@ pub fn run_with(
                 }
                 c
             };
-            src.covs.push(c);
+            src.last = c;
             for j in 0..6 {
                 tot[j] += c[j];
             }
         }
-        total.push(tot);
-        prev = trig;
-        cur = next;
+        self.k += 1;
+        tot
     }
-    for src in sources {
-        per_source.insert(src.term.code.clone(), src.covs);
+}
+
+/// Runs the model over a survey (first station = tie-on), with the Rev
+/// 5.10 conventions.
+pub fn run(terms: &[ErrorTerm], stations: &[Station], site: &Site) -> ModelResult {
+    run_with(terms, stations, site, Options::REV5_10)
+}
+
+/// Runs the model with explicit conventions, keeping every source's
+/// covariance at every station ([`Propagator`] keeps none).
+pub fn run_with(
+    terms: &[ErrorTerm],
+    stations: &[Station],
+    site: &Site,
+    opts: Options,
+) -> ModelResult {
+    let n = stations.len();
+    let Some(first) = stations.first() else {
+        return ModelResult {
+            per_source: BTreeMap::new(),
+            total: Vec::new(),
+            missing: Vec::new(),
+        };
+    };
+    let mut propagator = Propagator::new(terms, *first, site, opts);
+    let mut covs: Vec<Vec<Cov6>> = propagator
+        .source_covariances()
+        .map(|c| {
+            let mut v = Vec::with_capacity(n);
+            v.push(*c);
+            v
+        })
+        .collect();
+    let mut total = Vec::with_capacity(n);
+    total.push([0.0; 6]);
+    let mut keep = |p: &Propagator, c: Cov6| {
+        for (v, s) in covs.iter_mut().zip(p.source_covariances()) {
+            v.push(*s);
+        }
+        total.push(c);
+    };
+    for s in &stations[1..] {
+        if let Some(c) = propagator.push(*s) {
+            keep(&propagator, c);
+        }
     }
+    if let Some(c) = propagator.finish() {
+        keep(&propagator, c);
+    }
+    let per_source = propagator
+        .source_codes()
+        .map(String::from)
+        .zip(covs)
+        .collect();
     ModelResult {
         per_source,
         total,
-        missing,
+        missing: propagator.missing().to_vec(),
     }
 }
