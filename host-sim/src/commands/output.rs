@@ -43,3 +43,50 @@ pub fn print_text(args: std::fmt::Arguments<'_>) {
         eprintln!("error: writing to standard output: {e:#}");
     }
 }
+
+/// Standard output as a stream of lines (a survey of a million stations
+/// written as it is made), buffered; a closed pipe ends the output
+/// quietly, as [`print_out`] does, and another write error is an error.
+pub struct StdoutStream {
+    out: std::io::BufWriter<std::io::Stdout>,
+    closed: bool,
+}
+
+impl Default for StdoutStream {
+    fn default() -> Self {
+        Self {
+            out: std::io::BufWriter::new(std::io::stdout()),
+            closed: false,
+        }
+    }
+}
+
+impl StdoutStream {
+    fn quiet_if_closed(&mut self, r: std::io::Result<()>) -> std::io::Result<()> {
+        match r {
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+                self.closed = true;
+                Ok(())
+            }
+            other => other,
+        }
+    }
+}
+
+impl std::io::Write for StdoutStream {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if !self.closed {
+            let r = self.out.write_all(buf);
+            self.quiet_if_closed(r)?;
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if self.closed {
+            return Ok(());
+        }
+        let r = self.out.flush();
+        self.quiet_if_closed(r)
+    }
+}

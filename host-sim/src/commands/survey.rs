@@ -6,8 +6,11 @@
 //! job file they may name) and prints. With `--depth`, the capture survey
 //! (`survey_capture`).
 use super::limits::number_in;
+use super::output::StdoutStream;
 use super::site::SiteArgs;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
+use host_sim::formats::files::create_buffered;
+use host_sim::formats::station_csv::file_unit;
 use host_sim::survey::capture::{CaptureSurveyInputs, ProbeSetup};
 use host_sim::survey::iscwsa::Site;
 use host_sim::survey::job::{Job, SurveyJob, WellNames};
@@ -16,8 +19,9 @@ use host_sim::survey::listing::{
     self as listing, drilling, AzimuthReference, KnownModel, LengthUnit, TieOnInput,
 };
 use host_sim::survey::outputs::{listing_text, write_outputs, OutputPaths};
+use host_sim::survey::streamed::{survey_streamed, StreamOutputs};
 use host_sim::survey::well_survey::{
-    read_station_file, ModelChoice, OffsetInputs, SurveyInputs, WellSurvey,
+    read_station_file, ModelChoice, OffsetInputs, SiteFor, SurveyInputs, WellSurvey,
 };
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
@@ -321,6 +325,11 @@ pub fn run(args: Args) -> Result<()> {
         return super::survey_capture::run(&args.capture, &inputs, &outputs, &site_for);
     }
     let units = args.units.map(Units::unit);
+    let whole_survey_outputs = [&args.json, &args.witsml, &args.plot, &args.sep.offset];
+    if whole_survey_outputs.iter().all(|o| o.is_none()) {
+        // the listing and the CSV only: row by row, in constant memory
+        return run_streamed(&args, &resolved, units, &site_for);
+    }
     let file = read_station_file(&args.stations, units)?;
     let inputs = SurveyInputs {
         reference: azimuth_reference(&args)?,
@@ -348,6 +357,39 @@ pub fn run(args: Args) -> Result<()> {
         outln!("wrote {}", f.display());
     }
     Ok(())
+}
+
+/// The survey of a station file of any length, its listing and CSV
+/// written as the stations are read (`survey::streamed`); a CSV left
+/// incomplete by an error is removed.
+fn run_streamed(
+    args: &Args,
+    resolved: &Resolved,
+    units: Option<LengthUnit>,
+    site_for: SiteFor,
+) -> Result<()> {
+    let path = &args.stations;
+    let input = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    let file_unit = file_unit(input, units).with_context(|| format!("{}", path.display()))?;
+    let inputs = SurveyInputs {
+        reference: azimuth_reference(args)?,
+        tie: resolved.tie_on(args, file_unit),
+        vsec_azimuth: args.vsec_azimuth_deg.map(f64::to_radians),
+        model: model_choice(args, resolved),
+        confidence: args.confidence,
+    };
+    let mut listing = StdoutStream::default();
+    let mut csv = args.csv.as_deref().map(create_buffered).transpose()?;
+    let outputs = StreamOutputs {
+        listing: &mut listing,
+        csv: csv.as_mut().map(|w| w as &mut dyn std::io::Write),
+    };
+    let surveyed = survey_streamed(path, units, &inputs, site_for, units, outputs);
+    if let (Err(_), Some(csv)) = (&surveyed, &args.csv) {
+        // no partial file: the error says why
+        let _ = std::fs::remove_file(csv);
+    }
+    surveyed.map(drop)
 }
 
 /// The offset well's options are refused without `--offset`.

@@ -360,8 +360,43 @@ pub fn read_stations<R: Read>(input: R) -> Result<StationFile> {
 /// Reads and checks a station file whose MD column may leave its unit to
 /// `declared` (a header's own unit stands).
 pub fn read_stations_in<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<StationFile> {
-    let mut cols: Option<Columns> = None;
     let mut stations: Vec<InputStation> = Vec::new();
+    let unit = for_each_station(input, declared, |_, s| {
+        stations.push(*s);
+        Ok(())
+    })?;
+    Ok(StationFile { unit, stations })
+}
+
+/// The length unit of a station file, from its header (and its first
+/// station, checked): what a caller needs before the stations.
+pub fn file_unit<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<LengthUnit> {
+    /// Stops the reading at the first station.
+    #[derive(Debug)]
+    struct Found(LengthUnit);
+    impl std::fmt::Display for Found {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "unit found")
+        }
+    }
+    impl std::error::Error for Found {}
+    match for_each_station(input, declared, |unit, _| Err(Found(unit).into())) {
+        Ok(unit) => Ok(unit),
+        Err(e) => e.downcast_ref::<Found>().map(|f| f.0).ok_or(e),
+    }
+}
+
+/// Reads and checks a station file one station at a time, as
+/// [`read_stations_in`] does, handing each to `take` with the file's
+/// length unit; returns that unit. Holds one station, whatever the file's
+/// length.
+pub fn for_each_station<R: Read>(
+    input: R,
+    declared: Option<LengthUnit>,
+    mut take: impl FnMut(LengthUnit, &InputStation) -> Result<()>,
+) -> Result<LengthUnit> {
+    let mut cols: Option<Columns> = None;
+    let mut previous: Option<InputStation> = None;
     for_each_record_tab_aware(input, |line, fields| {
         let Some(c) = &cols else {
             cols = Some(columns(fields, line, declared)?);
@@ -383,7 +418,7 @@ pub fn read_stations_in<R: Read>(input: R, declared: Option<LengthUnit>) -> Resu
         if !(0.0..=180.0).contains(&s.inc_deg) {
             bail!("line {line}: inclination {} deg outside 0..180", s.inc_deg);
         }
-        if let Some(prev) = stations.last() {
+        if let Some(prev) = previous {
             if s.md <= prev.md {
                 bail!(
                     "line {line}: MD {} is not beyond the previous station's {} (MD must increase)",
@@ -392,21 +427,18 @@ pub fn read_stations_in<R: Read>(input: R, declared: Option<LengthUnit>) -> Resu
                 );
             }
         }
-        stations.push(s);
-        Ok(())
+        previous = Some(s);
+        take(c.unit, &s)
     })?;
     let Some(c) = cols else {
         bail!(
             "the file is empty: expected a header (md_m or md_ft, inc_deg, azi_deg) and stations"
         );
     };
-    if stations.is_empty() {
+    if previous.is_none() {
         bail!("no stations after the header");
     }
-    Ok(StationFile {
-        unit: c.unit,
-        stations,
-    })
+    Ok(c.unit)
 }
 
 #[cfg(test)]

@@ -14,6 +14,8 @@
 //! - [`well_survey`]: a station file's survey as `host-sim survey` makes
 //!   it (positions, the model's covariance, an offset well's separation).
 //! - [`outputs`]: that survey's listing, CSV, JSON, WITSML and figures.
+//! - [`streamed`]: a station file of any length surveyed in constant
+//!   memory, its listing and CSV written row by row.
 //! - [`capture`]: the survey of a drilling capture with its depth log.
 //! - [`simulated`]: a simulated drilling run surveyed end to end and
 //!   checked against its truth (`host-sim drill`).
@@ -28,4 +30,5 @@ pub mod listing;
 pub mod outputs;
 pub mod simulated;
 pub mod stations;
+pub mod streamed;
 pub mod well_survey;

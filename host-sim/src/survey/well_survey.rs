@@ -191,14 +191,11 @@ impl WellSurvey {
     /// Where the model stops being valid, as a sentence.
     pub fn validity_note(&self) -> Option<String> {
         let (m, inv) = (self.model?, self.invalid_from.as_ref()?);
-        let u = self.output_unit;
-        Some(format!(
-            "{} {}: no uncertainty from MD {:.2} {} (station {}) on, not extrapolated",
-            m.name,
-            inv.reason,
-            u.from_m(self.rows[inv.station].md_m),
-            u.symbol(),
-            inv.station
+        Some(validity_note(
+            m,
+            inv,
+            self.rows[inv.station].md_m,
+            self.output_unit,
         ))
     }
 
@@ -252,6 +249,19 @@ impl WellSurvey {
         }
         out
     }
+}
+
+/// Where model `m` stops being valid (`invalid`, at MD `md_m`), as a
+/// sentence in `unit`.
+pub fn validity_note(m: &KnownModel, invalid: &Invalid, md_m: f64, unit: LengthUnit) -> String {
+    format!(
+        "{} {}: no uncertainty from MD {:.2} {} (station {}) on, not extrapolated",
+        m.name,
+        invalid.reason,
+        unit.from_m(md_m),
+        unit.symbol(),
+        invalid.station
+    )
 }
 
 /// A station's separation as one word: ok, violation (SF < 1) or

@@ -19,7 +19,7 @@ pub use min_curvature::{
     dogleg, dogleg_severity_deg_per_100ft, dogleg_severity_deg_per_30m, ratio_factor, tangent,
     Segment, SERIES_THRESHOLD,
 };
-pub use path::{interpolate, positions, Positions, SurveyPoint, TieOn};
+pub use path::{interpolate, positions, Positions, SurveyPoint, TieOn, Walker};
 pub use reference::{GridConvergence, GridNorth, NorthReference, TrueNorth};
 pub use station::{GridStation, Station, TrueStation};
 

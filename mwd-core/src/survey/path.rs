@@ -136,8 +136,7 @@ pub fn positions<'a, N: NorthReference>(
     stations: &'a [Station<N>],
 ) -> Positions<'a, N> {
     Positions {
-        md: tie_on.md,
-        nev: tie_on.nev,
+        walker: Walker::new(tie_on),
         stations,
         index: 0,
         failed: false,
@@ -180,42 +179,68 @@ pub fn interpolate<N: NorthReference>(
     Err(SurveyError::InterpolationDepth)
 }
 
-/// The iterator of [`positions`].
+/// Minimum curvature one station at a time: the positions of a survey
+/// whose stations arrive as a stream (a file of a million stations, read
+/// once), holding only the last station. [`positions`] walks a slice with
+/// it.
 #[derive(Clone, Debug)]
-pub struct Positions<'a, N: NorthReference> {
+pub struct Walker<N: NorthReference> {
     md: f64,
     nev: Vector3<f64>,
-    stations: &'a [Station<N>],
+    previous: Option<Station<N>>,
+    /// Index of the next station (in the errors).
     index: usize,
-    failed: bool,
 }
 
-impl<N: NorthReference> Positions<'_, N> {
-    fn step(&mut self) -> Result<SurveyPoint<N>, SurveyError> {
-        let station = self.stations[self.index];
-        if self.index == 0 {
+impl<N: NorthReference> Walker<N> {
+    /// Starts at `tie_on`: the first station must be at its MD.
+    pub fn new(tie_on: &TieOn<N>) -> Self {
+        Self {
+            md: tie_on.md,
+            nev: tie_on.nev,
+            previous: None,
+            index: 0,
+        }
+    }
+
+    /// The next station's position; MD must strictly increase.
+    pub fn step(&mut self, station: Station<N>) -> Result<SurveyPoint<N>, SurveyError> {
+        let index = self.index;
+        let Some(previous) = self.previous else {
             if station.md() != self.md {
                 return Err(SurveyError::TieOnDepth);
             }
+            self.previous = Some(station);
+            self.index += 1;
             return Ok(SurveyPoint {
                 station,
                 nev: self.nev,
                 dls_deg_per_30m: 0.0,
             });
-        }
-        let index = self.index;
-        let segment = Segment::new(self.stations[index - 1], station).map_err(|e| match e {
+        };
+        let segment = Segment::new(previous, station).map_err(|e| match e {
             SurveyError::DepthNotIncreasing { .. } => SurveyError::DepthNotIncreasing { index },
             SurveyError::OppositeDirections { .. } => SurveyError::OppositeDirections { index },
             other => other,
         })?;
         self.nev += segment.increment();
+        self.previous = Some(station);
+        self.index += 1;
         Ok(SurveyPoint {
             station,
             nev: self.nev,
             dls_deg_per_30m: segment.dogleg_severity_deg_per_30m(),
         })
     }
+}
+
+/// The iterator of [`positions`].
+#[derive(Clone, Debug)]
+pub struct Positions<'a, N: NorthReference> {
+    walker: Walker<N>,
+    stations: &'a [Station<N>],
+    index: usize,
+    failed: bool,
 }
 
 impl<N: NorthReference> Iterator for Positions<'_, N> {
@@ -225,7 +250,7 @@ impl<N: NorthReference> Iterator for Positions<'_, N> {
         if self.failed || self.index >= self.stations.len() {
             return None;
         }
-        let item = self.step();
+        let item = self.walker.step(self.stations[self.index]);
         self.failed = item.is_err();
         self.index += 1;
         Some(item)

@@ -308,8 +308,8 @@ impl<'a> Propagator<'a> {
         for src in &mut self.sources {
             // `implemented` said the name is known: a station cannot change
             // that (the dispatch is by name)
-            let (interior, last) = error_vector(src.term, &w, trig, &leg, site, opts)
-                .unwrap_or(([0.0; 3], [0.0; 3]));
+            let (interior, last) =
+                error_vector(src.term, &w, trig, &leg, site, opts).unwrap_or(([0.0; 3], [0.0; 3]));
             let c = if src.random {
                 let c = outer(last);
                 let c: Cov6 = std::array::from_fn(|j| src.sum[j] + c[j]);

@@ -57,7 +57,7 @@ fn probe_gyro_errors(terms: &[ErrorTerm]) -> iscwsa::probe_weighting::GyroErrors
 impl Validity {
     /// Why the model (of these terms, at this site) is not valid at this
     /// row, or `None`.
-    fn check(&self, row: &Row, terms: &[ErrorTerm], site: &Site) -> Option<String> {
+    pub fn check(&self, row: &Row, terms: &[ErrorTerm], site: &Site) -> Option<String> {
         match *self {
             Self::MaxInclination(max) => {
                 (row.inc_deg > max).then(|| format!("is stated for inclinations up to {max} deg"))

@@ -25,4 +25,7 @@ pub use error_models::{
     apply_model, file_validity, model, model_from_file, terms, Invalid, KnownModel, Validity,
     MODELS,
 };
-pub use positions::{compute, plus_tie_on, tie_on_note, AzimuthReference, Row, TieOnInput};
+pub use positions::{
+    closure_azimuth, compute, plus_tie_on, row, tie_on_m, tie_on_note, true_station,
+    AzimuthReference, Row, TieOnInput,
+};

@@ -7,7 +7,7 @@ use super::ellipse::Ellipse;
 use crate::formats::station_csv::{InputStation, LengthUnit, StationFile};
 use crate::survey::iscwsa::{self, Cov6};
 use anyhow::{anyhow, bail, Context, Result};
-use mwd_core::survey::{positions, GridConvergence, Station, TieOn, TrueNorth};
+use mwd_core::survey::{positions, GridConvergence, Station, SurveyPoint, TieOn, TrueNorth};
 use nalgebra::Matrix3;
 
 /// North reference of the file's azimuths.
@@ -111,6 +111,77 @@ impl Row {
     }
 }
 
+/// A station of a file in `unit` as minimum curvature takes it: MD in
+/// metres, angles in radians, azimuth from true north.
+pub fn true_station(
+    s: &InputStation,
+    unit: LengthUnit,
+    reference: AzimuthReference,
+) -> Result<Station<TrueNorth>> {
+    let azi = s.azi_deg.to_radians();
+    let azi = match reference {
+        AzimuthReference::True => azi,
+        AzimuthReference::Grid(c) => GridConvergence::new(c)
+            .map_err(|e| anyhow!("convergence: {e:?}"))?
+            .true_azimuth(azi),
+    };
+    Station::<TrueNorth>::new(s.md * unit.to_m(), s.inc_deg.to_radians(), azi)
+        .map_err(|e| anyhow!("station at MD {}: {e:?}", s.md))
+}
+
+/// The tie-on of a file in `unit` whose first station is at MD
+/// `first_md` (the file's unit), in metres.
+pub fn tie_on_m(tie: &TieOnInput, unit: LengthUnit, first_md: f64) -> Result<TieOn<TrueNorth>> {
+    let k = unit.to_m();
+    if let Some(md) = tie.md {
+        if md != first_md {
+            bail!(
+                "the tie-on MD {md} is not the first station's MD {first_md}: the first station is the tie-on"
+            );
+        }
+    }
+    let tie_cov = tie.covariance_m2(unit).map_or_else(Matrix3::zeros, |c| {
+        Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2])
+    });
+    TieOn::<TrueNorth>::new(
+        first_md * k,
+        tie.tvd * k,
+        tie.north * k,
+        tie.east * k,
+        tie_cov,
+    )
+    .map_err(|e| anyhow!("tie-on: {e:?}"))
+}
+
+/// A station's row: its position and dogleg severity from minimum
+/// curvature, its vertical section along `direction` (rad); no covariance
+/// yet.
+pub fn row(input: &InputStation, p: &SurveyPoint<TrueNorth>, direction: f64) -> Row {
+    Row {
+        input: *input,
+        md_m: p.station.md(),
+        inc_deg: p.station.inclination().to_degrees(),
+        azi_deg: p.station.azimuth().to_degrees(),
+        tvd_m: p.tvd(),
+        north_m: p.north(),
+        east_m: p.east(),
+        dls_deg_per_30m: p.dls_deg_per_30m,
+        vsec_m: p.vertical_section(direction),
+        cov: None,
+    }
+}
+
+/// The azimuth (rad, in [0, 2 pi)) of a point from the origin of north
+/// and east: the default vertical-section direction; 0 at the origin.
+pub fn closure_azimuth(p: &SurveyPoint<TrueNorth>) -> f64 {
+    let (n, e) = (p.north(), p.east());
+    if n == 0.0 && e == 0.0 {
+        0.0
+    } else {
+        e.atan2(n).rem_euclid(std::f64::consts::TAU)
+    }
+}
+
 /// Positions by minimum curvature from the tie-on (true north), with the
 /// vertical section (from the origin of north and east) along
 /// `vsec_azimuth` (rad; `None`: the closure azimuth of the last station
@@ -121,65 +192,22 @@ pub fn compute(
     tie: TieOnInput,
     vsec_azimuth: Option<f64>,
 ) -> Result<(Vec<Row>, f64)> {
-    let k = file.unit.to_m();
-    let first = file.stations[0].md;
-    if let Some(md) = tie.md {
-        if md != first {
-            bail!(
-                "the tie-on MD {md} is not the first station's MD {first}: the first station is the tie-on"
-            );
-        }
-    }
-    let tie_cov = tie
-        .covariance_m2(file.unit)
-        .map_or_else(Matrix3::zeros, |c| {
-            Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2])
-        });
-    let tie_on =
-        TieOn::<TrueNorth>::new(first * k, tie.tvd * k, tie.north * k, tie.east * k, tie_cov)
-            .map_err(|e| anyhow!("tie-on: {e:?}"))?;
+    let first = file.stations.first().context("no stations")?;
+    let tie_on = tie_on_m(&tie, file.unit, first.md)?;
     let stations = file
         .stations
         .iter()
-        .map(|s| {
-            let azi = s.azi_deg.to_radians();
-            let azi = match reference {
-                AzimuthReference::True => azi,
-                AzimuthReference::Grid(c) => GridConvergence::new(c)
-                    .map_err(|e| anyhow!("convergence: {e:?}"))?
-                    .true_azimuth(azi),
-            };
-            Station::<TrueNorth>::new(s.md * k, s.inc_deg.to_radians(), azi)
-                .map_err(|e| anyhow!("station at MD {}: {e:?}", s.md))
-        })
+        .map(|s| true_station(s, file.unit, reference))
         .collect::<Result<Vec<_>>>()?;
     let points = positions(&tie_on, &stations)
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| anyhow!("minimum curvature: {e:?}"))?;
     let last = points.last().context("no stations")?;
-    let direction = vsec_azimuth.unwrap_or_else(|| {
-        let (n, e) = (last.north(), last.east());
-        if n == 0.0 && e == 0.0 {
-            0.0
-        } else {
-            e.atan2(n).rem_euclid(std::f64::consts::TAU)
-        }
-    });
+    let direction = vsec_azimuth.unwrap_or_else(|| closure_azimuth(last));
     let rows = points
         .iter()
         .zip(&file.stations)
-        .map(|(p, input)| Row {
-            input: *input,
-            md_m: p.station.md(),
-            inc_deg: p.station.inclination().to_degrees(),
-            azi_deg: p.station.azimuth().to_degrees(),
-            tvd_m: p.tvd(),
-            north_m: p.north(),
-            east_m: p.east(),
-            dls_deg_per_30m: p.dls_deg_per_30m,
-            vsec_m: p.vertical_section(direction),
-            cov: None,
-        })
+        .map(|(p, input)| row(input, p, direction))
         .collect();
     Ok((rows, direction))
 }

@@ -3,15 +3,15 @@
 //! 1.4.1.1 trajectory, and the plan and section figures. Lengths in
 //! metres, azimuths along true north, whatever the input.
 
-use crate::survey::listing::ellipse::scale_2d;
 use crate::survey::listing::separation as sep;
 use crate::survey::listing::{plot, tie_on_note};
 use crate::survey::well_survey::{sf_status, WellSurvey};
 use anyhow::Result;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod table;
 mod witsml;
+pub use table::{csv_head, csv_row, csv_text, listing_head, listing_row, listing_text, Head};
 pub use witsml::witsml_text;
 
 /// Where the outputs go (each one only when given).
@@ -53,184 +53,6 @@ pub fn write_outputs(s: &WellSurvey, paths: &OutputPaths, well: &str) -> Result<
             .map(|o| (o.short_name.as_str(), o.rows.as_slice())),
     };
     figures.write(dir)
-}
-
-/// The listing: a header line, the model's and the ellipse's, a table of
-/// the stations (with their sigmas and ellipse with a model, their
-/// separation with an offset well), the model's validity note and the
-/// separation summary.
-pub fn listing_text(s: &WellSurvey) -> String {
-    let u = s.output_unit;
-    let sym = u.symbol();
-    let mut text = String::new();
-    let _ = writeln!(
-        text,
-        "{} stations; lengths in {sym}, N/E along true north; DLS in deg/{}; vertical section along {:.2} deg",
-        s.rows.len(),
-        u.dls_course().1,
-        s.vsec_azimuth_deg
-    );
-    if let Some(m) = s.model {
-        let _ = writeln!(
-            text,
-            "error model {}; ellipse at {:.1} % (2-D normal, k = {:.4} x 1-sigma)",
-            m.name,
-            100.0 * s.confidence,
-            scale_2d(s.confidence)
-        );
-        let _ = writeln!(text, "{}", tie_on_note(s.tie_on_cov_m2.as_ref(), u));
-    }
-    let unit = |name: &str| format!("{name} {sym}");
-    let mut head = format!(
-        "{:>9} {:>7} {:>7} {:>9} {:>9} {:>9} {:>6} {:>9}",
-        unit("MD"),
-        "inc",
-        "azi",
-        unit("TVD"),
-        unit("N"),
-        unit("E"),
-        "DLS",
-        unit("VS")
-    );
-    if s.model.is_some() {
-        head += &format!(
-            " {:>7} {:>7} {:>7} {:>8} {:>8} {:>6}",
-            unit("sN"),
-            unit("sE"),
-            unit("sV"),
-            unit("major"),
-            unit("minor"),
-            "az"
-        );
-    }
-    if s.offset.is_some() {
-        head += &format!(" {:>9} {:>7} {:>8}", unit("ctc"), unit("sS"), "SF");
-    }
-    let _ = writeln!(text, "{head}");
-    let len = |m: f64| u.from_m(m);
-    for (k, r) in s.rows.iter().enumerate() {
-        let mut line = format!(
-            "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
-            len(r.md_m),
-            r.inc_deg,
-            r.azi_deg,
-            len(r.tvd_m),
-            len(r.north_m),
-            len(r.east_m),
-            u.dls_from_per_30m(r.dls_deg_per_30m),
-            len(r.vsec_m)
-        );
-        if s.model.is_some() {
-            match (r.cov, r.ellipse()) {
-                (Some(c), Some(e)) => {
-                    let (a, b) = e.scaled(s.confidence);
-                    let _ = write!(
-                        line,
-                        " {:>7.2} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>6.1}",
-                        len(c[0].max(0.0).sqrt()),
-                        len(c[1].max(0.0).sqrt()),
-                        len(e.sigma_vert),
-                        len(a),
-                        len(b),
-                        e.azimuth_deg
-                    );
-                }
-                _ => line += "  (outside the model's validity)",
-            }
-        }
-        if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
-            let _ = write!(line, " {:>9.2}", len(x.ctc_m));
-            match (x.sigma_s_m, x.sf) {
-                (Some(sig), Some(f)) => {
-                    let flag = if f < 1.0 { " SF<1" } else { "" };
-                    let _ = write!(line, " {:>7.2} {f:>8.3}{flag}", len(sig));
-                }
-                _ => line += "  SF undetermined",
-            }
-        }
-        let _ = writeln!(text, "{line}");
-    }
-    if let Some(note) = s.validity_note() {
-        let _ = writeln!(text, "note: {note}");
-    }
-    for l in s.separation_summary() {
-        let _ = writeln!(text, "{l}");
-    }
-    text
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map_or_else(String::new, |v| v.to_string())
-}
-
-pub fn csv_text(s: &WellSurvey) -> String {
-    let u = s.output_unit;
-    let sym = u.symbol();
-    let len = |m: f64| u.from_m(m);
-    let mut out = format!(
-        "md_{sym},inc_deg,azi_deg,tvd_{sym},north_{sym},east_{sym},dls_deg_per_{},vsec_{sym},toolface_deg,time_s",
-        u.dls_course().1
-    );
-    if s.model.is_some() {
-        let _ = write!(
-            out,
-            ",sigma_north_{sym},sigma_east_{sym},sigma_vert_{sym},ellipse_semi_major_{sym},ellipse_semi_minor_{sym},ellipse_azimuth_deg,confidence,error_model_valid"
-        );
-    }
-    if s.offset.is_some() {
-        let _ = write!(out, ",offset_md_{sym},ctc_{sym},sigma_s_{sym},sf,sf_status");
-    }
-    out += "\n";
-    for (k, r) in s.rows.iter().enumerate() {
-        let _ = write!(
-            out,
-            "{},{},{},{},{},{},{},{},{},{}",
-            len(r.md_m),
-            r.inc_deg,
-            r.azi_deg,
-            len(r.tvd_m),
-            len(r.north_m),
-            len(r.east_m),
-            u.dls_from_per_30m(r.dls_deg_per_30m),
-            len(r.vsec_m),
-            opt(r.input.toolface_deg),
-            opt(r.input.time_s)
-        );
-        if s.model.is_some() {
-            match (r.cov, r.ellipse()) {
-                (Some(c), Some(e)) => {
-                    let (a, b) = e.scaled(s.confidence);
-                    let _ = write!(
-                        out,
-                        ",{},{},{},{},{},{},{},true",
-                        len(c[0].max(0.0).sqrt()),
-                        len(c[1].max(0.0).sqrt()),
-                        len(e.sigma_vert),
-                        len(a),
-                        len(b),
-                        e.azimuth_deg,
-                        s.confidence
-                    );
-                }
-                _ => {
-                    let _ = write!(out, ",,,,,,,{},false", s.confidence);
-                }
-            }
-        }
-        if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
-            let _ = write!(
-                out,
-                ",{},{},{},{},{}",
-                len(x.closest.md_m),
-                len(x.ctc_m),
-                opt(x.sigma_s_m.map(len)),
-                opt(x.sf),
-                sf_status(x)
-            );
-        }
-        out += "\n";
-    }
-    out
 }
 
 /// One station of the JSON: position, and with a model its covariance and
