@@ -6,7 +6,8 @@
 # ended, and checks the DOM against `host-sim decode` of the same capture:
 # mode, an inclination with its sigma, the undetermined azimuth shown as
 # the word (never a number), the frame counters, the stations, the page's
-# bounded arrays. Then it saves a screenshot.
+# bounded arrays; that the page's token is what commands need (curl). Then
+# it saves a screenshot.
 #   scripts/dashboard-browser-test.sh [path/to/host-sim]
 # (default: builds target/debug/host-sim). Screenshot:
 # $DASHBOARD_SCREENSHOT, default target/dashboard.png.
@@ -100,6 +101,19 @@ check "$undetermined_stations station azimuths shown as undetermined, none as a 
   "$(is "$(echo "$rows" | grep -c '>undetermined<')" "$undetermined_stations")"
 check "the page holds every sample, within its bound ($(cell held))" \
   "$(cell held | grep -q "^$raw samples, $raw solutions (at most 12000)" && echo yes || echo no)"
+
+# The page holds this run's token; commands need it, and another site's
+# name (DNS rebinding) gets nothing.
+token="$(sed -n 's/.*<meta name="probe-token" content="\([0-9a-f]*\)".*/\1/p' "$work/dom.html" | head -1)"
+check "the page holds a 64-digit token" "$(is "${#token}" 64)"
+status() { curl -s -o /dev/null -w '%{http_code}' "$@"; }
+check "a command without the token is refused (403)" "$(is "$(status -X POST "${url}api/align")" 403)"
+check "a command with a wrong token is refused (403)" \
+  "$(is "$(status -X POST -H "X-Probe-Token: ${token//?/0}" "${url}api/align")" 403)"
+check "the page's command gets past the token (409: replaying, nothing to command)" \
+  "$(is "$(status -X POST -H "X-Probe-Token: $token" "${url}api/align")" 409)"
+check "another site's name gets nothing (421)" \
+  "$(is "$(status -H 'Host: attacker.example' "$url")" 421)"
 
 mkdir -p "$(dirname "$screenshot")"
 rm -f "$screenshot"

@@ -17,6 +17,10 @@ let dirty = true;
 
 const $ = (id) => document.getElementById(id);
 
+// This run's access token, which the server put in the page: commands
+// carry it in a header, the event stream in its address.
+const token = document.querySelector('meta[name="probe-token"]').content;
+
 function setText(id, text) {
   const el = $(id);
   if (el && el.textContent !== String(text)) el.textContent = String(text);
@@ -195,8 +199,8 @@ $("window").addEventListener("change", (e) => { view = e.target.value; dirty = t
 async function command(path) {
   setText("command-response", "sending...");
   try {
-    // The header tells the server the request comes from this page.
-    const r = await fetch(path, { method: "POST", headers: { "X-MWD-Dashboard": "1" } });
+    // The token tells the server the request comes from this page.
+    const r = await fetch(path, { method: "POST", headers: { "X-Probe-Token": token } });
     setText("command-response", r.ok ? "sent: the probe's reply shows below" : await r.text());
   } catch (e) {
     setText("command-response", "not sent: " + e);
@@ -210,7 +214,7 @@ $("cmd-index").onclick = () =>
 
 // --- the stream -----------------------------------------------------------
 
-const stream = new EventSource("/events");
+const stream = new EventSource("/events?token=" + encodeURIComponent(token));
 stream.onopen = () => setText("connection", "connected");
 stream.onerror = () => setText("connection", "reconnecting...");
 stream.onmessage = (m) => {

@@ -11,10 +11,15 @@
 //!   or a capture replayed at a chosen pace; the probe's commands.
 //! - [`state`]: what the page shows, in bounded buffers, and its updates.
 //! - [`view`], [`stations`]: frames and stations as people read them.
-//! - [`server`]: the page (uPlot embedded) and server-sent events.
+//! - [`server`]: the page (uPlot embedded) and server-sent events, over
+//!   [`connection`]s with a deadline.
+//! - [`access`]: who may read and command: the Host, the Origin, the
+//!   run's token.
 //! - [`launch`]: a dashboard started from its source, with the calibration
 //!   in use as the page shows it.
 
+pub mod access;
+pub mod connection;
 pub mod launch;
 pub mod ring;
 pub mod server;
