@@ -147,6 +147,65 @@ fn with_a_depth_log_the_stations_get_positions_with_their_sigma() {
 }
 
 #[test]
+fn with_a_job_plan_the_stations_are_drawn_against_it_with_their_ellipses() {
+    let dir = common::scratch("dashboard", "plan");
+    let (capture, depth, job) = common::simulate_tied_in(&dir);
+    // The tied-in job, with the plan the run drilled.
+    let text = std::fs::read_to_string(&job).unwrap();
+    let plan = common::plan("qemu-short.json");
+    let with_plan = text.replacen(
+        "\"site\"",
+        &format!("\"plan\": {:?},\n  \"site\"", plan.to_str().unwrap()),
+        1,
+    );
+    std::fs::write(&job, with_plan).unwrap();
+    let d = start(&[
+        "--file",
+        common::s(&capture),
+        "--speed",
+        "1000",
+        "--depth",
+        common::s(&depth),
+        "--job",
+        common::s(&job),
+    ]);
+    follow(&d.addr, None, |u| u["rest"]["finished"] == true);
+    // A new page's snapshot, with everything.
+    let (_, last) = follow(&d.addr, None, |_| true);
+    let stations = &last["rest"]["stations"];
+    let placed = stations["plan"].as_array().unwrap().len();
+    assert!(placed >= 2, "{stations}");
+    // Every station placed has its ellipse in both views (its covariance
+    // is valid), 2-sigma as the survey figures draw them.
+    assert_eq!(stations["plan_ellipses"].as_array().unwrap().len(), placed);
+    assert_eq!(
+        stations["section_ellipses"].as_array().unwrap().len(),
+        placed
+    );
+    assert_eq!(stations["ellipse_sigma"], 2.0);
+    // The plan from its tie-on (N 420, E 310, TVD 2450) in both views; the
+    // section along the azimuth to the plan's end.
+    let well_plan = &stations["well_plan"];
+    let plan_view = well_plan["plan"].as_array().unwrap();
+    assert_eq!(plan_view.len(), 401);
+    assert_eq!(plan_view[0], serde_json::json!([310.0, 420.0]));
+    let section = well_plan["section"].as_array().unwrap();
+    assert_eq!(section[0][1], 2450.0);
+    let [n, e] = [
+        plan_view[400][1].as_f64().unwrap(),
+        plan_view[400][0].as_f64().unwrap(),
+    ];
+    let azimuth = stations["section_azimuth_deg"].as_f64().unwrap();
+    assert!(
+        (azimuth - e.atan2(n).to_degrees()).abs() < 1e-9,
+        "{azimuth}"
+    );
+    // The first station sits on the plan's tie-on.
+    assert_eq!(stations["plan"][0], plan_view[0]);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
 fn bad_inputs_are_refused_before_serving() {
     let dir = common::scratch("dashboard", "bad");
     let not_capture = dir.join("notes.bin");

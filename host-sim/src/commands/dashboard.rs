@@ -7,7 +7,7 @@ use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 
 use anyhow::Result;
-use host_sim::dashboard::launch::{calibration_lines, start, Source};
+use host_sim::dashboard::launch::{calibration_lines, start, well_plan_path, Source};
 use host_sim::dashboard::server;
 use host_sim::dashboard::state::SourceInfo;
 use host_sim::formats::files::read_depth_log;
@@ -44,7 +44,9 @@ pub struct Args {
     pub depth: Option<PathBuf>,
     /// The job file the page's "configure" button sends (site, tie-in,
     /// calibration: `host-sim probe configure`); its calibration is shown
-    /// as the one in use.
+    /// as the one in use, its survey tie-on places the stations, and its
+    /// well plan (`plan`) is drawn under them in the plan view and the
+    /// vertical section.
     #[arg(long, value_name = "JOB.json")]
     pub job: Option<PathBuf>,
     /// Address to serve on (default: this machine only). On a loopback
@@ -103,6 +105,7 @@ pub fn run(args: Args) -> Result<()> {
         job: args.job.as_ref().map(|p| p.display().to_string()),
         depth,
         survey: SurveySetup::probe(job_tie_on(job.as_ref()), latitude_deg.to_radians())?,
+        well_plan: well_plan_path(job.as_ref())?,
     };
     let source = match (&args.port, &args.file) {
         (Some(port), _) => Source::Port {
