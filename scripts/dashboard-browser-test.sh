@@ -41,16 +41,21 @@ trap cleanup EXIT
   || { cat "$work/simulate.err"; exit 1; }
 "$bin" decode "$work/run.bin" >"$work/decode.txt"
 
-"$bin" dashboard --file "$work/run.bin" --speed 100 --depth "$work/depth.csv" \
-  --http-port 0 >"$work/server.out" 2>&1 &
-server=$!
-url=""
-for _ in $(seq 100); do
-  url="$(grep -o 'http://[^ ]*' "$work/server.out" || true)"
-  [ -n "$url" ] && break
-  sleep 0.1
-done
-[ -n "$url" ] || { echo "the dashboard did not start:"; cat "$work/server.out"; exit 1; }
+# Serves a capture (the arguments after the dashboard's) on a free port,
+# stopping the one served before: sets $server and $url.
+serve() {
+  if [ -n "$server" ]; then kill "$server" 2>/dev/null || true; fi
+  "$bin" dashboard "$@" --http-port 0 >"$work/server.out" 2>&1 &
+  server=$!
+  url=""
+  for _ in $(seq 100); do
+    url="$(grep -o 'http://[^ ]*' "$work/server.out" || true)"
+    [ -n "$url" ] && break
+    sleep 0.1
+  done
+  [ -n "$url" ] || { echo "the dashboard did not start:"; cat "$work/server.out"; exit 1; }
+}
+serve --file "$work/run.bin" --speed 100 --depth "$work/depth.csv"
 
 browse() {
   # The page closes its event stream once the replay has ended; until then
@@ -133,17 +138,7 @@ EOF
 "$bin" simulate --motion lateral --plan host-sim/data/plans/qemu-short.json --seed 3 \
   -o "$work/tied.bin" --depth-log "$work/tied.csv" --tie-in-job "$work/job.json" \
   >/dev/null 2>"$work/simulate.err" || { cat "$work/simulate.err"; exit 1; }
-kill "$server" 2>/dev/null || true
-"$bin" dashboard --file "$work/tied.bin" --speed 100 --depth "$work/tied.csv" \
-  --job "$work/job.json" --http-port 0 >"$work/server.out" 2>&1 &
-server=$!
-url=""
-for _ in $(seq 100); do
-  url="$(grep -o 'http://[^ ]*' "$work/server.out" || true)"
-  [ -n "$url" ] && break
-  sleep 0.1
-done
-[ -n "$url" ] || { echo "the dashboard did not start:"; cat "$work/server.out"; exit 1; }
+serve --file "$work/tied.bin" --speed 100 --depth "$work/tied.csv" --job "$work/job.json"
 browse --dump-dom >"$work/well.html" || { echo "chromium failed:"; tail -20 "$work/chromium.err"; exit 1; }
 # The drawing inside the svg with this id; how many of an element it has.
 svg() { sed -n "s/.*\(<svg id=\"$1\".*\)/\1/p" "$work/well.html" | sed 's#</svg>.*##'; }

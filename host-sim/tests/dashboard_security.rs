@@ -19,10 +19,7 @@ use dashboard_common::{raw_request, request, start, start_any};
 
 /// A simulated capture of 5 s (nothing to command: only reads).
 fn capture(dir: &std::path::Path) -> std::path::PathBuf {
-    let out = dir.join("run.bin");
-    let run = common::run(&["simulate", "--duration", "5", "-o", common::s(&out)]);
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
-    out
+    dashboard_common::simulated_capture(dir, 5)
 }
 
 #[test]

@@ -12,20 +12,13 @@ mod dashboard_common;
 
 use std::path::Path;
 
-use dashboard_common::{follow, raw_request, request, start};
+use dashboard_common::{follow, raw_request, request, simulated_capture, start};
 use serde_json::Value;
-
-fn simulated_capture(dir: &Path) -> std::path::PathBuf {
-    let out = dir.join("run.bin");
-    let run = common::run(&["simulate", "--duration", "30", "-o", out.to_str().unwrap()]);
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
-    out
-}
 
 #[test]
 fn a_replayed_capture_streams_to_its_end_and_a_reconnect_resumes() {
     let dir = common::scratch("dashboard", "replay");
-    let capture = simulated_capture(&dir);
+    let capture = simulated_capture(&dir, 30);
     let d = start(&["--file", capture.to_str().unwrap(), "--speed", "200"]);
 
     let (status, page) = request(&d, "GET", "/");
@@ -217,7 +210,7 @@ fn bad_inputs_are_refused_before_serving() {
         "{}",
         run.stderr
     );
-    let capture = simulated_capture(&dir);
+    let capture = simulated_capture(&dir, 30);
     let run = common::run(&[
         "dashboard",
         "--file",

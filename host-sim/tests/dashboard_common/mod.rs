@@ -1,14 +1,29 @@
-//! What the dashboard's test files share: the binary serving on a free
-//! port, HTTP requests as raw text (so that any Host, Origin or token can
+//! What the dashboard's test files share (with `common`, which each
+//! declares too): a capture, the binary serving it on a free port, HTTP requests as raw text (so that any Host, Origin or token can
 //! be sent), the event stream followed, and a stand-in probe on a pty.
 #![allow(dead_code)] // each test file uses its own part of it
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use serde_json::Value;
+
+/// A capture of `seconds` simulated by `host-sim simulate` in `dir`.
+pub fn simulated_capture(dir: &Path, seconds: u32) -> PathBuf {
+    let out = dir.join("run.bin");
+    let run = crate::common::run(&[
+        "simulate",
+        "--duration",
+        &seconds.to_string(),
+        "-o",
+        crate::common::s(&out),
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    out
+}
 
 /// A running dashboard, killed when dropped.
 pub struct Dashboard {
