@@ -3,8 +3,8 @@
 //! foreign Host (DNS rebinding), another site's Origin, and a command
 //! without the page's token or with a wrong one, and none of them reaches
 //! the probe; the page's own command does. A half-sent request is cut off;
-//! a non-loopback address needs --allow-remote, and then every read needs
-//! the token.
+//! connections beyond the cap are closed; a non-loopback address needs
+//! --allow-remote, and then every read needs the token.
 #![cfg(feature = "dashboard")]
 
 mod common;
@@ -90,6 +90,50 @@ fn a_request_half_sent_is_closed() {
     // The server still serves the next one.
     let (status, _) = request(&d, "GET", "/");
     assert_eq!(status, 200);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn connections_beyond_the_cap_are_closed_and_served_again_once_freed() {
+    let dir = common::scratch("dashboard-security", "cap");
+    let capture = capture(&dir);
+    let d = start(&["--file", common::s(&capture), "--speed", "1"]);
+    // The server's cap (dashboard::server::MAX_CONNECTIONS), held open.
+    let held: Vec<TcpStream> = (0..32)
+        .map(|_| TcpStream::connect(&d.addr).unwrap())
+        .collect();
+    let mut extra = TcpStream::connect(&d.addr).unwrap();
+    extra
+        .set_read_timeout(Some(Duration::from_secs(60)))
+        .unwrap();
+    // Closed at once: the request may not even be written.
+    let _ = write!(extra, "GET / HTTP/1.0\r\nHost: {}\r\n\r\n", d.addr);
+    let mut answer = Vec::new();
+    let outcome = extra.read_to_end(&mut answer);
+    let closed = match &outcome {
+        Ok(_) => true,
+        Err(e) => !matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut),
+    };
+    assert!(
+        closed && answer.is_empty(),
+        "{outcome:?}: {}",
+        String::from_utf8_lossy(&answer)
+    );
+    drop(held);
+    // Freed as the held ones close: served again.
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let mut probe = TcpStream::connect(&d.addr).unwrap();
+        let mut text = String::new();
+        let served = write!(probe, "GET /uPlot.css HTTP/1.0\r\nHost: {}\r\n\r\n", d.addr)
+            .and_then(|()| probe.read_to_string(&mut text))
+            .is_ok_and(|_| text.lines().next().is_some_and(|l| l.contains(" 200 ")));
+        if served {
+            break;
+        }
+        assert!(Instant::now() < deadline, "not served again: {text:?}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
     std::fs::remove_dir_all(dir).ok();
 }
 
