@@ -263,9 +263,12 @@ while addr is None:
         sys.exit("golden: no URL from the dashboard in 30 s")
     time.sleep(0.1)
 
+# The dashboard answers only to its own address (Host).
+host = f"Host: {addr[0]}:{addr[1]}\r\n"
+
 def request(method, path, headers=""):
     with socket.create_connection(addr, timeout=20) as s:
-        s.sendall(f"{method} {path} HTTP/1.0\r\nHost: x\r\n{headers}\r\n".encode())
+        s.sendall(f"{method} {path} HTTP/1.0\r\n{host}{headers}\r\n".encode())
         data = b""
         while chunk := s.recv(65536):
             data += chunk
@@ -275,7 +278,7 @@ def request(method, path, headers=""):
 def first_update():
     """The first update a new page gets (no Last-Event-ID): the full state."""
     with socket.create_connection(addr, timeout=20) as s:
-        s.sendall(b"GET /events HTTP/1.0\r\nHost: x\r\n\r\n")
+        s.sendall(f"GET /events HTTP/1.0\r\n{host}\r\n".encode())
         data = b""
         while True:
             chunk = s.recv(1 << 20)
@@ -298,20 +301,28 @@ while True:
     time.sleep(0.2)
 with open(os.path.join(out, "state.json"), "w") as f:
     f.write(update + "\n")
+token = None
 for path, name in [("/", "index.html"), ("/dashboard.js", "dashboard.js"),
                    ("/dashboard.css", "dashboard.css"), ("/uPlot.js", "uPlot.js"),
                    ("/uPlot.css", "uPlot.css")]:
     status, body = request("GET", path)
     if status != 200:
         sys.exit(f"golden: GET {path}: {status}")
+    if path == "/":
+        # The page holds the run's random access token: kept as <TOKEN>.
+        m = re.search(rb'name="probe-token" content="([0-9a-f]{64})"', body)
+        if not m:
+            sys.exit("golden: no access token in the page")
+        token = m.group(1).decode()
+        body = body.replace(m.group(1), b"<TOKEN>")
     with open(os.path.join(out, "asset-" + name), "wb") as f:
         f.write(body)
 with open(os.path.join(out, "commands-refused.txt"), "w") as f:
     for path in ["/api/align", "/api/station", "/api/index/1/30", "/api/configure"]:
-        status, body = request("POST", path, "X-MWD-Dashboard: 1\r\n")
+        status, body = request("POST", path, f"X-Probe-Token: {token}\r\n")
         f.write(f"POST {path}: {status} {body.decode()}\n")
     status, body = request("POST", "/api/align")
-    f.write(f"POST /api/align without the page's header: {status} {body.decode()}\n")
+    f.write(f"POST /api/align without the page's token: {status} {body.decode()}\n")
 EOF
 kill "$dash_pid"
 wait "$dash_pid" || true

@@ -22,6 +22,7 @@ fn state(limits: Limits) -> DashboardState {
         job: None,
         depth: None,
         survey: SurveySetup::probe(job_tie_on(None), 45f64.to_radians()).unwrap(),
+        well_plan: None,
     };
     DashboardState::new(info, 7, limits)
 }

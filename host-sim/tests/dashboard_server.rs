@@ -8,116 +8,23 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::TcpStream;
+mod dashboard_common;
+
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
 
+use dashboard_common::{follow, raw_request, request, simulated_capture, start};
 use serde_json::Value;
-
-/// A running dashboard, killed when dropped.
-struct Dashboard {
-    child: Child,
-    addr: String,
-}
-
-impl Drop for Dashboard {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn start(args: &[&str]) -> Dashboard {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .arg("dashboard")
-        .args(args)
-        .args(["--http-port", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .expect("host-sim runs");
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let addr = line
-        .split("http://")
-        .nth(1)
-        .and_then(|rest| rest.split('/').next())
-        .unwrap_or_else(|| panic!("no URL in {line:?}"))
-        .to_string();
-    assert!(addr.starts_with("127.0.0.1:"), "{addr}");
-    Dashboard { child, addr }
-}
-
-/// One HTTP/1.0 request (no chunked encoding to undo) with the page's
-/// command header: status and body.
-fn request(addr: &str, method: &str, path: &str) -> (u16, String) {
-    raw_request(addr, method, path, "X-MWD-Dashboard: 1\r\n")
-}
-
-fn raw_request(addr: &str, method: &str, path: &str, headers: &str) -> (u16, String) {
-    let mut stream = TcpStream::connect(addr).unwrap();
-    write!(
-        stream,
-        "{method} {path} HTTP/1.0\r\nHost: {addr}\r\n{headers}\r\n"
-    )
-    .unwrap();
-    let mut response = String::new();
-    stream.read_to_string(&mut response).unwrap();
-    let (head, body) = response.split_once("\r\n\r\n").unwrap();
-    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
-    (status, body.to_string())
-}
-
-/// Reads the event stream until `done` says so (or 30 s): the last event's
-/// id and data.
-fn follow(addr: &str, last_id: Option<&str>, done: impl Fn(&Value) -> bool) -> (String, Value) {
-    let mut stream = TcpStream::connect(addr).unwrap();
-    stream
-        .set_read_timeout(Some(Duration::from_secs(10)))
-        .unwrap();
-    let resume = last_id.map_or(String::new(), |id| format!("Last-Event-ID: {id}\r\n"));
-    write!(
-        stream,
-        "GET /events HTTP/1.0\r\nHost: {addr}\r\n{resume}\r\n"
-    )
-    .unwrap();
-    let started = Instant::now();
-    let mut id = String::new();
-    for line in BufReader::new(stream).lines() {
-        let line = line.unwrap();
-        if let Some(rest) = line.strip_prefix("id:") {
-            id = rest.trim().to_string();
-        } else if let Some(data) = line.strip_prefix("data:") {
-            let update: Value = serde_json::from_str(data).unwrap();
-            if done(&update) || started.elapsed() > Duration::from_secs(30) {
-                return (id, update);
-            }
-        }
-    }
-    panic!("the event stream ended");
-}
-
-fn simulated_capture(dir: &Path) -> std::path::PathBuf {
-    let out = dir.join("run.bin");
-    let run = common::run(&["simulate", "--duration", "30", "-o", out.to_str().unwrap()]);
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
-    out
-}
 
 #[test]
 fn a_replayed_capture_streams_to_its_end_and_a_reconnect_resumes() {
     let dir = common::scratch("dashboard", "replay");
-    let capture = simulated_capture(&dir);
+    let capture = simulated_capture(&dir, 30);
     let d = start(&["--file", capture.to_str().unwrap(), "--speed", "200"]);
 
-    let (status, page) = request(&d.addr, "GET", "/");
+    let (status, page) = request(&d, "GET", "/");
     assert_eq!(status, 200);
     assert!(page.contains("/uPlot.js") && page.contains("id=\"azimuth\""));
-    let (status, uplot) = request(&d.addr, "GET", "/uPlot.js");
+    let (status, uplot) = request(&d, "GET", "/uPlot.js");
     assert_eq!(status, 200);
     let vendored = include_str!("../assets/dashboard/vendor/uplot/uPlot.iife.min.js");
     assert_eq!(uplot, vendored);
@@ -148,10 +55,10 @@ fn a_replayed_capture_streams_to_its_end_and_a_reconnect_resumes() {
     assert_eq!(fresh["rest"]["reset"], true);
     assert_eq!(fresh["sensors"].as_array().unwrap().len(), 600);
 
-    let (status, why) = request(&d.addr, "POST", "/api/align");
+    let (status, why) = request(&d, "POST", "/api/align");
     assert_eq!(status, 409);
     assert!(why.contains("replaying"), "{why}");
-    let (status, why) = request(&d.addr, "POST", "/api/index/1/30");
+    let (status, why) = request(&d, "POST", "/api/index/1/30");
     assert_eq!(status, 400);
     assert!(why.contains("2 to 36 positions"), "{why}");
     std::fs::remove_dir_all(dir).ok();
@@ -233,6 +140,65 @@ fn with_a_depth_log_the_stations_get_positions_with_their_sigma() {
 }
 
 #[test]
+fn with_a_job_plan_the_stations_are_drawn_against_it_with_their_ellipses() {
+    let dir = common::scratch("dashboard", "plan");
+    let (capture, depth, job) = common::simulate_tied_in(&dir);
+    // The tied-in job, with the plan the run drilled.
+    let text = std::fs::read_to_string(&job).unwrap();
+    let plan = common::plan("qemu-short.json");
+    let with_plan = text.replacen(
+        "\"site\"",
+        &format!("\"plan\": {:?},\n  \"site\"", plan.to_str().unwrap()),
+        1,
+    );
+    std::fs::write(&job, with_plan).unwrap();
+    let d = start(&[
+        "--file",
+        common::s(&capture),
+        "--speed",
+        "1000",
+        "--depth",
+        common::s(&depth),
+        "--job",
+        common::s(&job),
+    ]);
+    follow(&d.addr, None, |u| u["rest"]["finished"] == true);
+    // A new page's snapshot, with everything.
+    let (_, last) = follow(&d.addr, None, |_| true);
+    let stations = &last["rest"]["stations"];
+    let placed = stations["plan"].as_array().unwrap().len();
+    assert!(placed >= 2, "{stations}");
+    // Every station placed has its ellipse in both views (its covariance
+    // is valid), 2-sigma as the survey figures draw them.
+    assert_eq!(stations["plan_ellipses"].as_array().unwrap().len(), placed);
+    assert_eq!(
+        stations["section_ellipses"].as_array().unwrap().len(),
+        placed
+    );
+    assert_eq!(stations["ellipse_sigma"], 2.0);
+    // The plan from its tie-on (N 420, E 310, TVD 2450) in both views; the
+    // section along the azimuth to the plan's end.
+    let well_plan = &stations["well_plan"];
+    let plan_view = well_plan["plan"].as_array().unwrap();
+    assert_eq!(plan_view.len(), 401);
+    assert_eq!(plan_view[0], serde_json::json!([310.0, 420.0]));
+    let section = well_plan["section"].as_array().unwrap();
+    assert_eq!(section[0][1], 2450.0);
+    let [n, e] = [
+        plan_view[400][1].as_f64().unwrap(),
+        plan_view[400][0].as_f64().unwrap(),
+    ];
+    let azimuth = stations["section_azimuth_deg"].as_f64().unwrap();
+    assert!(
+        (azimuth - e.atan2(n).to_degrees()).abs() < 1e-9,
+        "{azimuth}"
+    );
+    // The first station sits on the plan's tie-on.
+    assert_eq!(stations["plan"][0], plan_view[0]);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
 fn bad_inputs_are_refused_before_serving() {
     let dir = common::scratch("dashboard", "bad");
     let not_capture = dir.join("notes.bin");
@@ -244,7 +210,7 @@ fn bad_inputs_are_refused_before_serving() {
         "{}",
         run.stderr
     );
-    let capture = simulated_capture(&dir);
+    let capture = simulated_capture(&dir, 30);
     let run = common::run(&[
         "dashboard",
         "--file",
@@ -269,57 +235,9 @@ fn bad_inputs_are_refused_before_serving() {
 #[cfg(target_os = "linux")]
 mod on_a_port {
     use super::*;
-    use mwd_core::protocol::uplink::reply::encode_reply;
-    use mwd_core::protocol::uplink::{decode_command, Reply};
-    use mwd_core::protocol::{example, FrameEncoder, MAX_WIRE_LEN};
-    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
-    use std::fs::File;
-    use std::os::fd::AsFd;
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
-
-    /// A stand-in probe on a pty: raw-sample frames every few ms, an ACK
-    /// to every command; returns every byte it sent.
-    fn stand_in(stop: Arc<AtomicBool>) -> (String, std::thread::JoinHandle<Vec<u8>>) {
-        let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY).unwrap();
-        grantpt(&master).unwrap();
-        unlockpt(&master).unwrap();
-        let port = ptsname(&master, Vec::new()).unwrap().into_string().unwrap();
-        let mut master = File::from(master);
-        let probe = std::thread::spawn(move || {
-            rustix::fs::fcntl_setfl(master.as_fd(), rustix::fs::OFlags::NONBLOCK).unwrap();
-            let mut downlink = FrameEncoder::new();
-            let (mut sent, mut chunk) = (Vec::new(), Vec::new());
-            let (mut buf, mut out) = ([0u8; 256], [0u8; MAX_WIRE_LEN]);
-            while !stop.load(Ordering::Relaxed) {
-                let n = downlink.encode(&example::raw_sample(), &mut out).unwrap();
-                // Until the dashboard opens the port, nobody reads: not sent.
-                if master.write_all(&out[..n]).is_ok() {
-                    sent.extend_from_slice(&out[..n]);
-                }
-                std::thread::sleep(Duration::from_millis(5));
-                let got = master.read(&mut buf).unwrap_or(0);
-                for b in &buf[..got] {
-                    if *b != 0 {
-                        chunk.push(*b);
-                        continue;
-                    }
-                    let command = cobs::decode_in_place(&mut chunk)
-                        .ok()
-                        .and_then(|len| decode_command(&chunk[..len]).ok());
-                    chunk.clear();
-                    if let Some(c) = command {
-                        let reply = Reply::ack(0, c.seq, c.command.kind() as u8, 3);
-                        let n = encode_reply(downlink.next_seq(), &reply, &mut out).unwrap();
-                        master.write_all(&out[..n]).unwrap();
-                        sent.extend_from_slice(&out[..n]);
-                    }
-                }
-            }
-            sent
-        });
-        (port, probe)
-    }
+    use dashboard_common::probe::stand_in;
+    use mwd_core::protocol::MAX_WIRE_LEN;
+    use std::time::Duration;
 
     #[test]
     fn commands_are_acknowledged_on_the_page_and_the_bytes_recorded() {
@@ -332,22 +250,22 @@ mod on_a_port {
         )
         .unwrap();
         let saved = dir.join("saved.bin");
-        let stop = Arc::new(AtomicBool::new(false));
-        let (port, probe) = stand_in(stop.clone());
+        let probe = stand_in();
         let d = start(&[
             "--port",
-            &port,
+            &probe.port,
             "--save",
             saved.to_str().unwrap(),
             "--job",
             job.to_str().unwrap(),
         ]);
-        // Not from the page (another site's form): refused, nothing sent.
-        let (status, _) = raw_request(&d.addr, "POST", "/api/align", "");
+        // Not from the page (another site's form, no token): refused.
+        let host = format!("Host: {}\r\n", d.addr);
+        let (status, _) = raw_request(&d.addr, "POST", "/api/align", &host);
         assert_eq!(status, 403);
-        let (status, _) = request(&d.addr, "POST", "/api/station");
+        let (status, _) = request(&d, "POST", "/api/station");
         assert_eq!(status, 202);
-        let (status, _) = request(&d.addr, "POST", "/api/configure");
+        let (status, _) = request(&d, "POST", "/api/configure");
         assert_eq!(status, 202);
         let all_answered = |u: &Value| {
             u["rest"]["commands"].as_array().is_some_and(|c| {
@@ -367,8 +285,7 @@ mod on_a_port {
         assert_eq!(update["rest"]["source"]["controls_disabled"], Value::Null);
         assert!(update["rest"]["link"]["raw"].as_u64().unwrap() > 0);
 
-        stop.store(true, Ordering::Relaxed);
-        let sent = probe.join().unwrap();
+        let sent = probe.stop();
         // The dashboard reads every 100 ms at most: give it time to record.
         std::thread::sleep(Duration::from_millis(500));
         drop(d);

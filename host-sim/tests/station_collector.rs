@@ -96,6 +96,7 @@ fn the_capture_survey_and_the_dashboard_place_the_same_stations_from_the_job_tie
         job: None,
         depth: Some(depth_log),
         survey: SurveySetup::probe(job_tie_on(Some(&job_file)), job_file.site.lat).unwrap(),
+        well_plan: None,
     };
     let mut state = DashboardState::new(info, 1, LIMITS);
     for frame in &read_capture(&bin).unwrap().frames {

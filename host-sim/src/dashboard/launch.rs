@@ -6,6 +6,7 @@
 use crate::dashboard::server::App;
 use crate::dashboard::source::{self, Shared};
 use crate::dashboard::state::{DashboardState, SourceInfo, LIMITS};
+use crate::sim::plan::Plan;
 use crate::survey::job::Job;
 use anyhow::{Context, Result};
 use mwd_core::calibration::ProbeCalibration;
@@ -59,6 +60,27 @@ pub fn start(source: Source, mut info: SourceInfo, job: Option<Job>) -> Result<A
         commands,
         job: job.map(Arc::new),
     })
+}
+
+/// Points drawn along a well plan: enough for its curves to look round.
+const PLAN_POINTS: usize = 400;
+
+/// The job's well plan (its `plan` key), as (north, east, TVD) m at
+/// [`PLAN_POINTS`] + 1 MDs evenly along it; `None` without a job or plan.
+pub fn well_plan_path(job: Option<&Job>) -> Result<Option<Vec<[f64; 3]>>> {
+    let Some(path) = job.and_then(|j| j.plan.as_deref()) else {
+        return Ok(None);
+    };
+    let plan = Plan::load(path)?;
+    let (start, end) = (plan.start_md(), plan.end_md());
+    let points = (0..=PLAN_POINTS)
+        .map(|i| {
+            let md = start + (end - start) * i as f64 / PLAN_POINTS as f64;
+            let p = plan.at(md);
+            [p.nev[0], p.nev[1], p.nev[2]]
+        })
+        .collect();
+    Ok(Some(points))
 }
 
 /// The calibration in use, for people: the job's, or what is known.

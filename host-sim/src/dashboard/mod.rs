@@ -10,11 +10,18 @@
 //! - [`source`]: frames from a serial port (recorded raw as they arrive)
 //!   or a capture replayed at a chosen pace; the probe's commands.
 //! - [`state`]: what the page shows, in bounded buffers, and its updates.
-//! - [`view`], [`stations`]: frames and stations as people read them.
-//! - [`server`]: the page (uPlot embedded) and server-sent events.
+//! - [`view`], [`stations`]: frames and stations as people read them;
+//!   [`well_view`]: the stations drawn in plan and section against the
+//!   job's well plan.
+//! - [`server`]: the page (uPlot embedded) and server-sent events, over
+//!   [`connection`]s with a deadline.
+//! - [`access`]: who may read and command: the Host, the Origin, the
+//!   run's token.
 //! - [`launch`]: a dashboard started from its source, with the calibration
 //!   in use as the page shows it.
 
+pub mod access;
+pub mod connection;
 pub mod launch;
 pub mod ring;
 pub mod server;
@@ -22,3 +29,4 @@ pub mod source;
 pub mod state;
 pub mod stations;
 pub mod view;
+pub mod well_view;

@@ -1,7 +1,11 @@
 //! The dashboard's web server: the page and its scripts (embedded, so it
 //! works with no network), the data as server-sent events (a page that
 //! reconnects sends `Last-Event-ID` and picks up where the stream is), and
-//! the probe's commands as POST requests.
+//! the probe's commands as POST requests. Every request passes the
+//! dashboard's access rules first ([`super::access`]); each connection has
+//! [`HEADER_TIMEOUT`] to send its headers, is closed after
+//! [`IDLE_TIMEOUT`] with nothing moving, and at most [`MAX_CONNECTIONS`]
+//! are served at once.
 
 use std::convert::Infallible;
 use std::net::SocketAddr;
@@ -10,21 +14,38 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use axum::extract::{Path, State};
+use axum::extract::{Path, Request, State};
 use axum::http::{header, HeaderMap, StatusCode};
+use axum::middleware::{self, Next};
 use axum::response::sse::{Event, Sse};
-use axum::response::IntoResponse;
+use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
 use futures_util::stream::{self, Stream};
+use hyper_util::rt::{TokioIo, TokioTimer};
+use hyper_util::service::TowerToHyperService;
 use mwd_core::protocol::uplink::fields::{INDEX_DWELL_S, INDEX_POSITIONS};
 use mwd_core::protocol::uplink::{Command, IndexingProcedure};
 
+use super::access::{Access, Kind};
+use super::connection::IdleLimited;
 use super::source::{lock, CommandBatch, Shared};
 use crate::survey::job::Job;
 
 /// How often a page gets an update.
 const UPDATE_INTERVAL: Duration = Duration::from_millis(250);
+
+/// The time a client has to send a request's headers.
+pub const HEADER_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// A connection on which nothing moves either way this long is closed (a
+/// body that stops coming, a client that stops reading, an unused
+/// kept-alive connection). An open page's event stream writes four times a
+/// second.
+pub const IDLE_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Connections served at once; more are closed as they come.
+pub const MAX_CONNECTIONS: usize = 32;
 
 /// What the request handlers share.
 #[derive(Clone)]
@@ -38,6 +59,8 @@ pub struct App {
 }
 
 const PAGE: &str = include_str!("../../assets/dashboard/index.html");
+/// Where the page gets its run's token.
+const PAGE_TOKEN_SLOT: &str = "{{PROBE_TOKEN}}";
 const SCRIPT: &str = include_str!("../../assets/dashboard/dashboard.js");
 const STYLE: &str = include_str!("../../assets/dashboard/dashboard.css");
 const UPLOT_JS: &str = include_str!("../../assets/dashboard/vendor/uplot/uPlot.iife.min.js");
@@ -47,11 +70,52 @@ fn asset(content_type: &'static str, body: &'static str) -> impl IntoResponse {
     ([(header::CONTENT_TYPE, content_type)], body)
 }
 
-pub fn router(app: App) -> Router {
+/// The page with this run's token. Not to be cached (the token changes
+/// each run) nor framed by another site's page.
+fn page(token: &str) -> impl IntoResponse + Clone {
+    (
+        [
+            (header::CONTENT_TYPE, "text/html; charset=utf-8"),
+            (header::CACHE_CONTROL, "no-store"),
+            (header::X_FRAME_OPTIONS, "DENY"),
+        ],
+        PAGE.replace(PAGE_TOKEN_SLOT, token),
+    )
+}
+
+/// Refuses what the access rules refuse (status and reason, nothing of the
+/// dashboard) before any handler sees it, and any request with a body (no
+/// endpoint takes one).
+async fn guard(State(access): State<Arc<Access>>, request: Request, next: Next) -> Response {
+    let kind = Kind::of(request.method(), request.uri().path());
+    if let Err(refusal) = access.check(kind, request.headers(), request.uri().query()) {
+        return (refusal.status(), refusal.text()).into_response();
+    }
+    let headers = request.headers();
+    let has_body = headers.contains_key(header::TRANSFER_ENCODING)
+        || headers
+            .get(header::CONTENT_LENGTH)
+            .is_some_and(|v| v.as_bytes() != b"0");
+    if has_body {
+        let refused = (
+            StatusCode::PAYLOAD_TOO_LARGE,
+            [(header::CONNECTION, "close")],
+            "the dashboard's requests carry no body",
+        );
+        return refused.into_response();
+    }
+    next.run(request).await
+}
+
+pub fn router(app: App, access: Arc<Access>) -> Router {
+    let page = page(access.token());
     Router::new()
         .route(
             "/",
-            get(|| async { asset("text/html; charset=utf-8", PAGE) }),
+            get(move || {
+                let page = page.clone();
+                async move { page }
+            }),
         )
         .route(
             "/dashboard.js",
@@ -74,7 +138,9 @@ pub fn router(app: App) -> Router {
         .route("/api/station", post(station))
         .route("/api/configure", post(configure))
         .route("/api/index/{positions}/{dwell_s}", post(index))
+        .fallback(|| async { (StatusCode::NOT_FOUND, "not found") })
         .with_state(app)
+        .layer(middleware::from_fn_with_state(access, guard))
 }
 
 /// The update stream: at once everything the page lacks, then what is new
@@ -103,20 +169,10 @@ async fn events(
     Sse::new(updates)
 }
 
-/// The header the page sends with every command. A request with a custom
-/// header needs a CORS preflight, which this server does not grant: so
-/// another site open in the same browser cannot command the probe.
-pub const COMMAND_HEADER: &str = "x-mwd-dashboard";
-
-/// Queues commands for the probe: 202, 403 without the page's header, or
-/// 409 with the reason when there is no command link.
-fn send(app: &App, headers: &HeaderMap, batch: CommandBatch) -> (StatusCode, String) {
-    if !headers.contains_key(COMMAND_HEADER) {
-        return (
-            StatusCode::FORBIDDEN,
-            format!("commands are taken from the dashboard's page only (header {COMMAND_HEADER})"),
-        );
-    }
+/// Queues commands for the probe (the access rules have passed the
+/// request: it carries the token): 202, or 409 with the reason when there
+/// is no command link.
+fn send(app: &App, batch: CommandBatch) -> (StatusCode, String) {
     match &app.commands {
         Err(reason) => (StatusCode::CONFLICT, reason.clone()),
         Ok(sender) => {
@@ -132,19 +188,15 @@ fn send(app: &App, headers: &HeaderMap, batch: CommandBatch) -> (StatusCode, Str
     }
 }
 
-async fn align(State(app): State<App>, headers: HeaderMap) -> (StatusCode, String) {
-    send(&app, &headers, vec![("re-align".into(), Command::Realign)])
+async fn align(State(app): State<App>) -> (StatusCode, String) {
+    send(&app, vec![("re-align".into(), Command::Realign)])
 }
 
-async fn station(State(app): State<App>, headers: HeaderMap) -> (StatusCode, String) {
-    send(
-        &app,
-        &headers,
-        vec![("take a station".into(), Command::TakeStation)],
-    )
+async fn station(State(app): State<App>) -> (StatusCode, String) {
+    send(&app, vec![("take a station".into(), Command::TakeStation)])
 }
 
-async fn configure(State(app): State<App>, headers: HeaderMap) -> (StatusCode, String) {
+async fn configure(State(app): State<App>) -> (StatusCode, String) {
     let Some(job) = app.job.clone() else {
         return (
             StatusCode::CONFLICT,
@@ -153,12 +205,11 @@ async fn configure(State(app): State<App>, headers: HeaderMap) -> (StatusCode, S
     };
     let mut batch = job.commands();
     batch.push(("report configuration".into(), Command::ReportConfig));
-    send(&app, &headers, batch)
+    send(&app, batch)
 }
 
 async fn index(
     State(app): State<App>,
-    headers: HeaderMap,
     Path((positions, dwell_s)): Path<(u8, u16)>,
 ) -> (StatusCode, String) {
     let (p_lo, p_hi) = INDEX_POSITIONS;
@@ -174,7 +225,6 @@ async fn index(
     }
     send(
         &app,
-        &headers,
         vec![(
             format!("toolface indexing, {positions} positions of {dwell_s} s"),
             Command::IndexToolface(IndexingProcedure { positions, dwell_s }),
@@ -182,9 +232,17 @@ async fn index(
     )
 }
 
-/// Serves `app` on `bind` until the process ends; `listening` gets the
-/// address bound (a port 0 becomes a free one).
-pub fn serve(bind: SocketAddr, app: App, listening: impl FnOnce(SocketAddr)) -> Result<()> {
+/// Serves `app` on `bind` until the process ends, with `token` for the
+/// page and its commands; `remote`: other machines may connect (any Host,
+/// the token for every read; see [`super::access`]). `listening` gets the
+/// access rules, whose address is the one bound (a port 0 becomes a free
+/// one).
+pub fn serve(
+    bind: SocketAddr,
+    remote: bool,
+    app: App,
+    listening: impl FnOnce(SocketAddr, &Access),
+) -> Result<()> {
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
@@ -193,9 +251,35 @@ pub fn serve(bind: SocketAddr, app: App, listening: impl FnOnce(SocketAddr)) -> 
         let listener = tokio::net::TcpListener::bind(bind)
             .await
             .with_context(|| format!("binding {bind}"))?;
-        listening(listener.local_addr().context("the bound address")?);
-        axum::serve(listener, router(app))
-            .await
-            .context("serving the dashboard")
+        let bound = listener.local_addr().context("the bound address")?;
+        let access = Arc::new(Access::new(super::access::new_token(), bound, remote));
+        listening(bound, &access);
+        let router = router(app, access);
+        let slots = Arc::new(tokio::sync::Semaphore::new(MAX_CONNECTIONS));
+        loop {
+            let stream = match listener.accept().await {
+                Ok((stream, _)) => stream,
+                // Out of file descriptors and the like: try again shortly.
+                Err(_) => {
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                    continue;
+                }
+            };
+            // Full: this one is closed at once.
+            let Ok(slot) = Arc::clone(&slots).try_acquire_owned() else {
+                continue;
+            };
+            let service = TowerToHyperService::new(router.clone());
+            tokio::spawn(async move {
+                let io = TokioIo::new(IdleLimited::new(stream, IDLE_TIMEOUT));
+                // A client that breaks off, or runs out of time, ends here.
+                let _ = hyper::server::conn::http1::Builder::new()
+                    .timer(TokioTimer::new())
+                    .header_read_timeout(HEADER_TIMEOUT)
+                    .serve_connection(io, service)
+                    .await;
+                drop(slot);
+            });
+        }
     })
 }

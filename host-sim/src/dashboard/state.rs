@@ -68,6 +68,9 @@ pub struct SourceInfo {
     /// The tie-on and the probe's error model the stations are positioned
     /// with (as `survey CAPTURE --job` positions them).
     pub survey: SurveySetup,
+    /// The job's well plan, (north, east, TVD) m along its MD, that the
+    /// stations are drawn against.
+    pub well_plan: Option<Vec<[f64; 3]>>,
 }
 
 /// One command sent to the probe and what came of it.
@@ -132,7 +135,13 @@ pub struct DashboardState {
 impl DashboardState {
     pub fn new(source: SourceInfo, session: u64, limits: Limits) -> Self {
         let stations = StationCollector::default();
-        let stations_view = stations_json(&stations, 0, source.depth.as_ref(), &source.survey);
+        let stations_view = stations_json(
+            &stations,
+            0,
+            source.depth.as_ref(),
+            &source.survey,
+            source.well_plan.as_deref(),
+        );
         Self {
             limits,
             session,
@@ -221,6 +230,7 @@ impl DashboardState {
                     self.stations_dropped,
                     self.source.depth.as_ref(),
                     &self.source.survey,
+                    self.source.well_plan.as_deref(),
                 );
                 self.stations_update = update;
             }

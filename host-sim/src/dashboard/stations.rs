@@ -7,6 +7,7 @@
 use mwd_core::protocol::StationSurvey;
 use serde_json::{json, Value};
 
+use super::well_view::{drawing, PlacedStation};
 use crate::formats::depth_log::DepthLog;
 use crate::formats::display;
 use crate::survey::listing::drilling::{self, DrillingRow};
@@ -62,17 +63,19 @@ fn positioned(row: &mut Value, d: &DrillingRow) {
 
 /// The stations for the page: the list, the note on positions, and the
 /// plan view (east, north) and vertical section (section, TVD) of the
-/// stations whose position is determined.
+/// stations whose position is determined, with their ellipses, against
+/// `well_plan` ((north, east, TVD) along the job's plan) if given
+/// ([`drawing`]).
 pub fn stations_json(
     collected: &StationCollector,
     dropped: u64,
     depth: Option<&DepthLog>,
     setup: &SurveySetup,
+    well_plan: Option<&[[f64; 3]]>,
 ) -> Value {
     let stations = collected.stations();
     let mut rows: Vec<Value> = stations.iter().map(station_row).collect();
-    let mut plan = Vec::new();
-    let mut section = Vec::new();
+    let mut placed = Vec::new();
     let note = match (depth, stations.is_empty()) {
         (None, _) => "No depth log: positions by minimum curvature need MD, so the stations \
                       are listed only (start with --depth DEPTH.csv)."
@@ -93,8 +96,10 @@ pub fn stations_json(
                             positioned(&mut rows[k], d);
                         }
                         if d.position_determined {
-                            plan.push(json!([d.row.east_m, d.row.north_m]));
-                            section.push(json!([d.row.vsec_m, d.row.tvd_m]));
+                            placed.push(PlacedStation {
+                                nev: [d.row.north_m, d.row.east_m, d.row.tvd_m],
+                                cov: d.row.cov,
+                            });
                         }
                     }
                     let skipped: Vec<String> = survey
@@ -110,7 +115,7 @@ pub fn stations_json(
                     if !skipped.is_empty() {
                         note += &format!(" Left out: {}.", skipped.join("; "));
                     }
-                    if plan.is_empty() {
+                    if placed.is_empty() {
                         note += " No position is determined yet: the azimuth is undetermined.";
                     }
                     note
@@ -124,7 +129,10 @@ pub fn stations_json(
     } else {
         note
     };
-    json!({"rows": rows, "note": note, "plan": plan, "section": section})
+    let mut view = drawing(&placed, well_plan);
+    view.insert("rows".into(), rows.into());
+    view.insert("note".into(), note.into());
+    Value::Object(view)
 }
 
 /// How the stations are placed: from the job's tie-on, or from the first

@@ -31,6 +31,18 @@ const OTHER_COLOUR: RGBColor = RGBColor(44, 160, 44);
 /// Points per ellipse outline.
 const ELLIPSE_POINTS: usize = 73;
 
+/// The `k`-sigma ellipse of the covariance `[[sxx, sxy], [sxy, syy]]`
+/// of (x, y): semi-major and semi-minor axes, and the angle of the major
+/// axis from +x towards +y (rad).
+pub fn ellipse_axes(sxx: f64, syy: f64, sxy: f64, k: f64) -> (f64, f64, f64) {
+    let mean = 0.5 * (sxx + syy);
+    let half = (0.5 * (sxx - syy)).hypot(sxy);
+    let a = k * (mean + half).max(0.0).sqrt();
+    let b = k * (mean - half).max(0.0).sqrt();
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    (a, b, theta)
+}
+
 /// Outline of the `k`-sigma ellipse of the covariance
 /// `[[sxx, sxy], [sxy, syy]]` of (x, y) around `centre`: the eigenvectors
 /// of the block are the axes, `k` times the square roots of the eigenvalues
@@ -42,12 +54,7 @@ pub fn ellipse_outline(
     sxy: f64,
     k: f64,
 ) -> Vec<(f64, f64)> {
-    let mean = 0.5 * (sxx + syy);
-    let half = (0.5 * (sxx - syy)).hypot(sxy);
-    let a = k * (mean + half).max(0.0).sqrt();
-    let b = k * (mean - half).max(0.0).sqrt();
-    // angle of the major axis from +x, counter-clockwise
-    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let (a, b, theta) = ellipse_axes(sxx, syy, sxy, k);
     let (st, ct) = theta.sin_cos();
     (0..ELLIPSE_POINTS)
         .map(|i| {
