@@ -12,10 +12,10 @@ fn scratch(name: &str) -> PathBuf {
     common::scratch("bad-input-cli", name)
 }
 
-/// A refusal: exit 1 or 2 (clap), an error containing `needle`, short.
+/// A refusal: exit 1 (the command line's too), an error containing `needle`, short.
 fn refused(run: &Run, needle: &str) {
     assert!(
-        matches!(run.code, Some(1 | 2)),
+        matches!(run.code, Some(1)),
         "exit {:?}: {}",
         run.code,
         run.stderr

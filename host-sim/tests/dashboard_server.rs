@@ -218,7 +218,7 @@ fn bad_inputs_are_refused_before_serving() {
         "--speed",
         "0",
     ]);
-    assert_eq!(run.code, Some(2));
+    assert_eq!(run.code, Some(1));
     assert!(run.stderr.contains("above 0"), "{}", run.stderr);
     let run = common::run(&[
         "dashboard",

@@ -5,7 +5,7 @@
 //! output that a closed pipe does not turn into a panic), [`limits`] and
 //! [`site`] (the numbers checked when parsed), [`runs`] (the studies'
 //! threads, progress bar and Ctrl-C).
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 #[macro_use]
@@ -30,6 +30,7 @@ mod replay;
 mod runs;
 mod simulate;
 mod site;
+pub(crate) mod status;
 mod study;
 mod study_lateral;
 mod survey;
@@ -86,8 +87,30 @@ pub enum Command {
     Paper(paper::PaperCommand),
 }
 
-/// Runs a command; its exit status (only `replay` has others than 0: see
-/// its `--help`).
+/// The command line read from the arguments; every command's `--help`
+/// ends with its exit statuses ([`status`]), the general ones where the
+/// command does not say its own.
+pub fn parse() -> Result<Cli, clap::Error> {
+    let command = with_exit_status(Cli::command()).after_help(status::HELP_ALL);
+    Cli::from_arg_matches(&command.try_get_matches()?)
+}
+
+fn with_exit_status(command: clap::Command) -> clap::Command {
+    let command = if command.get_after_help().is_none() && !command.has_subcommands() {
+        let help = if command.get_name() == "survey" {
+            status::HELP_SURVEY
+        } else {
+            status::HELP_COMPLETE_OR_ERROR
+        };
+        command.after_help(help)
+    } else {
+        command
+    };
+    command.mut_subcommands(with_exit_status)
+}
+
+/// Runs a command; its exit status ([`status`]: `replay` and `survey`
+/// have others than 0 and 1, see their `--help`).
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     let done = |result: anyhow::Result<()>| result.map(|()| ExitCode::SUCCESS);
     match cli.command {
@@ -101,7 +124,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Arfit(args) => done(arfit::run(args)),
         Command::Calibrate(args) => done(calibrate::run(args)),
         Command::Observability(args) => done(observability::run(args)),
-        Command::Survey(args) => done(survey::run(args)),
+        Command::Survey(args) => survey::run(args),
         Command::Study(cmd) => done(study::run(cmd)),
         Command::Probe(args) => done(probe::run(args)),
         #[cfg(feature = "dashboard")]

@@ -29,32 +29,22 @@ use mwd_core::config::default_still_settings;
 use mwd_core::earth::Position;
 
 use super::site::SiteArgs;
-
-/// Exit statuses of `replay` (also in its `--help`).
-mod status {
-    /// Every probe solution compared was identical, none left unchecked (or
-    /// the run was post-processed with another calibration or site).
-    pub const PARITY: u8 = 0;
-    /// Replayed solutions differ from the probe's.
-    pub const DIFFERENT: u8 = 3;
-    /// Everything compared was identical, but some probe solutions could
-    /// not be compared (frames lost, the capture starts mid-run, the probe
-    /// dropped samples, a command the replay cannot repeat).
-    pub const INCOMPLETE: u8 = 4;
-}
+use super::status;
 
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "Exit status: 0 every probe solution compared was identical (or the \
-replay was post-processed with --calibration-file or a site option: differences are then \
-expected and reported, not a failure); 1 error (unreadable file, not a probe capture, bad \
-argument); 2 bad command line; 3 replayed solutions or station surveys differ from the probe's; 4 all compared \
-solutions identical but some could not be compared (frames lost: the replay stops comparing \
-from the first sample after the loss and starts again at the probe's next boot event; or a \
-command the replay cannot repeat: its place lost with frames, a re-align with new settings, \
-a lost reply that shows as the probe's navigation mode differing from the replay's). A \
-command the replay's navigator refuses though the probe acknowledged it, or a navigation \
-mode that differs with no frame lost, is a difference (3)."
+    after_help = "Exit status: 0 every probe solution and station compared was identical, \
+nothing left unchecked (or the replay was post-processed with --calibration-file, a site \
+option or a job's tie-in: differences are then expected and reported, not a failure); 1 error \
+(bad argument, unreadable file, not a probe capture, an output that could not be written); 2 \
+written but incomplete: all compared identical, but frames were lost (each one counted as not \
+compared, post-processed or not) or some solutions or stations could not be compared (the \
+replay stops comparing from the first sample after a loss and starts again at the probe's next \
+boot event; or a command the replay cannot repeat: its place lost with frames, a re-align with \
+new settings, a lost reply that shows as the probe's navigation mode differing from the \
+replay's); 3 replayed solutions or station surveys differ from the probe's. A command the \
+replay's navigator refuses though the probe acknowledged it, or a navigation mode that differs \
+with no frame lost, is a difference (3)."
 )]
 pub struct Args {
     /// Capture of the probe's UART bytes (`.bin`).
@@ -148,7 +138,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let report = replayed.report(args.csv.as_deref(), post_processed);
     out!("{}", report.text);
     let (prefix, status) = match report.verdict {
-        Verdict::Parity => ("", status::PARITY),
+        Verdict::Parity => ("", status::COMPLETE),
         Verdict::Different => ("error: ", status::DIFFERENT),
         Verdict::Incomplete => ("warning: ", status::INCOMPLETE),
     };

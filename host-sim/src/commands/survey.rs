@@ -26,6 +26,7 @@ use host_sim::survey::well_survey::{
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::config::default_still_settings;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 
 /// A length unit on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -291,7 +292,7 @@ impl Resolved {
     }
 }
 
-pub fn run(args: Args) -> Result<()> {
+pub fn run(args: Args) -> Result<ExitCode> {
     let resolved = Resolved::new(&args)?;
     check_offset_flags(&args.sep)?;
     if let Some(dir) = &args.plot {
@@ -328,7 +329,8 @@ pub fn run(args: Args) -> Result<()> {
     let whole_survey_outputs = [&args.json, &args.witsml, &args.plot, &args.sep.offset];
     if whole_survey_outputs.iter().all(|o| o.is_none()) {
         // the listing and the CSV only: row by row, in constant memory
-        return run_streamed(&args, &resolved, units, &site_for);
+        run_streamed(&args, &resolved, units, &site_for)?;
+        return Ok(ExitCode::from(super::status::COMPLETE));
     }
     let file = read_station_file(&args.stations, units)?;
     let inputs = SurveyInputs {
@@ -356,7 +358,7 @@ pub fn run(args: Args) -> Result<()> {
     for f in write_outputs(&survey, &paths, &well)? {
         outln!("wrote {}", f.display());
     }
-    Ok(())
+    Ok(ExitCode::from(super::status::COMPLETE))
 }
 
 /// The survey of a station file of any length, its listing and CSV

@@ -15,6 +15,7 @@ use host_sim::survey::job::WellNames;
 use host_sim::survey::outputs::{write_outputs, OutputPaths};
 use host_sim::survey::well_survey::{OffsetInputs, SiteFor};
 use std::path::PathBuf;
+use std::process::ExitCode;
 
 fn step_m(text: &str) -> Result<f64, String> {
     let v = number_in(text, "the trajectory step", (0.0, 1000.0), "m")?;
@@ -54,13 +55,14 @@ pub struct CaptureOutputs<'a> {
 }
 
 /// Surveys the capture, prints the listing and writes the outputs asked
-/// for and `--trajectory`.
+/// for and `--trajectory`; incomplete (exit 2) when frames or stations
+/// were lost, with their count on standard error.
 pub fn run(
     args: &CaptureArgs,
     inputs: &CaptureSurveyInputs,
     outputs: &CaptureOutputs,
     site_for: SiteFor,
-) -> Result<()> {
+) -> Result<ExitCode> {
     let confidence = outputs.confidence;
     let survey = CaptureSurvey::run(inputs)?;
     let mut exported = survey.well_survey(confidence, outputs.vsec_azimuth)?;
@@ -91,5 +93,5 @@ pub fn run(
         write_text(path, &trajectory_csv(&points, confidence))?;
         outln!("wrote {} ({} points)", path.display(), points.len());
     }
-    Ok(())
+    Ok(super::status::complete_unless(survey.incomplete()))
 }

@@ -79,16 +79,12 @@ impl Replayed {
                 self.rows
             );
         }
-        let (verdict, note) = if post_processed {
-            if summary.mismatched > 0 || stations_differ > 0 {
-                text += "post-processed   with another calibration or site than the probe's \
-                         defaults: differences from the probe's solutions are expected, not a \
-                         parity failure\n";
-            }
-            (Verdict::Parity, None)
-        } else {
-            self.verdict(stations_differ, stations_unchecked)
-        };
+        if post_processed && (summary.mismatched > 0 || stations_differ > 0) {
+            text += "post-processed   with another calibration or site than the probe's \
+                     defaults: differences from the probe's solutions are expected, not a \
+                     parity failure\n";
+        }
+        let (verdict, note) = self.verdict(stations_differ, stations_unchecked, post_processed);
         ReplayReport {
             text,
             verdict,
@@ -97,21 +93,42 @@ impl Replayed {
     }
 
     /// The verdict of a parity check and what to say about it, given how
-    /// many station surveys differ and how many could not be compared.
-    fn verdict(&self, stations_differ: u64, stations_unchecked: u64) -> (Verdict, Option<String>) {
+    /// many station surveys differ and how many could not be compared; a
+    /// replay `post_processed` has no differences (they are expected) but
+    /// is incomplete when frames were lost.
+    fn verdict(
+        &self,
+        stations_differ: u64,
+        stations_unchecked: u64,
+        post_processed: bool,
+    ) -> (Verdict, Option<String>) {
         let summary = &self.summary;
+        let lost = self.capture.stats.lost;
         let differences = self
             .step_losses
             .iter()
             .filter(|l| l.reason.is_a_difference())
             .count();
-        if summary.mismatched > 0 || stations_differ > 0 || differences > 0 {
+        if !post_processed && (summary.mismatched > 0 || stations_differ > 0 || differences > 0) {
             let note = format!(
                 "{} replayed solutions and {stations_differ} station surveys differ from the \
                  probe's; {differences} commands or navigation modes differ (see \"out of step\")",
                 summary.mismatched
             );
             return (Verdict::Different, Some(note));
+        }
+        if lost > 0 {
+            let note = format!(
+                "{lost} frames lost in the capture could not be compared; {} probe solutions and \
+                 {stations_unchecked} probe station surveys could not be compared either",
+                summary.unchecked
+            );
+            return (Verdict::Incomplete, Some(note));
+        }
+        if post_processed {
+            // What was not compared is out of step with another
+            // calibration or site: expected, as the differences are.
+            return (Verdict::Parity, None);
         }
         if stations_unchecked > 0 {
             let note = format!("{stations_unchecked} probe station surveys could not be compared");
@@ -142,10 +159,18 @@ impl Replayed {
             "probe restarts   {} (the replay restarted with it)",
             summary.restarts
         );
+        let lost = self.capture.stats.lost;
         let _ = writeln!(
             text,
-            "replay parity    {} identical, {} different, {} not compared",
-            summary.matched, summary.mismatched, summary.unchecked
+            "replay parity    {} identical, {} different, {} not compared{}",
+            summary.matched,
+            summary.mismatched,
+            summary.unchecked + lost,
+            if lost > 0 {
+                format!(" ({lost} of them frames lost in the capture)")
+            } else {
+                String::new()
+            }
         );
         for command in &self.commands {
             let _ = writeln!(text, "uplink           {command}");
@@ -243,6 +268,22 @@ mod tests {
             report.note.as_deref(),
             Some("1 probe station surveys could not be compared")
         );
+    }
+
+    #[test]
+    fn frames_lost_are_counted_as_not_compared_and_incomplete_even_post_processed() {
+        let mut r = replayed(ReplaySummary::default(), Some(StationSummary::default()));
+        r.capture.stats.lost = 2;
+        for post_processed in [false, true] {
+            let report = r.report(None, post_processed);
+            assert_eq!(report.verdict, Verdict::Incomplete, "{post_processed}");
+            assert!(report
+                .text
+                .contains("0 identical, 0 different, 2 not compared (2 of them frames lost"));
+            assert!(report
+                .note
+                .is_some_and(|n| n.starts_with("2 frames lost in the capture")));
+        }
     }
 
     #[test]

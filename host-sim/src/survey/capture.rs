@@ -13,6 +13,7 @@ use crate::formats::files::read_depth_log;
 use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::listing::drilling::{self, DrillingSurvey, TrajectoryPoint};
+use crate::survey::listing::station_gaps::numbers_text;
 use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
 use crate::survey::stations::{StationCollector, SurveySetup};
 use crate::survey::well_survey::WellSurvey;
@@ -107,6 +108,33 @@ impl CaptureSurvey {
             ),
         };
         text + &drilling_text::listing(&self.survey, confidence)
+    }
+
+    /// What the survey could not use, if anything: frames lost in the
+    /// capture (sequence gaps) and stations lost among them. A survey with
+    /// losses is written but incomplete (`survey` exits 2).
+    pub fn incomplete(&self) -> Option<String> {
+        let frames = self.stats.lost;
+        let stations: u64 = self
+            .survey
+            .lost
+            .iter()
+            .map(|(first, last)| u64::from(last - first) + 1)
+            .sum();
+        (frames > 0 || stations > 0).then(|| {
+            let named: Vec<String> = self
+                .survey
+                .lost
+                .iter()
+                .map(|(first, last)| numbers_text(*first, *last))
+                .collect();
+            let which = if named.is_empty() {
+                "no station among them (the others' positions stand)".to_string()
+            } else {
+                format!("{stations} stations among them ({})", named.join(", "))
+            };
+            format!("the survey is incomplete: {frames} frames lost in the capture, {which}")
+        })
     }
 
     /// The survey as a station file's survey is exported (JSON, WITSML,

@@ -29,6 +29,9 @@ pub struct StationCollector {
     /// The start each station (number, first sample) was given, so that a
     /// frame sent again starts where the first did.
     seen: HashMap<(u16, u32), Option<StationStart>>,
+    /// The oldest stations were forgotten ([`Self::drop_oldest`]): the
+    /// numbers before the oldest held are not lost ones.
+    forgot_oldest: bool,
 }
 
 impl StationCollector {
@@ -67,6 +70,7 @@ impl StationCollector {
         if !self.stations.is_empty() {
             self.stations.remove(0);
             self.starts.remove(0);
+            self.forgot_oldest = true;
         }
     }
 
@@ -89,7 +93,12 @@ impl StationCollector {
         setup: &SurveySetup,
         depth: &DepthLog,
     ) -> Result<DrillingSurvey> {
-        drilling::survey(
+        let numbered_from = match (self.forgot_oldest, self.stations.first()) {
+            (true, Some(oldest)) => oldest.station,
+            _ => drilling::FIRST_STATION,
+        };
+        drilling::survey_numbered_from(
+            numbered_from,
             &self.stations,
             &self.azimuth_sigma_before(),
             links,

@@ -37,11 +37,11 @@ pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// The run was refused: exit 1 or 2 (argument error), `needle` in its
-/// stderr, and no panic.
+/// The run was refused: exit 1 (an error, the command line's too),
+/// `needle` in its stderr, and no panic.
 pub fn refused(run: &Run, needle: &str) {
     assert!(
-        matches!(run.code, Some(1 | 2)),
+        matches!(run.code, Some(1)),
         "exit {:?}, stderr {}",
         run.code,
         run.stderr
@@ -73,6 +73,11 @@ pub fn plan(name: &str) -> PathBuf {
 /// configured with [`TIED_IN_JOB`], in `dir`: the capture, its depth log
 /// and the job file.
 pub fn simulate_tied_in(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
+    simulate_tied_in_on(dir, "qemu-short.json")
+}
+
+/// [`simulate_tied_in`] along the built-in plan `plan_name` (seed 3).
+pub fn simulate_tied_in_on(dir: &Path, plan_name: &str) -> (PathBuf, PathBuf, PathBuf) {
     let (bin, depth, job) = (
         dir.join("run.bin"),
         dir.join("depth.csv"),
@@ -84,7 +89,7 @@ pub fn simulate_tied_in(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
         "--motion",
         "lateral",
         "--plan",
-        s(&plan("qemu-short.json")),
+        s(&plan(plan_name)),
         "--seed",
         "3",
         "-o",

@@ -13,6 +13,7 @@
 //! referenced to the parent well's MD at the window). Either way the depth
 //! errors counted are those of the MD drilled from the tie-on.
 
+use super::station_gaps::{lost_numbers, numbers_text};
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
 use crate::formats::depth_log::DepthLog;
 use crate::survey::iscwsa::probe_station::{
@@ -54,6 +55,13 @@ pub struct Skipped {
 pub struct DrillingSurvey {
     pub rows: Vec<DrillingRow>,
     pub skipped: Vec<Skipped>,
+    /// Station numbers the probe sent that are not in the stations (their
+    /// frames were not received), as ranges `first..=last`: between the
+    /// first number expected (1, the probe's first station since boot)
+    /// and the last received. A lost station is left out alone: the
+    /// others keep their MD (from the depth log, by time) and are
+    /// positioned across the gap.
+    pub lost: Vec<(u16, u16)>,
     /// Added to the depth log's MD (m): `--tie-on-md` minus the log at the
     /// first station; 0 without it.
     pub md_offset_m: f64,
@@ -281,6 +289,29 @@ pub fn survey(
     depth: &DepthLog,
     setup: &SurveySetup,
 ) -> Result<DrillingSurvey> {
+    survey_numbered_from(FIRST_STATION, stations, azi_before, links, depth, setup)
+}
+
+/// The number of the probe's first station since boot
+/// (`StationSurvey::station`).
+pub const FIRST_STATION: u16 = 1;
+
+/// [`survey`] of stations numbered from `first_number` on (a display that
+/// forgot its oldest stations: the oldest it holds): a number from there
+/// to the last received that is not among `stations` is a lost station.
+/// The tie-on is the first usable station: when a station before the
+/// first kept one was lost, which station the tie-on belongs to is not
+/// known, and a tie-on given (its MD or position) is refused rather than
+/// put on a later station (every station would move).
+pub fn survey_numbered_from(
+    first_number: u16,
+    stations: &[StationSurvey],
+    azi_before: &[Option<f64>],
+    links: &[Option<StationLink>],
+    depth: &DepthLog,
+    setup: &SurveySetup,
+) -> Result<DrillingSurvey> {
+    let lost = lost_numbers(first_number, stations);
     let SurveySetup {
         tie, terms, site, ..
     } = setup;
@@ -333,9 +364,22 @@ pub fn survey(
             links.get(k).copied().flatten(),
         ));
     }
-    let Some(&(_, _, first_md, ..)) = kept.first() else {
+    let Some(&(first_kept, _, first_md, ..)) = kept.first() else {
         bail!("no usable station survey in the capture");
     };
+    if let Some(&(from, to)) = lost.first().filter(|(from, _)| *from < first_kept.station) {
+        if !tie.is_surface() {
+            bail!(
+                "{} lost (frame not received) before station {}, the first usable one \
+                 received: the tie-on belongs to the probe's first usable station, so it \
+                 cannot be placed, and putting it on station {} would move every station \
+                 (survey a capture that holds the lost station)",
+                numbers_text(from, to),
+                first_kept.station,
+                first_kept.station
+            );
+        }
+    }
     let md_offset_m = tie.md.map_or(0.0, |md| md - first_md);
     let mut file = StationFile {
         unit: LengthUnit::Metre,
@@ -416,6 +460,7 @@ pub fn survey(
     Ok(DrillingSurvey {
         rows,
         skipped,
+        lost,
         md_offset_m,
         bit,
         tie_on_cov_m2: tie.covariance_m2(LengthUnit::Metre),

@@ -4,6 +4,7 @@
 
 use super::drilling::{BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint};
 use super::ellipse::scale_2d;
+use super::station_gaps::lost_line;
 use super::LengthUnit;
 use mwd_core::probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD;
 use mwd_core::protocol::frame::station_flags;
@@ -48,8 +49,16 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         "st", "MD m", "inc deg", "azi deg", "tf deg", "TVD m", "N m", "E m", "sN m", "sE m", "sV m",
         "major m", "minor m", "az"
     );
+    // A lost station's line where it would have been.
+    let mut lost = s.lost.iter().peekable();
     for r in &s.rows {
+        while let Some((first, last)) = lost.next_if(|(first, _)| *first < r.survey.station) {
+            let _ = writeln!(out, "{}", lost_line(*first, *last));
+        }
         let _ = writeln!(out, "{}", line(r, confidence));
+    }
+    for (first, last) in lost {
+        let _ = writeln!(out, "{}", lost_line(*first, *last));
     }
     if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {
         let _ = writeln!(out, "{}", bit_line(bit, last, confidence));

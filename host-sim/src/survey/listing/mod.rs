@@ -17,6 +17,7 @@ mod error_models;
 pub mod plot;
 mod positions;
 pub mod separation;
+pub mod station_gaps;
 
 pub use crate::formats::station_csv::{
     read_stations, InputStation, LengthUnit, StationFile, FOOT_M,
