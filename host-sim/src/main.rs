@@ -20,6 +20,8 @@ fn main() -> ExitCode {
         }
     };
     match commands::run(cli) {
+        // Its output not whole: an error, whatever the command thought.
+        Ok(_) if commands::output::failed() => ExitCode::from(commands::status::ERROR),
         Ok(status) => status,
         Err(err) => {
             eprintln!("error: {err:#}");

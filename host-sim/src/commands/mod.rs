@@ -9,7 +9,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 #[macro_use]
-mod output;
+pub(crate) mod output;
 
 mod align;
 mod allan;

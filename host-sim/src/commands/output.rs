@@ -30,9 +30,21 @@ pub fn print_out(text: &str) -> anyhow::Result<()> {
     }
 }
 
+/// Set when standard output could not be written (another error than a
+/// closed pipe): the command then fails ([`failed`]) whatever it did.
+static FAILED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Whether writing standard output failed (a full disk behind a
+/// redirection, `> /dev/full`): the command's output is not whole, so it
+/// must not exit as if it were (`main` exits 1).
+pub fn failed() -> bool {
+    FAILED.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// What [`outln!`] calls: one line through [`print_out`]. Another write
 /// error than a closed pipe (a full disk behind a redirection) is said on
-/// stderr rather than panicking as `println!` would.
+/// stderr once, rather than panicking as `println!` would, and makes the
+/// command fail ([`failed`]).
 pub fn print_line(args: std::fmt::Arguments<'_>) {
     print_text(format_args!("{args}\n"));
 }
@@ -40,7 +52,9 @@ pub fn print_line(args: std::fmt::Arguments<'_>) {
 /// What [`out!`] calls.
 pub fn print_text(args: std::fmt::Arguments<'_>) {
     if let Err(e) = print_out(&args.to_string()) {
-        eprintln!("error: writing to standard output: {e:#}");
+        if !FAILED.swap(true, std::sync::atomic::Ordering::Relaxed) {
+            eprintln!("error: writing to standard output: {e:#}");
+        }
     }
 }
 

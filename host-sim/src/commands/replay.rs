@@ -222,12 +222,16 @@ fn replay_live(args: &Args, port: &str, probe: ReplayedProbe) -> anyhow::Result<
         outln!("{status}")
     });
     outln!("end of stream    {}", outcome.end);
+    if let live::StreamEnd::OutputFailed(e) = &outcome.end {
+        anyhow::bail!("writing the live session's output: {e}");
+    }
+    // Named only now (`OutputFile`): a session that failed leaves none.
+    for file in [save, csv].into_iter().flatten() {
+        file.finish()?;
+    }
     if let Some(path) = &args.save {
         let bytes = outcome.replayed.capture.stats.bytes;
         outln!("saved            {} ({bytes} bytes)", path.display());
-    }
-    if let live::StreamEnd::OutputFailed(e) = &outcome.end {
-        anyhow::bail!("writing the live session's output: {e}");
     }
     outcome.replayed.source = port.to_string();
     Ok(outcome.replayed)

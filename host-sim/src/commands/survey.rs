@@ -386,12 +386,12 @@ fn run_streamed(
         listing: &mut listing,
         csv: csv.as_mut().map(|w| w as &mut dyn std::io::Write),
     };
-    let surveyed = survey_streamed(path, units, &inputs, site_for, units, outputs);
-    if let (Err(_), Some(csv)) = (&surveyed, &args.csv) {
-        // no partial file: the error says why
-        let _ = std::fs::remove_file(csv);
+    // An error drops the CSV unfinished: no partial file, the error says why.
+    survey_streamed(path, units, &inputs, site_for, units, outputs)?;
+    if let Some(csv) = csv {
+        csv.finish()?;
     }
-    surveyed.map(drop)
+    Ok(())
 }
 
 /// The offset well's options are refused without `--offset`.

@@ -4,17 +4,16 @@
 //! its summary.
 
 use crate::formats::capture::{self, CaptureSummary, Item, ProbeCaptureFile};
-use crate::formats::files::create_buffered;
+use crate::formats::files::{create_buffered, OutputFile};
 use anyhow::{Context, Result};
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A decoded capture: its summary, and the CSV of its frames still to be
 /// flushed ([`Decoded::finish_csv`]).
 pub struct Decoded {
     pub summary: CaptureSummary,
-    csv: Option<(PathBuf, BufWriter<File>)>,
+    csv: Option<(PathBuf, OutputFile)>,
     rows: u64,
 }
 
@@ -48,11 +47,10 @@ pub fn decode_file(path: &Path, csv: Option<&Path>) -> Result<Decoded> {
 impl Decoded {
     /// Flushes the CSV; gives its path and rows, if one was asked for.
     pub fn finish_csv(self) -> Result<Option<(PathBuf, u64)>> {
-        let Some((out, mut w)) = self.csv else {
+        let Some((out, w)) = self.csv else {
             return Ok(None);
         };
-        w.flush()
-            .with_context(|| format!("writing {}", out.display()))?;
+        w.finish()?;
         Ok(Some((out, self.rows)))
     }
 }

@@ -64,8 +64,8 @@ pub fn replay_file(
     let sink = out.as_mut().map(|w| w as &mut dyn Write);
     replayer.write_settled(sink, true).map_err(csv_error)?;
     // The header alone (no raw frame) was never flushed with rows.
-    if let Some(w) = out.as_mut() {
-        w.flush().map_err(csv_error)?;
+    if let Some(w) = out {
+        w.finish()?;
     }
     let step_losses = replayer.step_losses().to_vec();
     let commands = replayer.commands().to_vec();

@@ -6,7 +6,7 @@
 //! kept).
 
 use crate::formats::capture::ProbeSetup;
-use crate::formats::files::{create_buffered, is_broken_pipe};
+use crate::formats::files::{create_buffered, is_broken_pipe, OutputFile};
 use crate::formats::{capture, samples_csv};
 use crate::sim::stream::SensorStreamWriter;
 use crate::sim::{Drilling, DrillingSimulator, SensorModel, SimSample, Truth};
@@ -54,11 +54,13 @@ fn write_capture(
     samples: impl Iterator<Item = SimSample>,
     probe: &ProbeSetup,
 ) -> Result<u64> {
-    let mut capture =
-        capture::create_capture(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut capture = capture::create_capture(path)?;
     capture::write_simulated_probe(&mut capture, samples, probe)?;
     let bytes = capture.bytes_written();
-    capture.finish()?;
+    capture
+        .finish()
+        .with_context(|| format!("writing {}", path.display()))?
+        .finish()?;
     Ok(bytes)
 }
 
@@ -66,8 +68,7 @@ fn write_capture(
 fn write_csv(path: &Path, samples: impl Iterator<Item = SimSample>) -> Result<()> {
     let mut out = create_buffered(path)?;
     samples_csv::write(&mut out, samples)?;
-    out.flush()?;
-    Ok(())
+    out.finish()
 }
 
 /// Longest drilling run simulated: 7 days (a 1000 m lateral at 30 m/h
@@ -126,6 +127,9 @@ pub fn drill(
         Some(p) => Some(SensorStreamWriter::create(p, n)?),
         None => None,
     };
+    // Created before the samples are written: a depth log that cannot be
+    // created fails the run before any output is named.
+    let depth_log = outputs.depth_log.map(create_buffered).transpose()?;
     let mut counts = OverRange::default();
     let mut failure: Option<anyhow::Error> = None;
     let every = outputs.truth_every;
@@ -159,15 +163,15 @@ pub fn drill(
     if let Some(w) = stream {
         w.finish()?;
     }
-    if let Some(p) = outputs.depth_log {
-        write_depth_log(p, drilling)?;
+    if let Some(out) = depth_log {
+        write_depth_log(out, drilling)?;
     }
     Ok(counts)
 }
 
 /// The truth trajectory CSV.
 struct TruthWriter {
-    out: std::io::BufWriter<std::fs::File>,
+    out: OutputFile,
     path: PathBuf,
 }
 
@@ -207,21 +211,20 @@ impl TruthWriter {
         .with_context(|| format!("writing {}", self.path.display()))
     }
 
-    fn finish(mut self) -> Result<()> {
-        self.out
-            .flush()
-            .with_context(|| format!("writing {}", self.path.display()))
+    fn finish(self) -> Result<()> {
+        self.out.finish()
     }
 }
 
 /// The surface depth log: time_s, md_m (with the plan's depth errors).
-fn write_depth_log(path: &Path, drilling: &Drilling) -> Result<()> {
-    let mut out = create_buffered(path)?;
-    writeln!(out, "time_s,md_m")?;
-    for (t, md) in drilling.depth_log() {
-        writeln!(out, "{t:.3},{md:.4}")?;
-    }
-    out.flush()
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
+fn write_depth_log(mut out: OutputFile, drilling: &Drilling) -> Result<()> {
+    let mut rows = || -> std::io::Result<()> {
+        writeln!(out, "time_s,md_m")?;
+        for (t, md) in drilling.depth_log() {
+            writeln!(out, "{t:.3},{md:.4}")?;
+        }
+        Ok(())
+    };
+    rows().with_context(|| format!("writing {}", out.path().display()))?;
+    out.finish()
 }

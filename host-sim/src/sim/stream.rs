@@ -6,12 +6,13 @@
 //! QEMU probe (feature `qemu-drilling`) feeds its simulated parts from it,
 //! so the probe in QEMU and the host's `.bin` capture see the same physics.
 use super::sensor::SimSample;
+use crate::formats::files::OutputFile;
 use anyhow::{Context, Result};
 use hil_mock::stream::{encode_record, StreamHeader, StreamRecord};
 use hil_mock::PhysicalSample;
 use mwd_core::sensor_units::PART_MOUNTINGS;
 use mwd_core::timing::SAMPLE_RATE_HZ;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The temperature both parts read: the simulator has no thermal model,
@@ -35,7 +36,7 @@ pub fn part_record(s: &SimSample) -> StreamRecord {
 
 /// Writes a stream of a known number of samples.
 pub struct SensorStreamWriter {
-    out: BufWriter<std::fs::File>,
+    out: OutputFile,
     path: PathBuf,
     expected: u32,
     written: u32,
@@ -48,9 +49,7 @@ impl SensorStreamWriter {
             .ok()
             .filter(|&n| n > 0)
             .with_context(|| format!("a sensor stream holds 1 to 2^32-1 samples, not {count}"))?;
-        let file =
-            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut out = BufWriter::new(file);
+        let mut out = OutputFile::create(path)?;
         let header = StreamHeader {
             sample_rate_hz: SAMPLE_RATE_HZ as u32,
             sample_count: expected,
@@ -89,7 +88,7 @@ impl SensorStreamWriter {
     }
 
     /// Flushes; fails unless every announced sample was written.
-    pub fn finish(mut self) -> Result<()> {
+    pub fn finish(self) -> Result<()> {
         anyhow::ensure!(
             self.written == self.expected,
             "{}: {} samples written of the {} announced",
@@ -97,9 +96,7 @@ impl SensorStreamWriter {
             self.written,
             self.expected
         );
-        self.out
-            .flush()
-            .with_context(|| format!("writing {}", self.path.display()))
+        self.out.finish()
     }
 }
 

@@ -1,8 +1,8 @@
 //! Writing a capture: simulated samples as the probe's raw-sample frames,
 //! and the navigation frames its own navigation code makes of them.
 
-use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use crate::formats::files::OutputFile;
+use std::io::{self, Write};
 use std::path::Path;
 
 use anyhow::Context;
@@ -149,9 +149,10 @@ impl<W: Write> CaptureWriter<W> {
     }
 }
 
-/// Creates a `.bin` capture file.
-pub fn create_capture(path: &Path) -> io::Result<CaptureWriter<BufWriter<File>>> {
-    Ok(CaptureWriter::new(BufWriter::new(File::create(path)?)))
+/// Creates a `.bin` capture file, named only when finished
+/// ([`OutputFile`]: `finish` the writer, then the file).
+pub fn create_capture(path: &Path) -> anyhow::Result<CaptureWriter<OutputFile>> {
+    Ok(CaptureWriter::new(OutputFile::create(path)?))
 }
 
 /// The `code` of a simulated capture's boot event (a real probe sends its
