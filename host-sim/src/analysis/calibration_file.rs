@@ -217,7 +217,7 @@ impl CalibrationFile {
         self.check()
             .with_context(|| format!("not writing {}", path.display()))?;
         let text = serde_json::to_string_pretty(self)? + "\n";
-        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+        crate::formats::files::write_text(path, &text)
     }
 
     /// The probe's whole correction: the first two triads (x-gyro part,

@@ -163,8 +163,7 @@ impl ArModelFile {
     /// Writes the file as pretty JSON.
     pub fn save(&self, path: &Path) -> Result<()> {
         let text = serde_json::to_string_pretty(self)?;
-        std::fs::write(path, text + "\n")
-            .with_context(|| format!("cannot write {}", path.display()))
+        crate::formats::files::write_text(path, &(text + "\n"))
     }
 
     /// The model of a named sensor.
