@@ -97,6 +97,60 @@ fn setup(sensor_to_bit: Option<f64>) -> SurveySetup {
     .with_sensor_to_bit(sensor_to_bit)
 }
 
+/// A station frame received twice is taken once; a lost one is listed as
+/// lost where it was, the others keep their MD; a tie-on given with the
+/// first station lost is refused, not moved to the next station.
+#[test]
+fn repeated_and_lost_stations() {
+    let stations: Vec<StationSurvey> = (0..4)
+        .map(|k| station(k as u16 + 1, 100.0 * (k + 1) as f64, 0.1))
+        .collect();
+    let whole = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
+    // station 2 received twice, one after the other
+    let mut repeated = [stations.clone(), vec![stations[1]]].concat();
+    repeated.sort_by_key(|s| s.station);
+    let again = survey(&repeated, &[], &[], &log(), &setup(None)).unwrap();
+    assert_eq!(again.rows.len(), 4);
+    assert!(again.skipped.is_empty() && again.lost.is_empty());
+    for (a, b) in again.rows.iter().zip(&whole.rows) {
+        assert_eq!(a.row.md_m, b.row.md_m);
+        assert_eq!(a.row.cov, b.row.cov);
+    }
+    let without_2: Vec<_> = stations
+        .iter()
+        .filter(|s| s.station != 2)
+        .copied()
+        .collect();
+    let gap = survey(&without_2, &[], &[], &log(), &setup(None)).unwrap();
+    assert_eq!(gap.lost, vec![(2, 2)]);
+    let mds = |s: &host_sim::survey::listing::drilling::DrillingSurvey| -> Vec<f64> {
+        s.rows.iter().map(|r| r.row.md_m).collect()
+    };
+    assert_eq!(mds(&gap), [1000.0, 1020.0, 1030.0]);
+    let text = listing(&gap, 0.95);
+    let lost_at = text.find("station 2 lost (frame not received)").unwrap();
+    let three_at = text.find("\n  3 ").unwrap();
+    assert!(lost_at < three_at, "{text}");
+    // the first station lost: a tie-on MD cannot be placed
+    let tied = SurveySetup {
+        tie: TieOnInput {
+            md: Some(3000.0),
+            ..TIE
+        },
+        ..setup(None)
+    };
+    let e = survey(&stations[1..], &[], &[], &log(), &tied).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("station 1 lost (frame not received) before station 2"),
+        "{e}"
+    );
+    assert_eq!(
+        mds(&survey(&stations, &[], &[], &log(), &tied).unwrap())[0],
+        3000.0
+    );
+}
+
 #[test]
 fn synthetic_stations_are_positioned_with_the_random_walk_depth_and_method_uncertainty() {
     let sig = [0.1, 0.2, 0.3, 0.4];

@@ -30,7 +30,7 @@ pub const HELP_SURVEY: &str =
     "Exit status: 0 complete; 1 error (bad argument, unreadable input, an output that could \
      not be written, the tie-on's station lost: no success is claimed, no partial file is \
      left); 2 written but incomplete: a capture's frames were lost (their count said on \
-     standard error; a lost station is listed as lost, the others keep their places).";
+     standard error; a lost station is listed as lost, the others keep their MD).";
 
 /// A command's status: complete, or incomplete with `why` said on
 /// standard error as a warning.

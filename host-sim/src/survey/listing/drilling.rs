@@ -318,7 +318,12 @@ pub fn survey_numbered_from(
     let mut skipped = Vec::new();
     let mut kept: Vec<Kept> = Vec::new();
     let (first, last) = depth.span();
+    // A station frame received twice (sent again) is one station.
+    let mut received = std::collections::HashSet::new();
     for (k, s) in stations.iter().enumerate() {
+        if !received.insert((s.station, s.time_us)) {
+            continue;
+        }
         if let Some(reason) = unusable(s) {
             skipped.push(Skipped {
                 survey: *s,
