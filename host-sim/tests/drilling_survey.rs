@@ -93,6 +93,7 @@ fn setup(sensor_to_bit: Option<f64>) -> SurveySetup {
         terms: survey_terms().unwrap(),
         site: site(),
         sensor_to_bit_m: None,
+        first_station: 1,
     }
     .with_sensor_to_bit(sensor_to_bit)
 }

@@ -459,6 +459,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         terms: config.terms.clone(),
         site: config.site,
         sensor_to_bit_m: None,
+        first_station: drilling::FIRST_STATION,
     };
     let survey = collected.survey(&links, &setup, &depth);
     let (td, td_note, method_td_error_ne) = match survey {

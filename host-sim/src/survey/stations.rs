@@ -93,12 +93,18 @@ impl StationCollector {
         setup: &SurveySetup,
         depth: &DepthLog,
     ) -> Result<DrillingSurvey> {
-        let numbered_from = match (self.forgot_oldest, self.stations.first()) {
-            (true, Some(oldest)) => oldest.station,
-            _ => drilling::FIRST_STATION,
+        let from_oldest;
+        let setup = match (self.forgot_oldest, self.stations.first()) {
+            (true, Some(oldest)) => {
+                from_oldest = SurveySetup {
+                    first_station: oldest.station,
+                    ..setup.clone()
+                };
+                &from_oldest
+            }
+            _ => setup,
         };
-        drilling::survey_numbered_from(
-            numbered_from,
+        drilling::survey(
             &self.stations,
             &self.azimuth_sigma_before(),
             links,

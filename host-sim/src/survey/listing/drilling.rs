@@ -13,7 +13,8 @@
 //! referenced to the parent well's MD at the window). Either way the depth
 //! errors counted are those of the MD drilled from the tie-on.
 
-use super::station_gaps::{lost_numbers, numbers_text};
+pub use super::station_gaps::FIRST_STATION;
+use super::station_gaps::{lost_numbers, tie_on_station_known};
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
 use crate::formats::depth_log::DepthLog;
 use crate::survey::iscwsa::probe_station::{
@@ -104,6 +105,9 @@ pub struct SurveySetup {
     pub site: Site,
     /// From the survey sensors to the bit, m (> 0); `None`: no projection.
     pub sensor_to_bit_m: Option<f64>,
+    /// The number of the first station expected ([`FIRST_STATION`]; a
+    /// display that forgot its oldest stations: the oldest it holds).
+    pub first_station: u16,
 }
 
 impl SurveySetup {
@@ -122,6 +126,7 @@ impl SurveySetup {
                 gyro_noise_reduction: 1.0,
             },
             sensor_to_bit_m: None,
+            first_station: FIRST_STATION,
         })
     }
 
@@ -281,7 +286,12 @@ type Kept = (StationSurvey, f64, f64, Option<f64>, Option<StationLink>);
 /// correlation; shorter than `stations` (empty) where not known; `links`:
 /// each station's link from the probe (`Navigator::station_link`; empty
 /// where not known: no frame carries them yet), for the chain in the
-/// links' states (`survey_error::probe_station`).
+/// links' states (`survey_error::probe_station`). A station number from `setup.first_station` to the last received that
+/// is not among `stations` is a lost station. The tie-on is the first
+/// usable station: when a station before the first kept one was lost,
+/// which station the tie-on belongs to is not known, and a tie-on given
+/// (its MD or position) is refused rather than put on a later station
+/// (every station would move).
 pub fn survey(
     stations: &[StationSurvey],
     azi_before: &[Option<f64>],
@@ -289,29 +299,7 @@ pub fn survey(
     depth: &DepthLog,
     setup: &SurveySetup,
 ) -> Result<DrillingSurvey> {
-    survey_numbered_from(FIRST_STATION, stations, azi_before, links, depth, setup)
-}
-
-/// The number of the probe's first station since boot
-/// (`StationSurvey::station`).
-pub const FIRST_STATION: u16 = 1;
-
-/// [`survey`] of stations numbered from `first_number` on (a display that
-/// forgot its oldest stations: the oldest it holds): a number from there
-/// to the last received that is not among `stations` is a lost station.
-/// The tie-on is the first usable station: when a station before the
-/// first kept one was lost, which station the tie-on belongs to is not
-/// known, and a tie-on given (its MD or position) is refused rather than
-/// put on a later station (every station would move).
-pub fn survey_numbered_from(
-    first_number: u16,
-    stations: &[StationSurvey],
-    azi_before: &[Option<f64>],
-    links: &[Option<StationLink>],
-    depth: &DepthLog,
-    setup: &SurveySetup,
-) -> Result<DrillingSurvey> {
-    let lost = lost_numbers(first_number, stations);
+    let lost = lost_numbers(setup.first_station, stations);
     let SurveySetup {
         tie, terms, site, ..
     } = setup;
@@ -372,19 +360,7 @@ pub fn survey_numbered_from(
     let Some(&(first_kept, _, first_md, ..)) = kept.first() else {
         bail!("no usable station survey in the capture");
     };
-    if let Some(&(from, to)) = lost.first().filter(|(from, _)| *from < first_kept.station) {
-        if !tie.is_surface() {
-            bail!(
-                "{} lost (frame not received) before station {}, the first usable one \
-                 received: the tie-on belongs to the probe's first usable station, so it \
-                 cannot be placed, and putting it on station {} would move every station \
-                 (survey a capture that holds the lost station)",
-                numbers_text(from, to),
-                first_kept.station,
-                first_kept.station
-            );
-        }
-    }
+    tie_on_station_known(&lost, first_kept.station, !tie.is_surface())?;
     let md_offset_m = tie.md.map_or(0.0, |md| md - first_md);
     let mut file = StationFile {
         unit: LengthUnit::Metre,

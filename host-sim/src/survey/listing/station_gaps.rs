@@ -2,8 +2,13 @@
 //! numbers found from the ones received (the probe numbers its stations
 //! from 1 since boot, one by one), and how a listing names them.
 
+use anyhow::{bail, Result};
 use mwd_core::protocol::StationSurvey;
 use std::collections::BTreeSet;
+
+/// The number of the probe's first station since boot
+/// (`StationSurvey::station`).
+pub const FIRST_STATION: u16 = 1;
 
 /// The station numbers from `first_number` to the last received that no
 /// station in `stations` has, as ranges `first..=last`.
@@ -18,6 +23,24 @@ pub fn lost_numbers(first_number: u16, stations: &[StationSurvey]) -> Vec<(u16, 
         next = n.saturating_add(1);
     }
     lost
+}
+
+/// The tie-on is the first usable station: with stations `lost` before
+/// `first_kept` (the first usable one received), which station it is is
+/// not known. A tie-on `given` (its MD or position) is then refused rather
+/// than put on a later station, which would move every station by a
+/// stand; without one the stations are placed from the surface anyway.
+pub fn tie_on_station_known(lost: &[(u16, u16)], first_kept: u16, given: bool) -> Result<()> {
+    match lost.first() {
+        Some(&(from, to)) if given && from < first_kept => bail!(
+            "{} lost (frame not received) before station {first_kept}, the first usable one \
+             received: the tie-on belongs to the probe's first usable station, so it cannot be \
+             placed, and putting it on station {first_kept} would move every station (survey a \
+             capture that holds the lost station)",
+            numbers_text(from, to)
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// "station 3" or "stations 3 to 5".
