@@ -70,17 +70,10 @@ fn an_output_file_that_cannot_be_written_is_an_error_and_none_is_left() {
     }
     // a later output that cannot be created: the capture is not left
     let lateral = dir.join("lateral.bin");
-    let out = run(&[
-        "simulate",
-        "--motion",
-        "lateral",
-        "--plan",
-        s(&plan("qemu-short.json")),
-        "-o",
-        s(&lateral),
-        "--depth-log",
-        s(&dir.join("no-such-dir").join("depth.csv")),
-    ]);
+    let (short, depth) = (plan("qemu-short.json"), dir.join("no-such-dir/depth.csv"));
+    let mut args = vec!["simulate", "--motion", "lateral", "--plan", s(&short)];
+    args.extend(["-o", s(&lateral), "--depth-log", s(&depth)]);
+    let out = run(&args);
     assert_eq!(out.code, Some(1), "{}", out.stderr);
     assert!(out.stderr.contains("depth.csv"), "{}", out.stderr);
     assert!(!lateral.exists());
