@@ -4,6 +4,7 @@
 //! ([`crate::survey::streamed`]) write the same bytes. Lengths in the
 //! survey's output unit, each header naming it.
 
+use crate::formats::fixed::push_fixed;
 use crate::survey::iscwsa::Cov6;
 use crate::survey::listing::ellipse::scale_2d;
 use crate::survey::listing::separation::Separation;
@@ -114,31 +115,38 @@ pub fn listing_head(h: &Head) -> String {
 pub fn listing_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String {
     let u = h.unit;
     let len = |m: f64| u.from_m(m);
-    let mut line = format!(
-        "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
-        len(r.md_m),
-        r.inc_deg,
-        r.azi_deg,
-        len(r.tvd_m),
-        len(r.north_m),
-        len(r.east_m),
-        u.dls_from_per_30m(r.dls_deg_per_30m),
-        len(r.vsec_m)
-    );
+    let mut line = String::with_capacity(160);
+    // (value, decimals, width), each after one space but the first
+    let mut put = |cells: &[(f64, usize, usize)]| {
+        for &(x, decimals, width) in cells {
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            push_fixed(&mut line, x, decimals, width);
+        }
+    };
+    put(&[
+        (len(r.md_m), 2, 9),
+        (r.inc_deg, 2, 7),
+        (r.azi_deg, 2, 7),
+        (len(r.tvd_m), 2, 9),
+        (len(r.north_m), 2, 9),
+        (len(r.east_m), 2, 9),
+        (u.dls_from_per_30m(r.dls_deg_per_30m), 2, 6),
+        (len(r.vsec_m), 2, 9),
+    ]);
     if h.model.is_some() {
         match (r.cov, r.ellipse()) {
             (Some(c), Some(e)) => {
                 let (a, b) = e.scaled(h.confidence);
-                let _ = write!(
-                    line,
-                    " {:>7.2} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>6.1}",
-                    len(c[0].max(0.0).sqrt()),
-                    len(c[1].max(0.0).sqrt()),
-                    len(e.sigma_vert),
-                    len(a),
-                    len(b),
-                    e.azimuth_deg
-                );
+                put(&[
+                    (len(c[0].max(0.0).sqrt()), 2, 7),
+                    (len(c[1].max(0.0).sqrt()), 2, 7),
+                    (len(e.sigma_vert), 2, 7),
+                    (len(a), 2, 8),
+                    (len(b), 2, 8),
+                    (e.azimuth_deg, 1, 6),
+                ]);
             }
             _ => line += "  (outside the model's validity)",
         }
@@ -193,7 +201,9 @@ pub fn csv_head(h: &Head) -> String {
 pub fn csv_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String {
     let u = h.unit;
     let len = |m: f64| u.from_m(m);
-    let mut out = format!(
+    let mut out = String::with_capacity(320);
+    let _ = write!(
+        out,
         "{},{},{},{},{},{},{},{},{},{}",
         len(r.md_m),
         r.inc_deg,
