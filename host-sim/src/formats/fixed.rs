@@ -43,8 +43,7 @@ fn fast_digits(x: f64, decimals: usize, buf: &mut [u8; 32]) -> Option<&str> {
     const SCALE: [f64; 7] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6];
     let scale = *SCALE.get(decimals)?;
     let y = x.abs() * scale;
-    if !(y < FAST_LIMIT) {
-        // NaN, infinite or too large
+    if !y.is_finite() || y >= FAST_LIMIT {
         return None;
     }
     let r = y.round();
@@ -99,15 +98,45 @@ mod tests {
     #[test]
     fn the_text_is_the_standard_librarys_on_edges_and_ties() {
         let edges = [
-            0.0, -0.0, 0.004, -0.004, 0.005, -0.005, 0.015, 0.125, 0.375, 2.5, 1.005, 1.015,
-            0.045, 99.995, 999.995, 1e-300, -1e-300, 123456.785, 1e7, 9.999999, 1e9, 1e12,
-            f64::NAN, f64::INFINITY, f64::NEG_INFINITY, f64::MAX, f64::MIN_POSITIVE, 360.0,
-            359.999, -359.995,
+            0.0,
+            -0.0,
+            0.004,
+            -0.004,
+            0.005,
+            -0.005,
+            0.015,
+            0.125,
+            0.375,
+            2.5,
+            1.005,
+            1.015,
+            0.045,
+            99.995,
+            999.995,
+            1e-300,
+            -1e-300,
+            123456.785,
+            1e7,
+            9.999999,
+            1e9,
+            1e12,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            360.0,
+            359.999,
+            -359.995,
         ];
         for x in edges {
             for decimals in 0..=4 {
                 for width in [0, 6, 9] {
-                    assert_eq!(ours(x, decimals, width), std_text(x, decimals, width), "{x}");
+                    assert_eq!(
+                        ours(x, decimals, width),
+                        std_text(x, decimals, width),
+                        "{x}"
+                    );
                 }
             }
         }
