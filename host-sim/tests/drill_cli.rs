@@ -76,6 +76,23 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
     );
     let csv = std::fs::read_to_string(run_dir.join("stations.csv")).unwrap();
     assert!(csv.lines().last().unwrap().starts_with("bit,,"), "{csv}");
+    // every station checked against the site's gravity and earth rate,
+    // each gravity within a few mg of the site's (a still, calibrated probe)
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (qc, error) = (col("qc"), col("gravity_error_m_s2"));
+    for line in csv.lines().skip(1).filter(|l| !l.starts_with("bit")) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_ne!(cells[qc], "not checked", "{line}");
+        let e: f64 = cells[error].parse().unwrap();
+        assert!(e.abs() < 0.1, "{line}");
+    }
+    let listing_text = std::fs::read_to_string(run_dir.join("listing.txt")).unwrap();
+    assert!(
+        listing_text.contains("station QC:")
+            && listing_text.contains("stations checked out of tolerance"),
+        "{listing_text}"
+    );
 
     // The same capture surveyed by `survey CAPTURE --job`: the same listing,
     // and the station-file survey's exports.

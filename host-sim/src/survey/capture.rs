@@ -12,8 +12,9 @@ use crate::formats::depth_log::DepthLog;
 use crate::formats::files::read_depth_log;
 use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
-use crate::survey::listing::drilling::{self, DrillingSurvey, TrajectoryPoint};
+use crate::survey::listing::drilling::{self, DrillingSurvey, QcReference, TrajectoryPoint};
 use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
+use crate::survey::station_qc::{CheckedStations, QcCollector, QcTolerances};
 use crate::survey::stations::{StationCollector, SurveySetup};
 use crate::survey::well_survey::WellSurvey;
 use anyhow::{Context, Result};
@@ -61,10 +62,21 @@ impl CaptureSurvey {
         let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?
             .with_sensor_to_bit(inputs.sensor_to_bit_m);
         let links = read.links;
-        let survey = read
+        let mut survey = read
             .collected
             .survey(links.as_deref().unwrap_or(&[]), &setup, &depth)
             .with_context(|| format!("{}", inputs.capture.display()))?;
+        if let Some((reference, checked)) = read.qc {
+            for row in survey.rows.iter_mut() {
+                row.qc = checked
+                    .iter()
+                    .find(|(station, end, _)| {
+                        (*station, *end) == (row.survey.station, row.survey.end_sample)
+                    })
+                    .map(|c| c.2);
+            }
+            survey.qc_reference = Some(reference);
+        }
         let SurveySetup {
             tie, terms, site, ..
         } = setup;
@@ -232,6 +244,10 @@ struct CaptureStations {
     /// (`replay::replayed_station_links`), or why there are none.
     links: Result<Vec<Option<StationLink>>, String>,
     stats: DecoderStats,
+    /// The stations' quality checks (station number, last sample, checks)
+    /// and what they were made against; `None` where the tool model has no
+    /// tolerances.
+    qc: Option<(QcReference, CheckedStations)>,
 }
 
 fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
@@ -239,10 +255,18 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
     let mut replayer = Replayer::with_settings(probe.site, probe.calibration, probe.still)
         .with_tie_in(probe.tie_in);
     let mut collected = StationCollector::default();
+    let mut qc = qc_collector(probe)?;
     let mut items = 0usize;
     while let Some(item) = capture.next_item()? {
         if let Item::Frame(frame) = &item {
             collected.push_frame(frame);
+            if let Some(qc) = qc.as_mut() {
+                match &frame.payload {
+                    Payload::Raw(raw) => qc.push_raw(raw),
+                    Payload::Station(s) => qc.push_station(s),
+                    _ => {}
+                }
+            }
         }
         replayer.push_received(item.received());
         items += 1;
@@ -256,5 +280,21 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
         collected,
         links,
         stats: *capture.stats(),
+        qc: qc.map(|q| {
+            let reference = QcReference {
+                gravity_m_s2: q.gravity(),
+                tolerances: q.tolerances(),
+            };
+            (reference, q.into_checked())
+        }),
     })
+}
+
+/// The stations' quality checks with the probe's calibration at its site,
+/// to the probe's tool model's tolerances.
+fn qc_collector(probe: &ProbeSetup) -> Result<Option<QcCollector>> {
+    let terms = listing::terms(listing::model(drilling::MODEL_NAME)?)?;
+    let gravity = mwd_core::earth::normal_gravity(probe.site.lat, probe.site.height);
+    Ok(QcTolerances::from_terms(&terms, gravity)
+        .map(|t| QcCollector::new(probe.calibration, probe.site, t)))
 }

@@ -19,6 +19,7 @@ use crate::survey::iscwsa::probe_station::{
     angle_covariance, angle_covariance_projected, links_in_order, AngleSigma,
 };
 use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site, Station};
+use crate::survey::station_qc::{QcTolerances, StationQc};
 use anyhow::{anyhow, bail, Result};
 use mwd_core::probe::StationLink;
 use mwd_core::protocol::frame::{nav_flags, nav_mode, station_flags};
@@ -40,6 +41,17 @@ pub struct DrillingRow {
     /// Every station up to this one has a determined azimuth: N/E/TVD and
     /// their covariance mean something.
     pub position_determined: bool,
+    /// The station's quality checks, where the capture had its samples
+    /// ([`crate::survey::station_qc`]).
+    pub qc: Option<StationQc>,
+}
+
+/// The site's gravity and the tolerances a capture's stations were checked
+/// against.
+#[derive(Clone, Copy, Debug)]
+pub struct QcReference {
+    pub gravity_m_s2: f64,
+    pub tolerances: QcTolerances,
 }
 
 /// A station left out, and why.
@@ -62,6 +74,8 @@ pub struct DrillingSurvey {
     /// The tie-on's position covariance (m^2) in every position's;
     /// `None`: the tie-on is taken as exact.
     pub tie_on_cov_m2: Option<Cov6>,
+    /// What the stations' quality checks were made against, where made.
+    pub qc_reference: Option<QcReference>,
 }
 
 /// The bit at the end of the depth log (TD: the log's last MD plus the
@@ -410,6 +424,7 @@ pub fn survey(
                 method_cov: covs.get(k).map(|c| c.method),
                 azimuth_determined: sigmas[k].is_some(),
                 position_determined: k < covs.len(),
+                qc: None,
             }
         })
         .collect();
@@ -419,6 +434,7 @@ pub fn survey(
         md_offset_m,
         bit,
         tie_on_cov_m2: tie.covariance_m2(LengthUnit::Metre),
+        qc_reference: None,
     })
 }
 
