@@ -61,6 +61,10 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
         serde_json::from_str(&std::fs::read_to_string(run_dir.join("survey.json")).unwrap())
             .unwrap();
     let stations = json["stations"].as_array().unwrap();
+    assert!(
+        stations.iter().all(|st| st["qc"]["result"].is_string()),
+        "every exported station carries its QC"
+    );
     let last_md = stations.last().unwrap()["md_m"].as_f64().unwrap();
     let bit = &json["bit_projection"];
     let bit_md = bit["md_m"].as_f64().unwrap();

@@ -128,13 +128,14 @@ impl CaptureSurvey {
     /// vertical section along `vsec_azimuth` (rad; `None`: the last
     /// exported station's closure azimuth).
     pub fn well_survey(&self, confidence: f64, vsec_azimuth: Option<f64>) -> Result<WellSurvey> {
-        let mut rows: Vec<Row> = self
+        let exported: Vec<_> = self
             .survey
             .rows
             .iter()
             .take_while(|r| r.position_determined && r.row.cov.is_some())
-            .map(|r| r.row)
             .collect();
+        let station_qc = exported.iter().map(|r| r.qc).collect();
+        let mut rows: Vec<Row> = exported.iter().map(|r| r.row).collect();
         let left_out = self.survey.rows.len() - rows.len();
         let bit = self
             .survey
@@ -175,6 +176,7 @@ impl CaptureSurvey {
             well: crate::survey::job::WellNames::default(),
             tie_on_cov_m2: self.survey.tie_on_cov_m2,
             output_unit: LengthUnit::Metre,
+            station_qc,
         })
     }
 

@@ -126,6 +126,17 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         .enumerate()
         .map(|(k, r)| {
             let mut v = json_station(s, r);
+            if let Some(q) = s.station_qc.get(k).copied().flatten() {
+                let deg_h = |r: f64| r.to_degrees() * 3600.0;
+                v["qc"] = serde_json::json!({
+                    "result": q.word(),
+                    "gravity_m_s2": q.gravity_m_s2,
+                    "gravity_error_m_s2": q.gravity_error_m_s2,
+                    "gravity_tolerance_m_s2": q.gravity_tolerance_m_s2,
+                    "earth_rate_residual_deg_h": q.earth_rate_residual.map(|r| deg_h(r.0)),
+                    "earth_rate_tolerance_deg_h": q.earth_rate_residual.map(|r| deg_h(r.1)),
+                });
+            }
             if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
                 let c = &x.closest;
                 v[format!("offset_md_{sym}")] = serde_json::json!(len(c.md_m));
