@@ -341,6 +341,13 @@ fn number(fields: &[&str], col: usize, name: &str, line: u64) -> Result<f64> {
     let text = fields
         .get(col)
         .ok_or_else(|| anyhow!("line {line}: no {name} (too few fields)"))?;
+    if text.trim().is_empty() {
+        // a capture's stations CSV leaves an undetermined azimuth empty
+        bail!(
+            "line {line}: no {name} (an empty cell: undetermined at this station); a survey needs \
+             every station's {name}: survey the stations before it"
+        );
+    }
     let value: f64 = text
         .parse()
         .map_err(|_| anyhow!("line {line}: {name} `{}` is not a number", excerpt(text)))?;
@@ -584,6 +591,10 @@ mod tests {
             refused(&format!("md_m,inc,azi,tf\n0,0,0,\n{row}\n"), needle);
         }
         refused("md_m,inc,azi\n-5,0,0\n", "line 2: MD -5 m outside 0..20000");
+        refused(
+            "md_m,inc,azi\n0,0,0\n30,90,\n",
+            "line 3: no azi (an empty cell: undetermined at this station)",
+        );
         // the limit in the file's unit: 20,000 m is 65,616 ft
         refused("md_ft,inc,azi\n65700,0,0\n", "MD 65700 ft outside 0..65616");
         assert!(read("md_ft,inc,azi\n65000,0,360\n").is_ok());
