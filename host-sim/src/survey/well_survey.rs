@@ -110,6 +110,10 @@ pub struct WellSurvey {
     /// The length unit of the listing, CSV, JSON and WITSML (the rows are
     /// kept in metres; the writers convert): metres unless asked.
     pub output_unit: LengthUnit,
+    /// The probe ran without a calibration (a capture's survey,
+    /// `DrillingSurvey::uncalibrated`): every output says so on top and
+    /// flags every station.
+    pub uncalibrated: bool,
 }
 
 impl WellSurvey {
@@ -148,6 +152,7 @@ impl WellSurvey {
             well: WellNames::default(),
             tie_on_cov_m2,
             output_unit: LengthUnit::Metre,
+            uncalibrated: false,
         })
     }
 
