@@ -192,7 +192,9 @@ fn a_job_without_a_calibration_flags_every_station_uncalibrated() {
     let run_dir = dir.join("run");
     let out = run(&["drill", "--job", s(&job_path), "--out", s(&run_dir)]);
     assert_eq!(out.code, Some(0), "{}\n{}", out.stdout, out.stderr);
-    assert!(out.stdout.contains("uncalibrated (the job has no calibration file)"));
+    assert!(out
+        .stdout
+        .contains("uncalibrated (the job has no calibration file)"));
     let listing = std::fs::read_to_string(run_dir.join("listing.txt")).unwrap();
     assert!(listing.starts_with("UNCALIBRATED: "), "{listing}");
     // every station's line (and the bit's) ends with the flag

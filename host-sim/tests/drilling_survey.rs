@@ -568,6 +568,9 @@ fn the_uncalibrated_coverage_study_flags_the_stations_its_sigmas_do_not_cover() 
         );
     }
     let (text, v) = study(false);
-    assert!(!text.contains("UNCALIBRATED") && !text.contains("flagged"), "{text}");
+    assert!(
+        !text.contains("UNCALIBRATED") && !text.contains("flagged"),
+        "{text}"
+    );
     assert!(v.get("uncalibrated_stations").is_none(), "{v}");
 }
