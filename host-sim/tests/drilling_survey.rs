@@ -469,6 +469,18 @@ fn the_coverage_study_finds_its_built_in_plan_from_any_directory() {
     );
 }
 
+/// The coverage study's fractions of stations within 2 sigma (JSON keys).
+const WITHIN_2_SIGMA: [&str; 3] = [
+    "azimuth_within_2_sigma",
+    "inclination_within_2_sigma",
+    "toolface_within_2_sigma",
+];
+
+/// A study fraction's cases inside and its cases.
+fn inside_and_total(f: &serde_json::Value) -> (u64, u64) {
+    (f["inside"].as_u64().unwrap(), f["total"].as_u64().unwrap())
+}
+
 #[test]
 fn the_coverage_study_harness_runs_a_short_plan() {
     let dir = scratch("drilling-survey", "study");
@@ -495,13 +507,9 @@ fn the_coverage_study_harness_runs_a_short_plan() {
     assert_eq!(v["failed_runs"].as_array().unwrap().len(), 0, "{v}");
     // every run surveys the window and the stand's end at least
     assert!(v["stations"].as_u64().unwrap() >= 24, "{v}");
-    for key in [
-        "azimuth_within_2_sigma",
-        "inclination_within_2_sigma",
-        "toolface_within_2_sigma",
-    ] {
+    for key in WITHIN_2_SIGMA {
         let f = &v[key];
-        let (inside, total) = (f["inside"].as_u64().unwrap(), f["total"].as_u64().unwrap());
+        let (inside, total) = inside_and_total(f);
         assert!(total > 0 && inside <= total, "{key}: {f}");
         let p = f["fraction"].as_f64().unwrap();
         assert!((p - inside as f64 / total as f64).abs() < 1e-12);
@@ -553,13 +561,8 @@ fn the_uncalibrated_coverage_study_flags_the_stations_its_sigmas_do_not_cover() 
     for c in v["by_station"].as_array().unwrap() {
         // within 2 sigma in every run, or flagged in every run
         let flagged = c["uncalibrated"].as_u64().unwrap_or(0);
-        for key in [
-            "inclination_within_2_sigma",
-            "azimuth_within_2_sigma",
-            "toolface_within_2_sigma",
-        ] {
-            let f = &c[key];
-            let (inside, total) = (f["inside"].as_u64().unwrap(), f["total"].as_u64().unwrap());
+        for key in WITHIN_2_SIGMA {
+            let (inside, total) = inside_and_total(&c[key]);
             assert!(inside == total || flagged >= total, "{key}: {c}");
         }
         assert!(
