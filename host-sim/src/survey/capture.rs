@@ -60,7 +60,8 @@ impl CaptureSurvey {
         let read = read_stations(&inputs.capture, &inputs.probe)?;
         let depth = read_depth_log(&inputs.depth)?;
         let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?
-            .with_sensor_to_bit(inputs.sensor_to_bit_m);
+            .with_sensor_to_bit(inputs.sensor_to_bit_m)
+            .with_uncalibrated(inputs.probe.is_uncalibrated());
         let links = read.links;
         let mut survey = read
             .collected
@@ -92,11 +93,13 @@ impl CaptureSurvey {
         })
     }
 
-    /// The listing: the capture's bad and lost frames (if any), where the
+    /// The listing: whether the probe ran uncalibrated, the capture's bad
+    /// and lost frames (if any), where the
     /// station links came from, and the stations with their uncertainty
     /// (the ellipse at `confidence`).
     pub fn report(&self, confidence: f64) -> String {
-        let mut text = String::new();
+        // a probe without a calibration: said first
+        let mut text = drilling_text::top_note(&self.survey);
         if let Some(note) = placement_note(&self.tie) {
             text += &format!("note: {note}\n");
         }
@@ -118,7 +121,7 @@ impl CaptureSurvey {
                  stations (docs/drilling-survey.md)\n"
             ),
         };
-        text + &drilling_text::listing(&self.survey, confidence)
+        text + &drilling_text::stations_listing(&self.survey, confidence)
     }
 
     /// The survey as a station file's survey is exported (JSON, WITSML,
@@ -177,6 +180,7 @@ impl CaptureSurvey {
             tie_on_cov_m2: self.survey.tie_on_cov_m2,
             output_unit: LengthUnit::Metre,
             station_qc,
+            uncalibrated: self.survey.uncalibrated,
         })
     }
 

@@ -114,6 +114,10 @@ pub struct WellSurvey {
     /// Each row's quality checks, where the survey comes from a capture
     /// that had the stations' samples (else empty).
     pub station_qc: Vec<Option<StationQc>>,
+    /// The probe ran without a calibration (a capture's survey,
+    /// `DrillingSurvey::uncalibrated`): every output says so on top and
+    /// flags every station.
+    pub uncalibrated: bool,
 }
 
 impl WellSurvey {
@@ -153,6 +157,7 @@ impl WellSurvey {
             tie_on_cov_m2,
             output_unit: LengthUnit::Metre,
             station_qc: Vec::new(),
+            uncalibrated: false,
         })
     }
 

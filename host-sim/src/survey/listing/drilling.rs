@@ -76,6 +76,10 @@ pub struct DrillingSurvey {
     pub tie_on_cov_m2: Option<Cov6>,
     /// What the stations' quality checks were made against, where made.
     pub qc_reference: Option<QcReference>,
+    /// The probe ran without a calibration ([`SurveySetup::uncalibrated`]):
+    /// every station is flagged, its sigmas do not cover the parts'
+    /// uncalibrated errors.
+    pub uncalibrated: bool,
 }
 
 /// The bit at the end of the depth log (TD: the log's last MD plus the
@@ -110,7 +114,22 @@ pub struct SurveySetup {
     pub site: Site,
     /// From the survey sensors to the bit, m (> 0); `None`: no projection.
     pub sensor_to_bit_m: Option<f64>,
+    /// The probe ran without a calibration of its parts' deterministic
+    /// errors (turn-on bias, scale factor, misalignment): its station
+    /// sigmas are the calibrated residual's and do not cover those
+    /// errors, so every station is flagged ([`UNCALIBRATED_NOTE`]).
+    pub uncalibrated: bool,
 }
+
+/// What the outputs of a survey whose probe ran without a calibration say
+/// on top: its stations' sigmas are the calibrated probe's.
+pub const UNCALIBRATED_NOTE: &str = "UNCALIBRATED: the probe ran without a calibration of its \
+parts; every station is flagged \"uncalibrated\": its sigmas do not cover the parts' uncalibrated \
+errors (turn-on bias, scale factor, misalignment), and its angles and positions may be off by \
+many sigmas";
+
+/// The flag of each station of an uncalibrated survey (CSV, JSON, WITSML).
+pub const UNCALIBRATED_FLAG: &str = "uncalibrated";
 
 impl SurveySetup {
     /// The probe's survey at a site at `latitude_rad`, tied on at `tie`.
@@ -128,7 +147,16 @@ impl SurveySetup {
                 gyro_noise_reduction: 1.0,
             },
             sensor_to_bit_m: None,
+            uncalibrated: false,
         })
+    }
+
+    /// The same, for a probe that ran without a calibration (`true`).
+    pub fn with_uncalibrated(self, uncalibrated: bool) -> Self {
+        Self {
+            uncalibrated,
+            ..self
+        }
     }
 
     /// The same, with the bit `m` metres ahead of the sensors (`None`, 0:
@@ -435,6 +463,7 @@ pub fn survey(
         bit,
         tie_on_cov_m2: tie.covariance_m2(LengthUnit::Metre),
         qc_reference: None,
+        uncalibrated: setup.uncalibrated,
     })
 }
 

@@ -2,7 +2,10 @@
 //! position with its sigma; an undetermined azimuth, and every position
 //! from the first one on, shown as undetermined, never as a number.
 
-use super::drilling::{BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint};
+use super::drilling::{
+    BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint, UNCALIBRATED_FLAG,
+    UNCALIBRATED_NOTE,
+};
 use super::ellipse::scale_2d;
 use super::LengthUnit;
 use mwd_core::probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD;
@@ -14,9 +17,28 @@ fn angle(value_deg: f64, sigma_rad: f64) -> String {
     format!("{value_deg:.3}+-{:.3}", sigma_rad.to_degrees())
 }
 
-/// The listing: one line per station, then the skipped stations.
+/// The listing: [`top_note`], one line per station, then the skipped
+/// stations ([`stations_listing`]).
 pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
+    top_note(s) + &stations_listing(s, confidence)
+}
+
+/// What a reader must see before anything else: for a probe that ran
+/// without a calibration, [`UNCALIBRATED_NOTE`] (a line); else nothing.
+pub fn top_note(s: &DrillingSurvey) -> String {
+    if s.uncalibrated {
+        format!("{UNCALIBRATED_NOTE}\n")
+    } else {
+        String::new()
+    }
+}
+
+/// The listing's stations: one line per station, then the skipped
+/// stations; for a probe that ran without a calibration every station
+/// (and the bit) flagged at the end of its line.
+pub fn stations_listing(s: &DrillingSurvey, confidence: f64) -> String {
     let mut out = String::new();
+    let flag = station_flag(s);
     let _ = writeln!(
         out,
         "{} stations from the probe's station surveys; MD from the depth log{}; N/E along true north, m",
@@ -49,10 +71,10 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         "major m", "minor m", "az"
     );
     for r in &s.rows {
-        let _ = writeln!(out, "{}", line(r, confidence));
+        let _ = writeln!(out, "{}{flag}", line(r, confidence));
     }
     if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {
-        let _ = writeln!(out, "{}", bit_line(bit, last, confidence));
+        let _ = writeln!(out, "{}{flag}", bit_line(bit, last, confidence));
         let _ = writeln!(
             out,
             "bit: at the depth log's end plus {:.2} m from the sensors to the bit, projected \
@@ -151,6 +173,16 @@ fn qc_text(s: &DrillingSurvey) -> String {
     out
 }
 
+/// What ends each station's line: "  uncalibrated" for a probe that ran
+/// without a calibration, else nothing.
+fn station_flag(s: &DrillingSurvey) -> String {
+    if s.uncalibrated {
+        format!("  {UNCALIBRATED_FLAG}")
+    } else {
+        String::new()
+    }
+}
+
 fn line(r: &DrillingRow, confidence: f64) -> String {
     let sd = r.survey.angles_std.map(f64::from);
     let azi = if r.azimuth_determined {
@@ -237,12 +269,18 @@ const POSITION_HEADER: &str = "tvd_m,north_m,east_m,sigma_north_m,sigma_east_m,s
 ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg";
 
 /// The stations as CSV (angles in deg, sigmas 1-sigma; empty cells:
-/// undetermined).
+/// undetermined). A probe that ran without a calibration: one more
+/// column, `flag`, "uncalibrated" on every row.
 pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
+    let (flag_header, flag) = if s.uncalibrated {
+        (",flag", format!(",{UNCALIBRATED_FLAG}"))
+    } else {
+        ("", String::new())
+    };
     let mut out = format!(
         "station,time_s,md_m,inc_deg,sigma_inc_deg,azi_deg,sigma_azi_deg,toolface_deg,sigma_toolface_deg,\
          corr_inc_azi,{POSITION_HEADER},confidence,qc,gravity_m_s2,gravity_error_m_s2,\
-         earth_rate_residual_deg_h,earth_rate_tolerance_deg_h\n"
+         earth_rate_residual_deg_h,earth_rate_tolerance_deg_h{flag_header}\n"
     );
     for r in &s.rows {
         let sd = r.survey.angles_std.map(f64::from);
@@ -260,7 +298,7 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
         let deg_h = |r: f64| r.to_degrees() * 3600.0;
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{confidence},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{confidence},{},{},{},{},{}{flag}",
             r.survey.station,
             r.time_s,
             r.row.md_m,
@@ -286,7 +324,7 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
         let determined = last.azimuth_determined;
         let _ = writeln!(
             out,
-            "bit,,{},{},{},{},{},,,{},{},{confidence},,,,,",
+            "bit,,{},{},{},{},{},,,{},{},{confidence},,,,,{flag}",
             bit.row.md_m,
             bit.row.inc_deg,
             sd[0].to_degrees(),

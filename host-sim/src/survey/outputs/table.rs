@@ -6,6 +6,7 @@
 
 use crate::formats::fixed::push_fixed;
 use crate::survey::iscwsa::Cov6;
+use crate::survey::listing::drilling::{UNCALIBRATED_FLAG, UNCALIBRATED_NOTE};
 use crate::survey::listing::ellipse::scale_2d;
 use crate::survey::listing::separation::Separation;
 use crate::survey::listing::{tie_on_note, KnownModel, LengthUnit, Row};
@@ -24,6 +25,9 @@ pub struct Head {
     pub unit: LengthUnit,
     /// Whether the rows carry an offset well's separation.
     pub offset: bool,
+    /// The probe ran without a calibration (`WellSurvey::uncalibrated`):
+    /// the note on top, every row flagged.
+    pub uncalibrated: bool,
 }
 
 impl Head {
@@ -36,6 +40,7 @@ impl Head {
             tie_on_cov_m2: s.tie_on_cov_m2,
             unit: s.output_unit,
             offset: s.offset.is_some(),
+            uncalibrated: s.uncalibrated,
         }
     }
 }
@@ -64,6 +69,9 @@ pub fn listing_head(h: &Head) -> String {
     let u = h.unit;
     let sym = u.symbol();
     let mut text = String::new();
+    if h.uncalibrated {
+        let _ = writeln!(text, "{UNCALIBRATED_NOTE}");
+    }
     let _ = writeln!(
         text,
         "{} stations; lengths in {sym}, N/E along true north; DLS in deg/{}; vertical section along {:.2} deg",
@@ -161,6 +169,9 @@ pub fn listing_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String
             _ => line += "  SF undetermined",
         }
     }
+    if h.uncalibrated {
+        let _ = write!(line, "  {UNCALIBRATED_FLAG}");
+    }
     line + "\n"
 }
 
@@ -193,6 +204,9 @@ pub fn csv_head(h: &Head) -> String {
     }
     if h.offset {
         let _ = write!(out, ",offset_md_{sym},ctc_{sym},sigma_s_{sym},sf,sf_status");
+    }
+    if h.uncalibrated {
+        out += ",flag";
     }
     out + "\n"
 }
@@ -247,6 +261,9 @@ pub fn csv_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String {
             opt(x.sf),
             sf_status(x)
         );
+    }
+    if h.uncalibrated {
+        let _ = write!(out, ",{UNCALIBRATED_FLAG}");
     }
     out + "\n"
 }
