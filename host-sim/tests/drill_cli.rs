@@ -47,6 +47,7 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
         "{stdout}"
     );
     assert!(stdout.contains("calibrated by"), "{stdout}");
+    assert!(!stdout.contains("UNCALIBRATED"), "{stdout}");
     assert!(stdout.contains("positioned beyond the tie-on"), "{stdout}");
     let bit_line = stdout
         .lines()
@@ -61,6 +62,10 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
         serde_json::from_str(&std::fs::read_to_string(run_dir.join("survey.json")).unwrap())
             .unwrap();
     let stations = json["stations"].as_array().unwrap();
+    assert!(
+        stations.iter().all(|st| st["qc"]["result"].is_string()),
+        "every exported station carries its QC"
+    );
     let last_md = stations.last().unwrap()["md_m"].as_f64().unwrap();
     let bit = &json["bit_projection"];
     let bit_md = bit["md_m"].as_f64().unwrap();
@@ -76,6 +81,23 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
     );
     let csv = std::fs::read_to_string(run_dir.join("stations.csv")).unwrap();
     assert!(csv.lines().last().unwrap().starts_with("bit,,"), "{csv}");
+    // every station checked against the site's gravity and earth rate,
+    // each gravity within a few mg of the site's (a still, calibrated probe)
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (qc, error) = (col("qc"), col("gravity_error_m_s2"));
+    for line in csv.lines().skip(1).filter(|l| !l.starts_with("bit")) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_ne!(cells[qc], "not checked", "{line}");
+        let e: f64 = cells[error].parse().unwrap();
+        assert!(e.abs() < 0.1, "{line}");
+    }
+    let listing_text = std::fs::read_to_string(run_dir.join("listing.txt")).unwrap();
+    assert!(
+        listing_text.contains("station QC:")
+            && listing_text.contains("stations checked out of tolerance"),
+        "{listing_text}"
+    );
 
     // The same capture surveyed by `survey CAPTURE --job`: the same listing,
     // and the station-file survey's exports.
@@ -152,4 +174,74 @@ fn a_job_that_cannot_be_drilled_is_refused_by_name() {
         "plann",
     );
     assert!(!out.exists(), "nothing written for a refused job");
+}
+
+/// A job without a calibration: the probe's parts run with their
+/// deterministic errors uncorrected, which its station sigmas (the
+/// calibrated residual's) do not cover. The summary counts the flagged
+/// stations, every output says so on top and flags every station.
+#[test]
+fn a_job_without_a_calibration_flags_every_station_uncalibrated() {
+    let dir = scratch("drill", "uncalibrated");
+    let job = std::fs::read_to_string(example_job())
+        .unwrap()
+        .replace("\"calibration_file\": \"probe-cal.json\",", "")
+        .replace(
+            "../../host-sim/data/plans/lateral-100m.json",
+            s(&common::plan("qemu-short.json")),
+        );
+    assert!(!job.contains("calibration_file"), "{job}");
+    let job_path = dir.join("job.json");
+    std::fs::write(&job_path, job).unwrap();
+    let run_dir = dir.join("run");
+    let out = run(&["drill", "--job", s(&job_path), "--out", s(&run_dir)]);
+    assert_eq!(out.code, Some(0), "{}\n{}", out.stdout, out.stderr);
+    assert!(out
+        .stdout
+        .contains("uncalibrated (the job has no calibration file)"));
+    let listing = std::fs::read_to_string(run_dir.join("listing.txt")).unwrap();
+    assert!(listing.starts_with("UNCALIBRATED: "), "{listing}");
+    // every station's line (and the bit's) ends with the flag
+    let lines: Vec<&str> = listing
+        .lines()
+        .filter(|l| {
+            // a station's or the bit's row: its angles have sigmas
+            let first = l.split_whitespace().next().unwrap_or("");
+            (first == "bit" || first.parse::<u16>().is_ok()) && l.contains("+-")
+        })
+        .collect();
+    assert!(lines.len() >= 3, "{listing}");
+    for l in &lines {
+        assert!(l.ends_with("  uncalibrated"), "{l}");
+    }
+    let stations = lines.len() - 1;
+    assert!(
+        out.stdout.contains(&format!(
+            "UNCALIBRATED: {stations} of {stations} stations flagged \"uncalibrated\""
+        )),
+        "{}",
+        out.stdout
+    );
+    let csv = std::fs::read_to_string(run_dir.join("stations.csv")).unwrap();
+    let mut rows = csv.lines();
+    assert!(rows.next().unwrap().ends_with(",flag"), "{csv}");
+    assert!(rows.all(|r| r.ends_with(",uncalibrated")), "{csv}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("survey.json")).unwrap())
+            .unwrap();
+    assert!(json["uncalibrated_note"]
+        .as_str()
+        .is_some_and(|n| n.starts_with("UNCALIBRATED: ")));
+    let positioned = json["stations"].as_array().unwrap();
+    assert!(!positioned.is_empty(), "{json}");
+    for st in positioned {
+        assert_eq!(st["flags"], serde_json::json!(["uncalibrated"]), "{st}");
+    }
+    let xml = std::fs::read_to_string(run_dir.join("trajectory.xml")).unwrap();
+    assert_eq!(
+        xml.matches("<comments>uncalibrated</comments>").count(),
+        positioned.len(),
+        "{xml}"
+    );
+    assert!(xml.contains("<comments>UNCALIBRATED: "), "{xml}");
 }

@@ -94,6 +94,7 @@ fn setup(sensor_to_bit: Option<f64>) -> SurveySetup {
         site: site(),
         sensor_to_bit_m: None,
         first_station: 1,
+        uncalibrated: false,
     }
     .with_sensor_to_bit(sensor_to_bit)
 }
@@ -523,6 +524,18 @@ fn the_coverage_study_finds_its_built_in_plan_from_any_directory() {
     );
 }
 
+/// The coverage study's fractions of stations within 2 sigma (JSON keys).
+const WITHIN_2_SIGMA: [&str; 3] = [
+    "azimuth_within_2_sigma",
+    "inclination_within_2_sigma",
+    "toolface_within_2_sigma",
+];
+
+/// A study fraction's cases inside and its cases.
+fn inside_and_total(f: &serde_json::Value) -> (u64, u64) {
+    (f["inside"].as_u64().unwrap(), f["total"].as_u64().unwrap())
+}
+
 #[test]
 fn the_coverage_study_harness_runs_a_short_plan() {
     let dir = scratch("drilling-survey", "study");
@@ -549,13 +562,9 @@ fn the_coverage_study_harness_runs_a_short_plan() {
     assert_eq!(v["failed_runs"].as_array().unwrap().len(), 0, "{v}");
     // every run surveys the window and the stand's end at least
     assert!(v["stations"].as_u64().unwrap() >= 24, "{v}");
-    for key in [
-        "azimuth_within_2_sigma",
-        "inclination_within_2_sigma",
-        "toolface_within_2_sigma",
-    ] {
+    for key in WITHIN_2_SIGMA {
         let f = &v[key];
-        let (inside, total) = (f["inside"].as_u64().unwrap(), f["total"].as_u64().unwrap());
+        let (inside, total) = inside_and_total(f);
         assert!(total > 0 && inside <= total, "{key}: {f}");
         let p = f["fraction"].as_f64().unwrap();
         assert!((p - inside as f64 / total as f64).abs() < 1e-12);
@@ -568,4 +577,58 @@ fn the_coverage_study_harness_runs_a_short_plan() {
         .map(|x| x[1].as_u64().unwrap())
         .sum();
     assert_eq!(td + unchecked, 12, "{v}");
+}
+
+/// `study drilling-coverage --uncalibrated`: the probe runs without the
+/// calibration of its parts' deterministic errors, which its station
+/// sigmas do not cover. Each station is within 2 sigma or flagged
+/// "uncalibrated", and the flag is not set on calibrated runs.
+#[test]
+fn the_uncalibrated_coverage_study_flags_the_stations_its_sigmas_do_not_cover() {
+    let dir = scratch("drilling-survey", "uncalibrated-study");
+    let short = plan("qemu-short.json");
+    let study = |uncalibrated: bool| {
+        let json = dir.join(format!("study-{uncalibrated}.json"));
+        let mut args = vec![
+            "study",
+            "drilling-coverage",
+            "--plan",
+            s(&short),
+            "--runs",
+            "3",
+            "--json",
+            s(&json),
+        ];
+        if uncalibrated {
+            args.push("--uncalibrated");
+        }
+        let out = run(&args);
+        assert_eq!(out.code, Some(0), "{}", out.stderr);
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (out.stdout, v)
+    };
+    let (text, v) = study(true);
+    assert!(text.contains("UNCALIBRATED: "), "{text}");
+    let stations = v["stations"].as_u64().unwrap();
+    assert!(stations >= 6, "{v}");
+    assert_eq!(v["uncalibrated_stations"].as_u64(), Some(stations), "{v}");
+    for c in v["by_station"].as_array().unwrap() {
+        // within 2 sigma in every run, or flagged in every run
+        let flagged = c["uncalibrated"].as_u64().unwrap_or(0);
+        for key in WITHIN_2_SIGMA {
+            let (inside, total) = inside_and_total(&c[key]);
+            assert!(inside == total || flagged >= total, "{key}: {c}");
+        }
+        assert!(
+            text.contains(&format!("flagged uncalibrated in {flagged}")),
+            "{text}"
+        );
+    }
+    let (text, v) = study(false);
+    assert!(
+        !text.contains("UNCALIBRATED") && !text.contains("flagged"),
+        "{text}"
+    );
+    assert!(v.get("uncalibrated_stations").is_none(), "{v}");
 }

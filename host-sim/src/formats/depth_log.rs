@@ -1,6 +1,8 @@
 //! The surface depth log (`time_s,md_m`, as `host-sim simulate --depth-log`
 //! writes it): read, checked, and interpolated in time.
 
+use crate::formats::ranges::number;
+use crate::formats::station_csv::MAX_MD_M;
 use crate::formats::text_records::{excerpt, for_each_record};
 use anyhow::{anyhow, bail, Result};
 use std::io::Read;
@@ -60,7 +62,17 @@ impl DepthLog {
                 text.parse::<f64>()
                     .map_err(|_| anyhow!("line {line}: {name} `{}` is not a number", excerpt(text)))
             };
-            points.push((value(t, "time_s")?, value(m, "md_m")?));
+            let (time, md) = (value(t, "time_s")?, value(m, "md_m")?);
+            if !(time.is_finite() && time >= 0.0) {
+                bail!(
+                    "line {line}: time_s {} is not a finite time of 0 s or more",
+                    number(time)
+                );
+            }
+            if !(0.0..=MAX_MD_M).contains(&md) {
+                bail!("line {line}: md_m {} outside 0..{MAX_MD_M} m", number(md));
+            }
+            points.push((time, md));
             Ok(())
         })?;
         if cols.is_none() {
@@ -116,6 +128,17 @@ mod tests {
             "time_s,md_m\n0,1\n1,inf\n",
         ] {
             assert!(DepthLog::read(bad.as_bytes()).is_err(), "{bad:?}");
+        }
+        for (bad, needle) in [
+            (
+                "time_s,md_m\n0,1\n1,1e300\n",
+                "line 3: md_m 1e300 outside 0..20000 m",
+            ),
+            ("time_s,md_m\n0,1\n1,-5\n", "line 3: md_m -5 outside"),
+            ("time_s,md_m\n-1,1\n1,2\n", "line 2: time_s -1"),
+        ] {
+            let e = format!("{:#}", DepthLog::read(bad.as_bytes()).unwrap_err());
+            assert!(e.contains(needle), "{bad:?}: {e}");
         }
     }
 }

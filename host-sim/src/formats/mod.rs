@@ -26,6 +26,7 @@ pub mod depth_log;
 pub mod display;
 pub mod figure;
 pub mod files;
+pub mod fixed;
 pub mod ranges;
 pub mod samples_csv;
 pub mod station_csv;

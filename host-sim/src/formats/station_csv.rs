@@ -22,15 +22,22 @@
 //! column holds `bit` (the bit's projection ending a capture survey's
 //! stations CSV) is skipped: it repeats the last station's angles at the
 //! bit's depth, it is no survey station. Read and checked here (finite
-//! numbers, MD increasing, inclination in 0..=180 deg, at least one
+//! numbers, MD increasing and within 0..=20,000 m, inclination in 0..=180
+//! deg, azimuth in 0..=360 deg, toolface within +-360 deg, at least one
 //! station), lengths left in the file's unit.
 
+use crate::formats::ranges::number as shown;
 use crate::formats::text_records::{excerpt, for_each_record_tab_aware};
 use anyhow::{anyhow, bail, Result};
 use std::io::Read;
 
 /// Metres per international foot.
 pub const FOOT_M: f64 = 0.3048;
+
+/// The deepest MD a station or depth file may hold, m: beyond the deepest
+/// wells drilled (about 12,300 m), so a value past it is a mistake (a unit,
+/// a column, a corrupted number), not a well.
+pub const MAX_MD_M: f64 = 20_000.0;
 
 /// Length unit of a station file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -334,6 +341,13 @@ fn number(fields: &[&str], col: usize, name: &str, line: u64) -> Result<f64> {
     let text = fields
         .get(col)
         .ok_or_else(|| anyhow!("line {line}: no {name} (too few fields)"))?;
+    if text.trim().is_empty() {
+        // a capture's stations CSV leaves an undetermined azimuth empty
+        bail!(
+            "line {line}: no {name} (an empty cell: undetermined at this station); a survey needs \
+             every station's {name}: survey the stations before it"
+        );
+    }
     let value: f64 = text
         .parse()
         .map_err(|_| anyhow!("line {line}: {name} `{}` is not a number", excerpt(text)))?;
@@ -417,6 +431,25 @@ pub fn for_each_station<R: Read>(
         };
         if !(0.0..=180.0).contains(&s.inc_deg) {
             bail!("line {line}: inclination {} deg outside 0..180", s.inc_deg);
+        }
+        if !(0.0..=360.0).contains(&s.azi_deg) {
+            bail!(
+                "line {line}: azimuth {} deg outside 0..360 (give azimuths from north, clockwise, \
+                 in 0..360)",
+                shown(s.azi_deg)
+            );
+        }
+        let md_limit = MAX_MD_M / c.unit.to_m();
+        if !(0.0..=md_limit).contains(&s.md) {
+            bail!(
+                "line {line}: MD {} {} outside 0..{} (the deepest wells are about 12,000 m)",
+                shown(s.md),
+                c.unit.symbol(),
+                md_limit.floor()
+            );
+        }
+        if let Some(tf) = s.toolface_deg.filter(|tf| !(-360.0..=360.0).contains(tf)) {
+            bail!("line {line}: toolface {} deg outside -360..360", shown(tf));
         }
         if let Some(prev) = previous {
             if s.md <= prev.md {
@@ -540,6 +573,31 @@ mod tests {
         ] {
             expect_rows(&read(text).unwrap());
         }
+    }
+
+    #[test]
+    fn values_outside_their_ranges_are_refused_by_line() {
+        for (row, needle) in [
+            ("100,10,400", "line 3: azimuth 400 deg outside 0..360"),
+            ("100,10,-30", "line 3: azimuth -30 deg outside 0..360"),
+            ("100,10,1e300", "line 3: azimuth 1e300 deg outside 0..360"),
+            ("1e300,10,30", "line 3: MD 1e300 m outside 0..20000"),
+            ("100,190,30", "line 3: inclination 190 deg outside 0..180"),
+            (
+                "100,10,30,720",
+                "line 3: toolface 720 deg outside -360..360",
+            ),
+        ] {
+            refused(&format!("md_m,inc,azi,tf\n0,0,0,\n{row}\n"), needle);
+        }
+        refused("md_m,inc,azi\n-5,0,0\n", "line 2: MD -5 m outside 0..20000");
+        refused(
+            "md_m,inc,azi\n0,0,0\n30,90,\n",
+            "line 3: no azi (an empty cell: undetermined at this station)",
+        );
+        // the limit in the file's unit: 20,000 m is 65,616 ft
+        refused("md_ft,inc,azi\n65700,0,0\n", "MD 65700 ft outside 0..65616");
+        assert!(read("md_ft,inc,azi\n65000,0,360\n").is_ok());
     }
 
     #[test]

@@ -9,7 +9,7 @@
 use super::drilling_run::{failures, outcomes, run, RunConfig, RunOutcome};
 use super::stats::{rms, rms_and_median_sigma};
 use super::{Interruption, StudyRuns};
-use crate::survey::listing::drilling::station_valid;
+use crate::survey::listing::drilling::{station_valid, UNCALIBRATED_NOTE};
 use crate::survey::listing::ellipse::scale_2d;
 use mwd_core::protocol::frame::station_flags;
 use serde::Serialize;
@@ -82,6 +82,16 @@ pub struct Summary {
     /// The same counts by station number (1 = the window's): where along
     /// the well the bounds hold or fail.
     pub by_station: Vec<StationCoverage>,
+    /// Stations flagged "uncalibrated" (the runs' probe without the
+    /// calibration of its parts, `RunOutcome::uncalibrated`): their sigmas
+    /// do not cover the parts' uncalibrated errors. Left out at 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub uncalibrated_stations: usize,
+}
+
+/// Serde's test for the counts left out at 0.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Coverage of the stations with one station number across the runs.
@@ -99,6 +109,10 @@ pub struct StationCoverage {
     /// The same of the determined azimuths.
     pub rms_azimuth_deg: Option<f64>,
     pub median_azimuth_sigma_deg: Option<f64>,
+    /// Of this station's surveys, those flagged "uncalibrated" (left out
+    /// at 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub uncalibrated: usize,
 }
 
 /// Runs the seeds of `runs` (on its threads);
@@ -130,6 +144,7 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
         s.samples += o.samples;
         for st in &o.stations {
             s.stations += 1;
+            s.uncalibrated_stations += usize::from(o.uncalibrated);
             let sd = st.survey.angles_std.map(f64::from);
             if !station_valid(&st.survey) || !sd[0].is_finite() || !sd[2].is_finite() {
                 s.invalid_stations += 1;
@@ -137,6 +152,7 @@ fn summarise(results: &[(u64, Result<RunOutcome, String>)]) -> Summary {
             }
             let number = st.survey.station;
             let slot = by_station.entry(number).or_default();
+            slot.uncalibrated += usize::from(o.uncalibrated);
             let mut count = |i: usize, err: f64, sigma: f64, list: &mut Vec<f64>| {
                 let within = usize::from(err.abs() <= 2.0 * sigma);
                 totals[i] += 1;
@@ -189,6 +205,7 @@ struct StationTally {
     inside: [usize; 3],
     totals: [usize; 3],
     undetermined: usize,
+    uncalibrated: usize,
     /// (error, its sigma), deg: toolface, determined azimuth.
     toolface: Vec<(f64, f64)>,
     azimuth: Vec<(f64, f64)>,
@@ -211,6 +228,7 @@ impl StationTally {
             median_toolface_sigma_deg,
             rms_azimuth_deg,
             median_azimuth_sigma_deg,
+            uncalibrated: self.uncalibrated,
         }
     }
 }
@@ -234,6 +252,17 @@ pub fn table(s: &Summary) -> String {
             format!("{} ({} failed)", s.runs, s.failed_runs.len()),
         ),
         ("stations", s.stations.to_string()),
+    ];
+    if s.uncalibrated_stations > 0 {
+        rows.push((
+            "  flagged uncalibrated",
+            format!(
+                "{} (the probe without the calibration of its parts: their sigmas do not cover its uncalibrated errors)",
+                s.uncalibrated_stations
+            ),
+        ));
+    }
+    rows.extend([
         ("  invalid (not counted)", s.invalid_stations.to_string()),
         (
             "  azimuth undetermined",
@@ -261,7 +290,7 @@ pub fn table(s: &Summary) -> String {
         ("RMS TD horizontal error", opt(s.rms_td_horizontal_m, "m")),
         ("samples", s.samples.to_string()),
         ("wall time", format!("{:.1} s", s.wall_s)),
-    ];
+    ]);
     for (reason, n) in &s.td_unchecked {
         rows.push(("TD not checked", format!("{n} runs: {reason}")));
     }
@@ -275,6 +304,9 @@ pub fn table(s: &Summary) -> String {
             i.jobs_done, i.jobs
         ));
     }
+    if s.uncalibrated_stations > 0 {
+        out.push_str(&format!("{UNCALIBRATED_NOTE}\n\n"));
+    }
     out.extend(rows.iter().map(|(k, v)| format!("{k:<42} {v}\n")));
     out.push_str("\nby station: within 2 sigma (inclination, azimuth where determined, toolface); azimuth error RMS against its median sigma; toolface error mean and RMS against its median sigma\n");
     for c in &s.by_station {
@@ -283,8 +315,13 @@ pub fn table(s: &Summary) -> String {
                 .map_or_else(|| "  -  ".into(), |p| format!("{:5.1}", 100.0 * p))
         };
         let deg = |v: Option<f64>| v.map_or_else(|| "-".into(), |v| format!("{v:.3}"));
+        let flagged = if c.uncalibrated > 0 {
+            format!("  flagged uncalibrated in {}", c.uncalibrated)
+        } else {
+            String::new()
+        };
         out.push_str(&format!(
-            "  station {:>3}: inc {} %  azi {} % ({} undetermined, RMS {} sigma {})  tf {} %  tf error mean {} RMS {} sigma {} deg\n",
+            "  station {:>3}: inc {} %  azi {} % ({} undetermined, RMS {} sigma {})  tf {} %  tf error mean {} RMS {} sigma {} deg{flagged}\n",
             c.station,
             short(&c.inclination_within_2_sigma),
             short(&c.azimuth_within_2_sigma),

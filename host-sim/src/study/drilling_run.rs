@@ -11,7 +11,10 @@ use super::grade::Grade;
 pub use super::run_checks::{PositionCheck, StationCheck, TdCheck};
 use crate::formats::capture::{raw_sample_from_si, SiSample};
 use crate::formats::depth_log::DepthLog;
-use crate::sim::{BuiltPlan, DrillState, Drilling, DrillingSimulator, SensorErrors, SensorModel};
+use crate::sim::{
+    BuiltPlan, DeterministicErrors, DrillState, Drilling, DrillingSimulator, SensorErrors,
+    SensorModel,
+};
 use crate::survey::iscwsa::{ErrorTerm, Site};
 use crate::survey::listing::drilling::{self, DrillingSurvey, StationStart};
 use crate::survey::listing::{
@@ -135,6 +138,11 @@ pub struct RunOutcome {
     /// ([`thread_cpu_s`]): on a shared machine the wall time is not the
     /// work.
     pub cpu_s: Option<f64>,
+    /// The probe ran without the calibration of its parts' deterministic
+    /// errors ([`RunConfig::uncalibrated`] with parts that have them):
+    /// every station is flagged "uncalibrated", as a capture's survey
+    /// flags them (`SurveySetup::uncalibrated`).
+    pub uncalibrated: bool,
 }
 
 #[cfg(test)]
@@ -151,6 +159,7 @@ impl RunOutcome {
             samples: 0,
             elapsed_s: 0.0,
             cpu_s: None,
+            uncalibrated: false,
         }
     }
 }
@@ -339,6 +348,9 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     // (error-free samples through the SCC1300's counts would be rounded
     // without the noise that dithers them: a bias of up to half a count)
     let raw_frames = config.grade.is_scc1300_part() && !config.noise_free;
+    // the navigator sees the parts' deterministic errors uncorrected: its
+    // station sigmas (the calibrated residual's) do not cover them
+    let uncalibrated = config.uncalibrated && model.deterministic != DeterministicErrors::none();
     let calibration = if config.uncalibrated || !raw_frames {
         // other parts' samples come calibrated (`Grade::sensor_model`)
         ProbeCalibration::default()
@@ -460,6 +472,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         site: config.site,
         sensor_to_bit_m: None,
         first_station: drilling::FIRST_STATION,
+        uncalibrated,
     };
     let survey = collected.survey(&links, &setup, &depth);
     let (td, td_note, method_td_error_ne) = match survey {
@@ -480,6 +493,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         samples,
         elapsed_s: started.elapsed().as_secs_f64(),
         cpu_s: cpu_start.zip(thread_cpu_s()).map(|(a, b)| b - a),
+        uncalibrated,
     })
 }
 

@@ -12,9 +12,10 @@ use crate::formats::depth_log::DepthLog;
 use crate::formats::files::read_depth_log;
 use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
-use crate::survey::listing::drilling::{self, DrillingSurvey, TrajectoryPoint};
+use crate::survey::listing::drilling::{self, DrillingSurvey, QcReference, TrajectoryPoint};
 use crate::survey::listing::station_gaps::numbers_text;
 use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
+use crate::survey::station_qc::{CheckedStations, QcCollector, QcTolerances};
 use crate::survey::stations::{StationCollector, SurveySetup};
 use crate::survey::well_survey::WellSurvey;
 use anyhow::{Context, Result};
@@ -60,12 +61,24 @@ impl CaptureSurvey {
         let read = read_stations(&inputs.capture, &inputs.probe)?;
         let depth = read_depth_log(&inputs.depth)?;
         let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?
-            .with_sensor_to_bit(inputs.sensor_to_bit_m);
+            .with_sensor_to_bit(inputs.sensor_to_bit_m)
+            .with_uncalibrated(inputs.probe.is_uncalibrated());
         let links = read.links;
-        let survey = read
+        let mut survey = read
             .collected
             .survey(links.as_deref().unwrap_or(&[]), &setup, &depth)
             .with_context(|| format!("{}", inputs.capture.display()))?;
+        if let Some((reference, checked)) = read.qc {
+            for row in survey.rows.iter_mut() {
+                row.qc = checked
+                    .iter()
+                    .find(|(station, end, _)| {
+                        (*station, *end) == (row.survey.station, row.survey.end_sample)
+                    })
+                    .map(|c| c.2);
+            }
+            survey.qc_reference = Some(reference);
+        }
         let SurveySetup {
             tie, terms, site, ..
         } = setup;
@@ -81,11 +94,13 @@ impl CaptureSurvey {
         })
     }
 
-    /// The listing: the capture's bad and lost frames (if any), where the
+    /// The listing: whether the probe ran uncalibrated, the capture's bad
+    /// and lost frames (if any), where the
     /// station links came from, and the stations with their uncertainty
     /// (the ellipse at `confidence`).
     pub fn report(&self, confidence: f64) -> String {
-        let mut text = String::new();
+        // a probe without a calibration: said first
+        let mut text = drilling_text::top_note(&self.survey);
         if let Some(note) = placement_note(&self.tie) {
             text += &format!("note: {note}\n");
         }
@@ -107,7 +122,7 @@ impl CaptureSurvey {
                  stations (docs/drilling-survey.md)\n"
             ),
         };
-        text + &drilling_text::listing(&self.survey, confidence)
+        text + &drilling_text::stations_listing(&self.survey, confidence)
     }
 
     /// What the survey could not use, if anything: frames lost in the
@@ -144,13 +159,14 @@ impl CaptureSurvey {
     /// vertical section along `vsec_azimuth` (rad; `None`: the last
     /// exported station's closure azimuth).
     pub fn well_survey(&self, confidence: f64, vsec_azimuth: Option<f64>) -> Result<WellSurvey> {
-        let mut rows: Vec<Row> = self
+        let exported: Vec<_> = self
             .survey
             .rows
             .iter()
             .take_while(|r| r.position_determined && r.row.cov.is_some())
-            .map(|r| r.row)
             .collect();
+        let station_qc = exported.iter().map(|r| r.qc).collect();
+        let mut rows: Vec<Row> = exported.iter().map(|r| r.row).collect();
         let left_out = self.survey.rows.len() - rows.len();
         let bit = self
             .survey
@@ -191,6 +207,8 @@ impl CaptureSurvey {
             well: crate::survey::job::WellNames::default(),
             tie_on_cov_m2: self.survey.tie_on_cov_m2,
             output_unit: LengthUnit::Metre,
+            station_qc,
+            uncalibrated: self.survey.uncalibrated,
         })
     }
 
@@ -260,6 +278,10 @@ struct CaptureStations {
     /// (`replay::replayed_station_links`), or why there are none.
     links: Result<Vec<Option<StationLink>>, String>,
     stats: DecoderStats,
+    /// The stations' quality checks (station number, last sample, checks)
+    /// and what they were made against; `None` where the tool model has no
+    /// tolerances.
+    qc: Option<(QcReference, CheckedStations)>,
 }
 
 fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
@@ -267,10 +289,18 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
     let mut replayer = Replayer::with_settings(probe.site, probe.calibration, probe.still)
         .with_tie_in(probe.tie_in);
     let mut collected = StationCollector::default();
+    let mut qc = qc_collector(probe)?;
     let mut items = 0usize;
     while let Some(item) = capture.next_item()? {
         if let Item::Frame(frame) = &item {
             collected.push_frame(frame);
+            if let Some(qc) = qc.as_mut() {
+                match &frame.payload {
+                    Payload::Raw(raw) => qc.push_raw(raw),
+                    Payload::Station(s) => qc.push_station(s),
+                    _ => {}
+                }
+            }
         }
         replayer.push_received(item.received());
         items += 1;
@@ -284,5 +314,21 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
         collected,
         links,
         stats: *capture.stats(),
+        qc: qc.map(|q| {
+            let reference = QcReference {
+                gravity_m_s2: q.gravity(),
+                tolerances: q.tolerances(),
+            };
+            (reference, q.into_checked())
+        }),
     })
+}
+
+/// The stations' quality checks with the probe's calibration at its site,
+/// to the probe's tool model's tolerances.
+fn qc_collector(probe: &ProbeSetup) -> Result<Option<QcCollector>> {
+    let terms = listing::terms(listing::model(drilling::MODEL_NAME)?)?;
+    let gravity = mwd_core::earth::normal_gravity(probe.site.lat, probe.site.height);
+    Ok(QcTolerances::from_terms(&terms, gravity)
+        .map(|t| QcCollector::new(probe.calibration, probe.site, t)))
 }

@@ -29,6 +29,7 @@ pub mod job;
 pub mod listing;
 pub mod outputs;
 pub mod simulated;
+pub mod station_qc;
 pub mod stations;
 pub mod streamed;
 pub mod well_survey;

@@ -81,6 +81,8 @@ pub fn survey_streamed(
         tie_on_cov_m2,
         unit: unit.unwrap_or(LengthUnit::Metre),
         offset: false,
+        // a station file says nothing of the probe's calibration
+        uncalibrated: false,
     };
     let terms = model.map(listing::terms).transpose()?.unwrap_or_default();
     let mut run = model

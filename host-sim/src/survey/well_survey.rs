@@ -16,6 +16,7 @@ use crate::survey::listing::{
     self as listing, AzimuthReference, Invalid, KnownModel, LengthUnit, Row, StationFile,
     TieOnInput,
 };
+use crate::survey::station_qc::StationQc;
 use anyhow::{bail, Context, Result};
 use std::path::Path;
 
@@ -110,6 +111,13 @@ pub struct WellSurvey {
     /// The length unit of the listing, CSV, JSON and WITSML (the rows are
     /// kept in metres; the writers convert): metres unless asked.
     pub output_unit: LengthUnit,
+    /// Each row's quality checks, where the survey comes from a capture
+    /// that had the stations' samples (else empty).
+    pub station_qc: Vec<Option<StationQc>>,
+    /// The probe ran without a calibration (a capture's survey,
+    /// `DrillingSurvey::uncalibrated`): every output says so on top and
+    /// flags every station.
+    pub uncalibrated: bool,
 }
 
 impl WellSurvey {
@@ -148,6 +156,8 @@ impl WellSurvey {
             well: WellNames::default(),
             tie_on_cov_m2,
             output_unit: LengthUnit::Metre,
+            station_qc: Vec::new(),
+            uncalibrated: false,
         })
     }
 

@@ -182,6 +182,13 @@ impl ProbeSetup {
             tie_in: None,
         }
     }
+
+    /// The probe ran without a calibration of its parts (the identity
+    /// correction, as it boots): its station sigmas do not cover the
+    /// parts' turn-on biases, scale factors and misalignments.
+    pub fn is_uncalibrated(&self) -> bool {
+        self.calibration == ProbeCalibration::default()
+    }
 }
 
 /// Writes what a probe at `site` sends for simulated `samples`: its boot

@@ -417,6 +417,7 @@ mod tests {
             samples: 1000,
             elapsed_s: 0.5,
             cpu_s: Some(0.25),
+            uncalibrated: false,
         }
     }
 

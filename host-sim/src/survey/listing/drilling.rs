@@ -21,6 +21,7 @@ use crate::survey::iscwsa::probe_station::{
     angle_covariance, angle_covariance_projected, links_in_order, AngleSigma,
 };
 use crate::survey::iscwsa::{self, Cov6, ErrorTerm, Site, Station};
+use crate::survey::station_qc::{QcTolerances, StationQc};
 use anyhow::{anyhow, bail, Result};
 use mwd_core::probe::StationLink;
 use mwd_core::protocol::frame::{nav_flags, nav_mode, station_flags};
@@ -42,6 +43,17 @@ pub struct DrillingRow {
     /// Every station up to this one has a determined azimuth: N/E/TVD and
     /// their covariance mean something.
     pub position_determined: bool,
+    /// The station's quality checks, where the capture had its samples
+    /// ([`crate::survey::station_qc`]).
+    pub qc: Option<StationQc>,
+}
+
+/// The site's gravity and the tolerances a capture's stations were checked
+/// against.
+#[derive(Clone, Copy, Debug)]
+pub struct QcReference {
+    pub gravity_m_s2: f64,
+    pub tolerances: QcTolerances,
 }
 
 /// A station left out, and why.
@@ -71,6 +83,12 @@ pub struct DrillingSurvey {
     /// The tie-on's position covariance (m^2) in every position's;
     /// `None`: the tie-on is taken as exact.
     pub tie_on_cov_m2: Option<Cov6>,
+    /// What the stations' quality checks were made against, where made.
+    pub qc_reference: Option<QcReference>,
+    /// The probe ran without a calibration ([`SurveySetup::uncalibrated`]):
+    /// every station is flagged, its sigmas do not cover the parts'
+    /// uncalibrated errors.
+    pub uncalibrated: bool,
 }
 
 /// The bit at the end of the depth log (TD: the log's last MD plus the
@@ -108,7 +126,22 @@ pub struct SurveySetup {
     /// The number of the first station expected ([`FIRST_STATION`]; a
     /// display that forgot its oldest stations: the oldest it holds).
     pub first_station: u16,
+    /// The probe ran without a calibration of its parts' deterministic
+    /// errors (turn-on bias, scale factor, misalignment): its station
+    /// sigmas are the calibrated residual's and do not cover those
+    /// errors, so every station is flagged ([`UNCALIBRATED_NOTE`]).
+    pub uncalibrated: bool,
 }
+
+/// What the outputs of a survey whose probe ran without a calibration say
+/// on top: its stations' sigmas are the calibrated probe's.
+pub const UNCALIBRATED_NOTE: &str = "UNCALIBRATED: the probe ran without a calibration of its \
+parts; every station is flagged \"uncalibrated\": its sigmas do not cover the parts' uncalibrated \
+errors (turn-on bias, scale factor, misalignment), and its angles and positions may be off by \
+many sigmas";
+
+/// The flag of each station of an uncalibrated survey (CSV, JSON, WITSML).
+pub const UNCALIBRATED_FLAG: &str = "uncalibrated";
 
 impl SurveySetup {
     /// The probe's survey at a site at `latitude_rad`, tied on at `tie`.
@@ -127,7 +160,16 @@ impl SurveySetup {
             },
             sensor_to_bit_m: None,
             first_station: FIRST_STATION,
+            uncalibrated: false,
         })
+    }
+
+    /// The same, for a probe that ran without a calibration (`true`).
+    pub fn with_uncalibrated(self, uncalibrated: bool) -> Self {
+        Self {
+            uncalibrated,
+            ..self
+        }
     }
 
     /// The same, with the bit `m` metres ahead of the sensors (`None`, 0:
@@ -435,6 +477,7 @@ pub fn survey(
                 method_cov: covs.get(k).map(|c| c.method),
                 azimuth_determined: sigmas[k].is_some(),
                 position_determined: k < covs.len(),
+                qc: None,
             }
         })
         .collect();
@@ -445,6 +488,8 @@ pub fn survey(
         md_offset_m,
         bit,
         tie_on_cov_m2: tie.covariance_m2(LengthUnit::Metre),
+        qc_reference: None,
+        uncalibrated: setup.uncalibrated,
     })
 }
 

@@ -2,7 +2,10 @@
 //! position with its sigma; an undetermined azimuth, and every position
 //! from the first one on, shown as undetermined, never as a number.
 
-use super::drilling::{BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint};
+use super::drilling::{
+    BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint, UNCALIBRATED_FLAG,
+    UNCALIBRATED_NOTE,
+};
 use super::ellipse::scale_2d;
 use super::station_gaps::lost_line;
 use super::LengthUnit;
@@ -15,9 +18,28 @@ fn angle(value_deg: f64, sigma_rad: f64) -> String {
     format!("{value_deg:.3}+-{:.3}", sigma_rad.to_degrees())
 }
 
-/// The listing: one line per station, then the skipped stations.
+/// The listing: [`top_note`], one line per station, then the skipped
+/// stations ([`stations_listing`]).
 pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
+    top_note(s) + &stations_listing(s, confidence)
+}
+
+/// What a reader must see before anything else: for a probe that ran
+/// without a calibration, [`UNCALIBRATED_NOTE`] (a line); else nothing.
+pub fn top_note(s: &DrillingSurvey) -> String {
+    if s.uncalibrated {
+        format!("{UNCALIBRATED_NOTE}\n")
+    } else {
+        String::new()
+    }
+}
+
+/// The listing's stations: one line per station, then the skipped
+/// stations; for a probe that ran without a calibration every station
+/// (and the bit) flagged at the end of its line.
+pub fn stations_listing(s: &DrillingSurvey, confidence: f64) -> String {
     let mut out = String::new();
+    let flag = station_flag(s);
     let _ = writeln!(
         out,
         "{} stations from the probe's station surveys; MD from the depth log{}; N/E along true north, m",
@@ -55,13 +77,13 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
         while let Some((first, last)) = lost.next_if(|(first, _)| *first < r.survey.station) {
             let _ = writeln!(out, "{}", lost_line(*first, *last));
         }
-        let _ = writeln!(out, "{}", line(r, confidence));
+        let _ = writeln!(out, "{}{flag}", line(r, confidence));
     }
     for (first, last) in lost {
         let _ = writeln!(out, "{}", lost_line(*first, *last));
     }
     if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {
-        let _ = writeln!(out, "{}", bit_line(bit, last, confidence));
+        let _ = writeln!(out, "{}{flag}", bit_line(bit, last, confidence));
         let _ = writeln!(
             out,
             "bit: at the depth log's end plus {:.2} m from the sensors to the bit, projected \
@@ -91,7 +113,83 @@ pub fn listing(s: &DrillingSurvey, confidence: f64) -> String {
     for k in &s.skipped {
         let _ = writeln!(out, "skipped station {}: {}", k.survey.station, k.reason);
     }
+    out + &qc_text(s)
+}
+
+/// The stations' quality checks: what they were checked against, one line
+/// a station, and the count out of tolerance.
+fn qc_text(s: &DrillingSurvey) -> String {
+    let Some(reference) = &s.qc_reference else {
+        return String::new();
+    };
+    let t = &reference.tolerances;
+    let mut out = format!(
+        "station QC: total gravity against the site's {:.4} m/s^2 (tolerance +-{:.4} m/s^2, 3 sigma \
+         of the tool model's accelerometer terms); the cross-axis gyros' rates against the earth \
+         rate the station's attitude predicts (tolerance 3.44 sigma of the gyro terms, {:.1} deg/h \
+         an axis, and of the azimuth sigma)\n",
+        reference.gravity_m_s2,
+        t.gravity_m_s2,
+        t.gyro_sigma_rad_s.to_degrees() * 3600.0
+    );
+    let deg_h = |r: f64| r.to_degrees() * 3600.0;
+    let mut out_of_tolerance = Vec::new();
+    for r in &s.rows {
+        let Some(q) = &r.qc else {
+            let _ = writeln!(
+                out,
+                "  station {:>3}: not checked (its samples are not all in the capture)",
+                r.survey.station
+            );
+            continue;
+        };
+        let rate = match q.earth_rate_residual {
+            Some((res, tol)) => format!(
+                "earth-rate residual {:.1} deg/h (tolerance {:.1}) {}",
+                deg_h(res),
+                deg_h(tol),
+                if res <= tol { "ok" } else { "OUT" }
+            ),
+            None => "earth rate not checked (azimuth undetermined)".into(),
+        };
+        let _ = writeln!(
+            out,
+            "  station {:>3}: gravity {:.4} m/s^2 ({:+.2} mg) {}; {rate}",
+            r.survey.station,
+            q.gravity_m_s2,
+            q.gravity_error_m_s2 / 9.80665e-3,
+            if q.gravity_ok() { "ok" } else { "OUT" }
+        );
+        if !q.ok() {
+            out_of_tolerance.push(r.survey.station.to_string());
+        }
+    }
+    let checked = s.rows.iter().filter(|r| r.qc.is_some()).count();
+    let _ = writeln!(
+        out,
+        "station QC: {} of {checked} stations checked out of tolerance{}",
+        out_of_tolerance.len(),
+        if out_of_tolerance.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " (stations {}): their sensors disagree with the earth at the site; check the \
+                 calibration and whether the probe was still",
+                out_of_tolerance.join(", ")
+            )
+        }
+    );
     out
+}
+
+/// What ends each station's line: "  uncalibrated" for a probe that ran
+/// without a calibration, else nothing.
+fn station_flag(s: &DrillingSurvey) -> String {
+    if s.uncalibrated {
+        format!("  {UNCALIBRATED_FLAG}")
+    } else {
+        String::new()
+    }
 }
 
 fn line(r: &DrillingRow, confidence: f64) -> String {
@@ -180,11 +278,18 @@ const POSITION_HEADER: &str = "tvd_m,north_m,east_m,sigma_north_m,sigma_east_m,s
 ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg";
 
 /// The stations as CSV (angles in deg, sigmas 1-sigma; empty cells:
-/// undetermined).
+/// undetermined). A probe that ran without a calibration: one more
+/// column, `flag`, "uncalibrated" on every row.
 pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
+    let (flag_header, flag) = if s.uncalibrated {
+        (",flag", format!(",{UNCALIBRATED_FLAG}"))
+    } else {
+        ("", String::new())
+    };
     let mut out = format!(
         "station,time_s,md_m,inc_deg,sigma_inc_deg,azi_deg,sigma_azi_deg,toolface_deg,sigma_toolface_deg,\
-         corr_inc_azi,{POSITION_HEADER},confidence\n"
+         corr_inc_azi,{POSITION_HEADER},confidence,qc,gravity_m_s2,gravity_error_m_s2,\
+         earth_rate_residual_deg_h,earth_rate_tolerance_deg_h{flag_header}\n"
     );
     for r in &s.rows {
         let sd = r.survey.angles_std.map(f64::from);
@@ -197,9 +302,12 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
         } else {
             (None, None, None)
         };
+        let qc = r.qc.as_ref();
+        let rate = qc.and_then(|q| q.earth_rate_residual);
+        let deg_h = |r: f64| r.to_degrees() * 3600.0;
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{confidence}",
+            "{},{},{},{},{},{},{},{},{},{},{},{confidence},{},{},{},{},{}{flag}",
             r.survey.station,
             r.time_s,
             r.row.md_m,
@@ -210,7 +318,12 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
             opt(r.row.input.toolface_deg),
             sd[2].to_degrees(),
             opt(corr.filter(|c| c.is_finite())),
-            position_cells(&r.row, r.position_determined, confidence)
+            position_cells(&r.row, r.position_determined, confidence),
+            qc.map_or("not checked", |q| q.word()),
+            opt(qc.map(|q| q.gravity_m_s2)),
+            opt(qc.map(|q| q.gravity_error_m_s2)),
+            opt(rate.map(|r| deg_h(r.0))),
+            opt(rate.map(|r| deg_h(r.1)))
         );
     }
     if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {
@@ -220,7 +333,7 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
         let determined = last.azimuth_determined;
         let _ = writeln!(
             out,
-            "bit,,{},{},{},{},{},,,{},{},{confidence}",
+            "bit,,{},{},{},{},{},,,{},{},{confidence},,,,,{flag}",
             bit.row.md_m,
             bit.row.inc_deg,
             sd[0].to_degrees(),

@@ -3,6 +3,7 @@
 //! 1.4.1.1 trajectory, and the plan and section figures. Lengths in
 //! metres, azimuths along true north, whatever the input.
 
+use crate::survey::listing::drilling::{UNCALIBRATED_FLAG, UNCALIBRATED_NOTE};
 use crate::survey::listing::separation as sep;
 use crate::survey::listing::{plot, tie_on_note};
 use crate::survey::well_survey::{sf_status, WellSurvey};
@@ -113,6 +114,9 @@ fn json_station(s: &WellSurvey, r: &crate::survey::listing::Row) -> serde_json::
         );
         put("error_model_valid".into(), json!(r.cov.is_some()));
     }
+    if s.uncalibrated {
+        put("flags".into(), json!([UNCALIBRATED_FLAG]));
+    }
     serde_json::Value::Object(v)
 }
 
@@ -126,6 +130,17 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         .enumerate()
         .map(|(k, r)| {
             let mut v = json_station(s, r);
+            if let Some(q) = s.station_qc.get(k).copied().flatten() {
+                let deg_h = |r: f64| r.to_degrees() * 3600.0;
+                v["qc"] = serde_json::json!({
+                    "result": q.word(),
+                    "gravity_m_s2": q.gravity_m_s2,
+                    "gravity_error_m_s2": q.gravity_error_m_s2,
+                    "gravity_tolerance_m_s2": q.gravity_tolerance_m_s2,
+                    "earth_rate_residual_deg_h": q.earth_rate_residual.map(|r| deg_h(r.0)),
+                    "earth_rate_tolerance_deg_h": q.earth_rate_residual.map(|r| deg_h(r.1)),
+                });
+            }
             if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
                 let c = &x.closest;
                 v[format!("offset_md_{sym}")] = serde_json::json!(len(c.md_m));
@@ -156,6 +171,9 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         doc[format!("tie_on_covariance_{sym}2")] =
             serde_json::json!(s.tie_on_cov_m2.map(|c| c.map(|x| u.from_m2(x))));
         doc["tie_on_note"] = serde_json::json!(tie_on_note(s.tie_on_cov_m2.as_ref(), u));
+    }
+    if s.uncalibrated {
+        doc["uncalibrated_note"] = serde_json::json!(UNCALIBRATED_NOTE);
     }
     if let Some(note) = &s.header_note {
         doc["placement_note"] = serde_json::json!(note);

@@ -4,7 +4,9 @@
 //! ([`crate::survey::streamed`]) write the same bytes. Lengths in the
 //! survey's output unit, each header naming it.
 
+use crate::formats::fixed::push_fixed;
 use crate::survey::iscwsa::Cov6;
+use crate::survey::listing::drilling::{UNCALIBRATED_FLAG, UNCALIBRATED_NOTE};
 use crate::survey::listing::ellipse::scale_2d;
 use crate::survey::listing::separation::Separation;
 use crate::survey::listing::{tie_on_note, KnownModel, LengthUnit, Row};
@@ -23,6 +25,9 @@ pub struct Head {
     pub unit: LengthUnit,
     /// Whether the rows carry an offset well's separation.
     pub offset: bool,
+    /// The probe ran without a calibration (`WellSurvey::uncalibrated`):
+    /// the note on top, every row flagged.
+    pub uncalibrated: bool,
 }
 
 impl Head {
@@ -35,6 +40,7 @@ impl Head {
             tie_on_cov_m2: s.tie_on_cov_m2,
             unit: s.output_unit,
             offset: s.offset.is_some(),
+            uncalibrated: s.uncalibrated,
         }
     }
 }
@@ -63,6 +69,9 @@ pub fn listing_head(h: &Head) -> String {
     let u = h.unit;
     let sym = u.symbol();
     let mut text = String::new();
+    if h.uncalibrated {
+        let _ = writeln!(text, "{UNCALIBRATED_NOTE}");
+    }
     let _ = writeln!(
         text,
         "{} stations; lengths in {sym}, N/E along true north; DLS in deg/{}; vertical section along {:.2} deg",
@@ -114,31 +123,38 @@ pub fn listing_head(h: &Head) -> String {
 pub fn listing_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String {
     let u = h.unit;
     let len = |m: f64| u.from_m(m);
-    let mut line = format!(
-        "{:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>9.2} {:>9.2} {:>6.2} {:>9.2}",
-        len(r.md_m),
-        r.inc_deg,
-        r.azi_deg,
-        len(r.tvd_m),
-        len(r.north_m),
-        len(r.east_m),
-        u.dls_from_per_30m(r.dls_deg_per_30m),
-        len(r.vsec_m)
-    );
+    let mut line = String::with_capacity(160);
+    // (value, decimals, width), each after one space but the first
+    let mut put = |cells: &[(f64, usize, usize)]| {
+        for &(x, decimals, width) in cells {
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            push_fixed(&mut line, x, decimals, width);
+        }
+    };
+    put(&[
+        (len(r.md_m), 2, 9),
+        (r.inc_deg, 2, 7),
+        (r.azi_deg, 2, 7),
+        (len(r.tvd_m), 2, 9),
+        (len(r.north_m), 2, 9),
+        (len(r.east_m), 2, 9),
+        (u.dls_from_per_30m(r.dls_deg_per_30m), 2, 6),
+        (len(r.vsec_m), 2, 9),
+    ]);
     if h.model.is_some() {
         match (r.cov, r.ellipse()) {
             (Some(c), Some(e)) => {
                 let (a, b) = e.scaled(h.confidence);
-                let _ = write!(
-                    line,
-                    " {:>7.2} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>6.1}",
-                    len(c[0].max(0.0).sqrt()),
-                    len(c[1].max(0.0).sqrt()),
-                    len(e.sigma_vert),
-                    len(a),
-                    len(b),
-                    e.azimuth_deg
-                );
+                put(&[
+                    (len(c[0].max(0.0).sqrt()), 2, 7),
+                    (len(c[1].max(0.0).sqrt()), 2, 7),
+                    (len(e.sigma_vert), 2, 7),
+                    (len(a), 2, 8),
+                    (len(b), 2, 8),
+                    (e.azimuth_deg, 1, 6),
+                ]);
             }
             _ => line += "  (outside the model's validity)",
         }
@@ -152,6 +168,9 @@ pub fn listing_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String
             }
             _ => line += "  SF undetermined",
         }
+    }
+    if h.uncalibrated {
+        let _ = write!(line, "  {UNCALIBRATED_FLAG}");
     }
     line + "\n"
 }
@@ -186,6 +205,9 @@ pub fn csv_head(h: &Head) -> String {
     if h.offset {
         let _ = write!(out, ",offset_md_{sym},ctc_{sym},sigma_s_{sym},sf,sf_status");
     }
+    if h.uncalibrated {
+        out += ",flag";
+    }
     out + "\n"
 }
 
@@ -193,7 +215,9 @@ pub fn csv_head(h: &Head) -> String {
 pub fn csv_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String {
     let u = h.unit;
     let len = |m: f64| u.from_m(m);
-    let mut out = format!(
+    let mut out = String::with_capacity(320);
+    let _ = write!(
+        out,
         "{},{},{},{},{},{},{},{},{},{}",
         len(r.md_m),
         r.inc_deg,
@@ -237,6 +261,9 @@ pub fn csv_row(h: &Head, r: &Row, separation: Option<&Separation>) -> String {
             opt(x.sf),
             sf_status(x)
         );
+    }
+    if h.uncalibrated {
+        let _ = write!(out, ",{UNCALIBRATED_FLAG}");
     }
     out + "\n"
 }

@@ -7,6 +7,7 @@
 //! The output is not validated against the XSD: Energistics publishes it
 //! on its site only, through no package registry.
 
+use crate::survey::listing::drilling::{UNCALIBRATED_FLAG, UNCALIBRATED_NOTE};
 use crate::survey::listing::{LengthUnit, Row};
 use crate::survey::well_survey::WellSurvey;
 use std::fmt::Write as _;
@@ -112,7 +113,22 @@ pub fn witsml_text(s: &WellSurvey) -> String {
             u.dls_from_per_30m(r.dls_deg_per_30m)
         );
         x += &matrix_cov(r, u);
+        if s.uncalibrated {
+            // TrajectoryStation's commonData comes after its matrixCov
+            let _ = writeln!(
+                x,
+                "      <commonData><comments>{UNCALIBRATED_FLAG}</comments></commonData>"
+            );
+        }
         x += "    </trajectoryStation>\n";
+    }
+    if s.uncalibrated {
+        // the trajectory's commonData follows its stations
+        let _ = writeln!(
+            x,
+            "    <commonData><comments>{}</comments></commonData>",
+            escaped(UNCALIBRATED_NOTE)
+        );
     }
     x += "  </trajectory>\n</trajectorys>\n";
     x

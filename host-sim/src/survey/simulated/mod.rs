@@ -116,6 +116,21 @@ impl SimulatedRun {
     pub fn summary(&self) -> String {
         let mut text = format!("{}\n", self.drilled);
         text += &self.checks.summary();
+        let rows = &self.survey.survey.rows;
+        let checked: Vec<_> = rows.iter().filter_map(|r| r.qc).collect();
+        if !checked.is_empty() || rows.is_empty() {
+            let out = checked.iter().filter(|q| !q.ok()).count();
+            text += &format!(
+                "station QC (gravity and earth rate against the site): {out} of {} stations out \
+                 of tolerance{}\n",
+                checked.len(),
+                if rows.len() > checked.len() {
+                    format!(", {} not checked", rows.len() - checked.len())
+                } else {
+                    String::new()
+                }
+            );
+        }
         text
     }
 }

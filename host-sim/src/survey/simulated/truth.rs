@@ -75,6 +75,9 @@ pub struct TruthChecks {
     /// Projected from the last station, if the survey has a bit.
     pub bit: Option<PointCheck>,
     pub confidence: f64,
+    /// Stations flagged "uncalibrated" (the probe ran without a
+    /// calibration: all of them).
+    pub uncalibrated_stations: usize,
 }
 
 impl TruthChecks {
@@ -100,10 +103,16 @@ impl TruthChecks {
             let truth = along_hole(drilling, end_md + b.sensor_to_bit_m);
             check("bit".into(), &b.row, truth, b.row.cov.is_some())
         });
+        let uncalibrated_stations = if survey.uncalibrated {
+            survey.rows.len()
+        } else {
+            0
+        };
         Self {
             stations,
             bit,
             confidence,
+            uncalibrated_stations,
         }
     }
 
@@ -135,6 +144,16 @@ impl TruthChecks {
             count(PointCheck::inside_vertical),
             positioned.len()
         );
+        if self.uncalibrated_stations > 0 {
+            let _ = writeln!(
+                text,
+                "UNCALIBRATED: {} of {} stations flagged \"uncalibrated\": the probe ran without a \
+                 calibration; their sigmas do not cover the parts' uncalibrated errors (turn-on \
+                 bias, scale factor, misalignment)",
+                self.uncalibrated_stations,
+                self.stations.len()
+            );
+        }
         if let Some(last) = self.last_station() {
             let _ = writeln!(text, "last station {}", point_line(last, p));
         }
