@@ -110,9 +110,10 @@ fn ten_thousand_stations_stream_as_they_are_held() {
     let path = dir.join("stations.csv");
     let mut text = String::from("md_m,inc_deg,azi_deg\n");
     for k in 0..=10_000u32 {
-        let md = f64::from(k) * 10.0;
+        // 1 m apart: 10 km, within the 20,000 m a station file may reach
+        let md = f64::from(k);
         let inc = (f64::from(k) * 0.05).min(88.0);
-        let azi = (30.0 + f64::from(k) * 0.01).rem_euclid(360.0);
+        let azi = (30.0 + f64::from(k) * 0.05).rem_euclid(360.0);
         text += &format!("{md},{inc},{azi}\n");
     }
     std::fs::write(&path, text).unwrap();
