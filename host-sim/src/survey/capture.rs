@@ -3,7 +3,7 @@
 //! stream, replayed through the probe's navigation for their links,
 //! paired with MD from the surface depth log and given the probe's own
 //! position uncertainty ([`drilling::survey`]); and the continuous
-//! trajectory from the 20 Hz solutions ([`drilling::trajectory`]).
+//! trajectory from the 20 Hz solutions ([`trajectory::trajectory`]).
 //! docs/drilling-survey.md.
 
 pub use crate::formats::capture::ProbeSetup;
@@ -12,8 +12,9 @@ use crate::formats::depth_log::DepthLog;
 use crate::formats::files::read_depth_log;
 use crate::replay::{replayed_station_links, Replayer, FILE_BATCH_ITEMS};
 use crate::survey::iscwsa::{ErrorTerm, Site};
-use crate::survey::listing::drilling::{self, DrillingSurvey, QcReference, TrajectoryPoint};
+use crate::survey::listing::drilling::{self, DrillingSurvey, QcReference};
 use crate::survey::listing::station_gaps::numbers_text;
+use crate::survey::listing::trajectory::{self, TrajectoryPoint};
 use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
 use crate::survey::station_qc::{CheckedStations, QcCollector, QcTolerances};
 use crate::survey::stations::{StationCollector, SurveySetup};
@@ -237,7 +238,7 @@ impl CaptureSurvey {
                 }
             }
         });
-        let points = drilling::trajectory(
+        let points = trajectory::trajectory(
             solutions,
             &self.depth,
             &self.survey,

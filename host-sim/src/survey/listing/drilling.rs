@@ -15,7 +15,6 @@
 
 pub use super::station_gaps::FIRST_STATION;
 use super::station_gaps::{lost_numbers, tie_on_station_known};
-pub use super::trajectory::{trajectory, TrajectoryPoint};
 use super::{compute, AzimuthReference, InputStation, LengthUnit, Row, StationFile, TieOnInput};
 use crate::formats::depth_log::DepthLog;
 use crate::survey::iscwsa::probe_station::{

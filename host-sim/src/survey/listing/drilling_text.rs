@@ -3,11 +3,11 @@
 //! from the first one on, shown as undetermined, never as a number.
 
 use super::drilling::{
-    BitProjection, DrillingRow, DrillingSurvey, TrajectoryPoint, UNCALIBRATED_FLAG,
-    UNCALIBRATED_NOTE,
+    BitProjection, DrillingRow, DrillingSurvey, UNCALIBRATED_FLAG, UNCALIBRATED_NOTE,
 };
 use super::ellipse::scale_2d;
 use super::station_gaps::lost_line;
+use super::trajectory::TrajectoryPoint;
 use super::LengthUnit;
 use mwd_core::probe::navigator::AZIMUTH_SIGMA_LIMIT_RAD;
 use mwd_core::protocol::frame::station_flags;

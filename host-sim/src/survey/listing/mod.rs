@@ -18,7 +18,7 @@ pub mod plot;
 mod positions;
 pub mod separation;
 pub mod station_gaps;
-mod trajectory;
+pub mod trajectory;
 
 pub use crate::formats::station_csv::{
     read_stations, InputStation, LengthUnit, StationFile, FOOT_M,
