@@ -114,10 +114,6 @@ mod tests {
             .collect()
     }
 
-    fn matrix(c: &Cov6) -> Matrix3<f64> {
-        Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2])
-    }
-
     fn psd(m: &Matrix3<f64>, what: &str) {
         let e = SymmetricEigen::new(*m).eigenvalues;
         let scale = m.trace().abs().max(1e-300);
@@ -162,7 +158,7 @@ mod tests {
             let mut prev = 0.0;
             for (k, c) in r.total.iter().enumerate().skip(1) {
                 assert!(c.iter().all(|x| x.is_finite()), "lat {lat}, station {k}");
-                let m = matrix(c);
+                let m = cov_matrix(c);
                 assert_eq!(m, m.transpose());
                 psd(&m, &format!("lat {lat}, station {k}"));
                 // the cross-hole (east) variance grows with MD
@@ -291,7 +287,7 @@ mod tests {
                 let with = run(&terms, &hold(90.0, azi, |k| Some(tf(k))), &site());
                 let free = run(&terms, &hold(90.0, azi, |_| None), &site());
                 for k in 1..with.total.len() {
-                    let d = matrix(&free.total[k]) - matrix(&with.total[k]);
+                    let d = cov_matrix(&free.total[k]) - cov_matrix(&with.total[k]);
                     psd(&d, &format!("azi {azi}, {name}, station {k}"));
                 }
             }

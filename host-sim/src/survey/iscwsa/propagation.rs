@@ -11,6 +11,12 @@ use std::collections::BTreeMap;
 /// NEV covariance, m^2: `[nn, ee, vv, ne, nv, ev]`.
 pub type Cov6 = [f64; 6];
 
+/// A [`Cov6`] as the symmetric 3x3 matrix of (north, east, vertical).
+pub fn cov_matrix(c: &Cov6) -> nalgebra::Matrix3<f64> {
+    let [nn, ee, vv, ne, nv, ev] = *c;
+    nalgebra::Matrix3::new(nn, ne, nv, ne, ee, ev, nv, ev, vv)
+}
+
 pub(super) fn outer(v: [f64; 3]) -> Cov6 {
     [
         v[0] * v[0],

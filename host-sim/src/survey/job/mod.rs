@@ -419,7 +419,7 @@ fn tie_on_covariance(
                     );
                 }
             }
-            let m = nalgebra::Matrix3::new(c.nn, c.ne, c.nv, c.ne, c.ee, c.ev, c.nv, c.ev, c.vv);
+            let m = crate::survey::iscwsa::cov_matrix(&cov);
             let least = m.symmetric_eigenvalues().min();
             // a rounding below the matrix's own scale is not a negative
             // variance

@@ -140,9 +140,9 @@ pub fn tie_on_m(tie: &TieOnInput, unit: LengthUnit, first_md: f64) -> Result<Tie
             );
         }
     }
-    let tie_cov = tie.covariance_m2(unit).map_or_else(Matrix3::zeros, |c| {
-        Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2])
-    });
+    let tie_cov = tie
+        .covariance_m2(unit)
+        .map_or_else(Matrix3::zeros, |c| iscwsa::cov_matrix(&c));
     TieOn::<TrueNorth>::new(
         first_md * k,
         tie.tvd * k,

@@ -42,10 +42,10 @@
 //! undetermined.
 
 use super::Row;
-use crate::survey::iscwsa::Cov6;
+use crate::survey::iscwsa::{cov_matrix, Cov6};
 use anyhow::{anyhow, bail, Result};
 use mwd_core::survey::{Segment, Station, TrueNorth};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// The rule's constants (Sawaryn et al. 2019, see the module notes).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -199,17 +199,12 @@ pub fn closest_point(p: &Vector3<f64>, offset: &[Row]) -> Result<Closest> {
     })
 }
 
-fn matrix(c: &Cov6) -> Matrix3<f64> {
-    let [nn, ee, vv, ne, nv, ev] = *c;
-    Matrix3::new(nn, ne, nv, ne, ee, ev, nv, ev, vv)
-}
-
 /// sigma_S and SF for centre-to-centre vector `d` (reference to offset)
 /// and the two covariances. At D = 0 the direction is undefined: the
 /// largest combined variance (any direction) is used, which cannot raise
 /// the factor of an already negative numerator above that of any direction.
 pub fn factor(d: &Vector3<f64>, c_ref: &Cov6, c_off: &Cov6, rule: &Rule) -> (f64, f64) {
-    let sum = matrix(c_ref) + matrix(c_off);
+    let sum = cov_matrix(c_ref) + cov_matrix(c_off);
     let dist = d.norm();
     let var_s = if dist > 0.0 {
         let u = d / dist;

@@ -202,7 +202,7 @@ fn check_site(job: &Job, plan_site: &mwd_core::earth::Position, plan_path: &Path
 /// simulated well starts where the window truly is.
 fn parent_survey_error(job: &Job, seed: u64) -> Option<[f64; 3]> {
     let c = job_tie_on(Some(job)).covariance?;
-    let m = Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2]);
+    let m = crate::survey::iscwsa::cov_matrix(&c);
     // a square root by the eigenvectors: the job's covariance may be
     // singular (a sigma of 0), where Cholesky fails
     let eigen = m.symmetric_eigen();
