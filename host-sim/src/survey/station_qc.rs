@@ -28,6 +28,7 @@ use mwd_core::conventions::{dcm_from_euler, DrillingAngles};
 use mwd_core::earth::{earth_rate_n, normal_gravity, Position, EARTH_RATE};
 use mwd_core::probe::raw::body_sample;
 use mwd_core::protocol::{RawSample, StationSurvey};
+use mwd_core::sensor_units::STANDARD_GRAVITY;
 use nalgebra::Vector3;
 use std::collections::VecDeque;
 
@@ -49,6 +50,11 @@ pub struct QcTolerances {
 }
 
 impl QcTolerances {
+    /// The per-axis gyro sigma in deg/h.
+    pub fn gyro_sigma_deg_h(&self) -> f64 {
+        deg_per_h(self.gyro_sigma_rad_s)
+    }
+
     /// From a model's terms; `None` if it lacks the accelerometer or gyro
     /// terms (gravity is then not checked either: one rule for both).
     pub fn from_terms(terms: &[ErrorTerm], gravity: f64) -> Option<Self> {
@@ -88,7 +94,23 @@ pub struct StationQc {
     pub earth_rate_residual: Option<(f64, f64)>,
 }
 
+/// A rate in rad/s in deg/h, as gyro tolerances are quoted.
+fn deg_per_h(rate_rad_s: f64) -> f64 {
+    rate_rad_s.to_degrees() * 3600.0
+}
+
 impl StationQc {
+    /// The gravity error in mg (of standard gravity).
+    pub fn gravity_error_mg(&self) -> f64 {
+        self.gravity_error_m_s2 / (STANDARD_GRAVITY * 1e-3)
+    }
+
+    /// The earth-rate residual and its tolerance in deg/h, where checked.
+    pub fn earth_rate_deg_h(&self) -> Option<(f64, f64)> {
+        self.earth_rate_residual
+            .map(|(r, tol)| (deg_per_h(r), deg_per_h(tol)))
+    }
+
     pub fn gravity_ok(&self) -> bool {
         self.gravity_error_m_s2.abs() <= self.gravity_tolerance_m_s2
     }
@@ -304,7 +326,7 @@ mod tests {
         // 3 sigma of a 1 mg residual bias (AXYZ-ZB) and the rest: about 3 mg
         assert!((0.029..0.031).contains(&t.gravity_m_s2), "{t:?}");
         // hypot(2.1, 5.04) deg/h
-        let deg_h = t.gyro_sigma_rad_s.to_degrees() * 3600.0;
+        let deg_h = t.gyro_sigma_deg_h();
         assert!((deg_h - 2.1f64.hypot(5.038)).abs() < 0.01, "{deg_h}");
         let mwd = crate::survey::listing::model("ISCWSA MWD Rev5").unwrap();
         let none = crate::survey::listing::terms(mwd).unwrap();

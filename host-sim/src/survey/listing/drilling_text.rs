@@ -130,9 +130,8 @@ fn qc_text(s: &DrillingSurvey) -> String {
          an axis, and of the azimuth sigma)\n",
         reference.gravity_m_s2,
         t.gravity_m_s2,
-        t.gyro_sigma_rad_s.to_degrees() * 3600.0
+        t.gyro_sigma_deg_h()
     );
-    let deg_h = |r: f64| r.to_degrees() * 3600.0;
     let mut out_of_tolerance = Vec::new();
     for r in &s.rows {
         let Some(q) = &r.qc else {
@@ -143,21 +142,19 @@ fn qc_text(s: &DrillingSurvey) -> String {
             );
             continue;
         };
-        let rate = match q.earth_rate_residual {
-            Some((res, tol)) => format!(
-                "earth-rate residual {:.1} deg/h (tolerance {:.1}) {}",
-                deg_h(res),
-                deg_h(tol),
-                if res <= tol { "ok" } else { "OUT" }
+        let rate = match (q.earth_rate_deg_h(), q.earth_rate_ok()) {
+            (Some((res, tol)), Some(ok)) => format!(
+                "earth-rate residual {res:.1} deg/h (tolerance {tol:.1}) {}",
+                if ok { "ok" } else { "OUT" }
             ),
-            None => "earth rate not checked (azimuth undetermined)".into(),
+            _ => "earth rate not checked (azimuth undetermined)".into(),
         };
         let _ = writeln!(
             out,
             "  station {:>3}: gravity {:.4} m/s^2 ({:+.2} mg) {}; {rate}",
             r.survey.station,
             q.gravity_m_s2,
-            q.gravity_error_m_s2 / 9.80665e-3,
+            q.gravity_error_mg(),
             if q.gravity_ok() { "ok" } else { "OUT" }
         );
         if !q.ok() {
@@ -303,8 +300,7 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
             (None, None, None)
         };
         let qc = r.qc.as_ref();
-        let rate = qc.and_then(|q| q.earth_rate_residual);
-        let deg_h = |r: f64| r.to_degrees() * 3600.0;
+        let rate = qc.and_then(|q| q.earth_rate_deg_h());
         let _ = writeln!(
             out,
             "{},{},{},{},{},{},{},{},{},{},{},{confidence},{},{},{},{},{}{flag}",
@@ -322,8 +318,8 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
             qc.map_or("not checked", |q| q.word()),
             opt(qc.map(|q| q.gravity_m_s2)),
             opt(qc.map(|q| q.gravity_error_m_s2)),
-            opt(rate.map(|r| deg_h(r.0))),
-            opt(rate.map(|r| deg_h(r.1)))
+            opt(rate.map(|r| r.0)),
+            opt(rate.map(|r| r.1))
         );
     }
     if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {

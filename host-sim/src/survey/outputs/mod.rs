@@ -131,14 +131,14 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         .map(|(k, r)| {
             let mut v = json_station(s, r);
             if let Some(q) = s.station_qc.get(k).copied().flatten() {
-                let deg_h = |r: f64| r.to_degrees() * 3600.0;
+                let rate = q.earth_rate_deg_h();
                 v["qc"] = serde_json::json!({
                     "result": q.word(),
                     "gravity_m_s2": q.gravity_m_s2,
                     "gravity_error_m_s2": q.gravity_error_m_s2,
                     "gravity_tolerance_m_s2": q.gravity_tolerance_m_s2,
-                    "earth_rate_residual_deg_h": q.earth_rate_residual.map(|r| deg_h(r.0)),
-                    "earth_rate_tolerance_deg_h": q.earth_rate_residual.map(|r| deg_h(r.1)),
+                    "earth_rate_residual_deg_h": rate.map(|r| r.0),
+                    "earth_rate_tolerance_deg_h": rate.map(|r| r.1),
                 });
             }
             if let Some(x) = s.offset.as_ref().map(|o| &o.seps[k]) {
