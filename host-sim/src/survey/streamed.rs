@@ -4,7 +4,7 @@
 //! nothing is written from a file that turns out bad) and to find the last
 //! station's closure (the default vertical-section direction); then to
 //! position each station (`mwd_core::survey::Walker`), give it the error
-//! model's covariance ([`iscwsa::Propagator`], the sources' running sums)
+//! model's covariance ([`listing::ModelRun`], the sources' running sums)
 //! and write its listing line and CSV row. Held at any time: two stations
 //! and the sources' sums, so a million stations take the memory of ten.
 //!
@@ -13,13 +13,12 @@
 //! bytes ([`crate::survey::outputs::table`]).
 
 use crate::formats::station_csv::{for_each_station, InputStation, LengthUnit};
-use crate::survey::iscwsa::{Cov6, ErrorTerm, Options, Propagator, Site};
 use crate::survey::listing::{
-    self, closure_azimuth, plus_tie_on, row, tie_on_m, true_station, Invalid, KnownModel, Row,
+    self, closure_azimuth, plus_tie_on, row, tie_on_m, true_station, ModelRun, Row,
 };
 use crate::survey::outputs::{csv_head, csv_row, listing_head, listing_row, Head};
 use crate::survey::well_survey::{validity_note, ModelChoice, SiteFor, SurveyInputs};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use mwd_core::survey::{SurveyPoint, TrueNorth, Walker};
 use std::io::Write;
 use std::path::Path;
@@ -86,8 +85,14 @@ pub fn survey_streamed(
     };
     let terms = model.map(listing::terms).transpose()?.unwrap_or_default();
     let mut run = model
-        .map(|m| Ok::<_, anyhow::Error>(ModelRun::new(m, &terms, site_for(m)?, tie_on_cov_m2)))
+        .map(|m| Ok::<_, anyhow::Error>(ModelRun::new(m, &terms, site_for(m)?)))
         .transpose()?;
+    // the tie-on's covariance in each station's, as `WellSurvey::compute`
+    // adds it
+    let with_tie_on = |mut r: Row| {
+        r.cov = r.cov.map(|c| plus_tie_on(c, tie_on_cov_m2.as_ref()));
+        r
+    };
     // Pass 2: the rows, one behind the file where a model runs (a
     // station's covariance needs the station after it).
     let mut table = Tables::new(&head, out)?;
@@ -96,16 +101,21 @@ pub fn survey_streamed(
         let r = row(s, &walk(&mut walker, file_unit, s, inputs)?, direction);
         match run.as_mut() {
             None => table.write(&r),
-            Some(run) => run.push(r)?.iter().try_for_each(|r| table.write(r)),
+            Some(run) => run
+                .push(r)?
+                .into_iter()
+                .try_for_each(|r| table.write(&with_tie_on(r))),
         }
     })
     .map_err(named)?;
     let mut note = None;
-    if let Some(mut run) = run {
-        run.finish()?.iter().try_for_each(|r| table.write(r))?;
+    if let (Some(mut run), Some(m)) = (run, model) {
+        run.finish()?
+            .into_iter()
+            .try_for_each(|r| table.write(&with_tie_on(r)))?;
         note = run
             .invalid
-            .map(|(invalid, md_m)| validity_note(run.model, &invalid, md_m, head.unit));
+            .map(|(invalid, md_m)| validity_note(m, &invalid, md_m, head.unit));
     }
     if let Some(note) = &note {
         writeln!(table.out.listing, "note: {note}")?;
@@ -165,102 +175,5 @@ impl<'h, 'o> Tables<'h, 'o> {
             csv.flush()?;
         }
         Ok(())
-    }
-}
-
-/// The error model run along the stream as `listing::apply_model` runs it
-/// over a survey in memory: the stations before the first where the model
-/// is not valid get covariances (the last of them as the survey's last
-/// station), the rest none; the tie-on's covariance added to each.
-struct ModelRun<'t> {
-    model: &'static KnownModel,
-    terms: &'t [ErrorTerm],
-    site: Site,
-    tie_on_cov_m2: Option<Cov6>,
-    propagator: Option<Propagator<'t>>,
-    /// The row waiting for its covariance.
-    pending: Option<Row>,
-    /// Where the model stopped being valid, and that station's MD (m).
-    invalid: Option<(Invalid, f64)>,
-    /// Index of the next row.
-    index: usize,
-}
-
-impl<'t> ModelRun<'t> {
-    fn new(
-        model: &'static KnownModel,
-        terms: &'t [ErrorTerm],
-        site: Site,
-        tie_on_cov_m2: Option<Cov6>,
-    ) -> Self {
-        Self {
-            model,
-            terms,
-            site,
-            tie_on_cov_m2,
-            propagator: None,
-            pending: None,
-            invalid: None,
-            index: 0,
-        }
-    }
-
-    /// Takes the next row; returns the rows now complete, in order.
-    fn push(&mut self, r: Row) -> Result<Vec<Row>> {
-        let k = self.index;
-        self.index += 1;
-        if self.invalid.is_some() {
-            return Ok(vec![r]);
-        }
-        if let Some(reason) = self.model.validity.check(&r, self.terms, &self.site) {
-            self.invalid = Some((Invalid { station: k, reason }, r.md_m));
-            let mut done = self.finish()?;
-            done.push(r);
-            return Ok(done);
-        }
-        let station = r.iscwsa_station();
-        let cov = match self.propagator.as_mut() {
-            Some(p) => p.push(station),
-            None => {
-                let p = Propagator::new(self.terms, station, &self.site, Options::REV5_10);
-                if !p.missing().is_empty() {
-                    bail!(
-                        "error model {}: weighting functions not implemented for {}",
-                        self.model.name,
-                        p.missing().join(", ")
-                    );
-                }
-                self.propagator = Some(p);
-                None
-            }
-        };
-        let done = self.pending.replace(r).map(|p| self.with(p, cov, k - 1));
-        done.into_iter().collect()
-    }
-
-    /// The row still waiting, with its covariance as the last station's.
-    fn finish(&mut self) -> Result<Vec<Row>> {
-        let cov = self.propagator.as_mut().and_then(Propagator::finish);
-        let k = self.index.saturating_sub(1);
-        self.pending
-            .take()
-            .map(|p| self.with(p, cov, k))
-            .into_iter()
-            .collect()
-    }
-
-    /// Row `k` with its covariance (`None`: the survey's first station,
-    /// which carries no error of its own) and the tie-on's.
-    fn with(&self, mut r: Row, cov: Option<Cov6>, k: usize) -> Result<Row> {
-        let cov = cov.unwrap_or([0.0; 6]);
-        if !cov.iter().all(|x| x.is_finite()) {
-            bail!(
-                "error model {}: non-finite covariance at station {k} (MD {} m)",
-                self.model.name,
-                r.md_m
-            );
-        }
-        r.cov = Some(plus_tie_on(cov, self.tie_on_cov_m2.as_ref()));
-        Ok(r)
     }
 }

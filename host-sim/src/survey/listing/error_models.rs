@@ -6,7 +6,7 @@
 
 use super::positions::Row;
 use crate::formats::text_records::excerpt;
-use crate::survey::iscwsa::{self, ErrorTerm, Site};
+use crate::survey::iscwsa::{self, ErrorTerm, Propagator, Site};
 use anyhow::{anyhow, bail, Context, Result};
 
 /// Where an error model may be applied.
@@ -283,38 +283,109 @@ pub fn apply_model(
     terms: &[ErrorTerm],
     site: &Site,
 ) -> Result<Option<Invalid>> {
-    let invalid = rows.iter().enumerate().find_map(|(k, r)| {
-        model
-            .validity
-            .check(r, terms, site)
-            .map(|reason| Invalid { station: k, reason })
-    });
-    let valid_to = invalid.as_ref().map_or(rows.len(), |i| i.station);
-    let stations: Vec<iscwsa::Station> = rows[..valid_to].iter().map(Row::iscwsa_station).collect();
+    let stations: Vec<iscwsa::Station> = rows.iter().map(Row::iscwsa_station).collect();
     if !stations.is_empty() {
         iscwsa::check_stations(&stations).map_err(|e| anyhow!("{e}"))?;
-        let result = iscwsa::run(terms, &stations, site);
-        if !result.missing.is_empty() {
-            bail!(
-                "error model {}: weighting functions not implemented for {}",
-                model.name,
-                result.missing.join(", ")
-            );
-        }
-        for (k, (row, cov)) in rows.iter_mut().zip(result.total).enumerate() {
-            // every station before the first invalid one is valid: a
-            // non-finite covariance here is a fault, not a flag
-            if !cov.iter().all(|x| x.is_finite()) {
-                bail!(
-                    "error model {}: non-finite covariance at station {k} (MD {} m)",
-                    model.name,
-                    row.md_m
-                );
-            }
-            row.cov = Some(cov);
+    }
+    let mut run = ModelRun::new(model, terms, *site);
+    let mut done = Vec::with_capacity(rows.len());
+    for r in rows.iter() {
+        done.extend(run.push(*r)?);
+    }
+    done.extend(run.finish()?);
+    rows.copy_from_slice(&done);
+    Ok(run.invalid.map(|(invalid, _)| invalid))
+}
+
+/// A model run over rows one at a time: the stations before the first
+/// where the model is not valid get covariances (the last of them as the
+/// survey's last station), the rest none. [`apply_model`] runs it over a
+/// survey in memory; `survey::streamed` over a file as it is read, holding
+/// one row and the sources' sums ([`iscwsa::Propagator`]).
+pub struct ModelRun<'t> {
+    model: &'t KnownModel,
+    terms: &'t [ErrorTerm],
+    site: Site,
+    propagator: Option<Propagator<'t>>,
+    /// The row waiting for its covariance.
+    pending: Option<Row>,
+    /// Where the model stopped being valid, and that station's MD (m).
+    pub invalid: Option<(Invalid, f64)>,
+    /// Index of the next row.
+    index: usize,
+}
+
+impl<'t> ModelRun<'t> {
+    pub fn new(model: &'t KnownModel, terms: &'t [ErrorTerm], site: Site) -> Self {
+        Self {
+            model,
+            terms,
+            site,
+            propagator: None,
+            pending: None,
+            invalid: None,
+            index: 0,
         }
     }
-    Ok(invalid)
+
+    /// Takes the next row; returns the rows now complete, in order.
+    pub fn push(&mut self, r: Row) -> Result<Vec<Row>> {
+        let k = self.index;
+        self.index += 1;
+        if self.invalid.is_some() {
+            return Ok(vec![r]);
+        }
+        if let Some(reason) = self.model.validity.check(&r, self.terms, &self.site) {
+            self.invalid = Some((Invalid { station: k, reason }, r.md_m));
+            let mut done = self.finish()?;
+            done.push(r);
+            return Ok(done);
+        }
+        let station = r.iscwsa_station();
+        let cov = match self.propagator.as_mut() {
+            Some(p) => p.push(station),
+            None => {
+                let p = Propagator::new(self.terms, station, &self.site, iscwsa::Options::REV5_10);
+                if !p.missing().is_empty() {
+                    bail!(
+                        "error model {}: weighting functions not implemented for {}",
+                        self.model.name,
+                        p.missing().join(", ")
+                    );
+                }
+                self.propagator = Some(p);
+                None
+            }
+        };
+        let done = self.pending.replace(r).map(|p| self.with(p, cov, k - 1));
+        done.into_iter().collect()
+    }
+
+    /// The row still waiting, with its covariance as the last station's.
+    pub fn finish(&mut self) -> Result<Vec<Row>> {
+        let cov = self.propagator.as_mut().and_then(Propagator::finish);
+        let k = self.index.saturating_sub(1);
+        self.pending
+            .take()
+            .map(|p| self.with(p, cov, k))
+            .into_iter()
+            .collect()
+    }
+
+    /// Row `k` with its covariance (`None`: the survey's first station,
+    /// which carries no error of its own).
+    fn with(&self, mut r: Row, cov: Option<iscwsa::Cov6>, k: usize) -> Result<Row> {
+        let cov = cov.unwrap_or([0.0; 6]);
+        if !cov.iter().all(|x| x.is_finite()) {
+            bail!(
+                "error model {}: non-finite covariance at station {k} (MD {} m)",
+                self.model.name,
+                r.md_m
+            );
+        }
+        r.cov = Some(cov);
+        Ok(r)
+    }
 }
 
 #[cfg(test)]

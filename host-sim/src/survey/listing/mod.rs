@@ -24,8 +24,8 @@ pub use crate::formats::station_csv::{
     read_stations, InputStation, LengthUnit, StationFile, FOOT_M,
 };
 pub use error_models::{
-    apply_model, file_validity, model, model_from_file, terms, Invalid, KnownModel, Validity,
-    MODELS,
+    apply_model, file_validity, model, model_from_file, terms, Invalid, KnownModel, ModelRun,
+    Validity, MODELS,
 };
 pub use positions::{
     closure_azimuth, compute, plus_tie_on, row, tie_on_m, tie_on_note, true_station,
