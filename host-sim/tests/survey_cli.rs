@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{refused, s, Run};
+use common::{refused, s, well1, Run, WELL1_SITE};
 use std::path::{Path, PathBuf};
 
 fn host_sim(args: &[&str]) -> Run {
@@ -14,22 +14,6 @@ fn host_sim(args: &[&str]) -> Run {
 fn scratch(name: &str) -> PathBuf {
     common::scratch("survey-cli", name)
 }
-
-fn well1() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa/well1_stations.csv")
-}
-
-/// Well #1's site (tests/data/iscwsa/wells.json).
-const WELL1_SITE: [&str; 8] = [
-    "--lat",
-    "60",
-    "--b-total-nt",
-    "50000",
-    "--dip-deg",
-    "72",
-    "--declination-deg",
-    "-4",
-];
 
 fn refused_file(name: &str, text: &str, extra: &[&str], needle: &str) {
     let path = scratch(name).join("stations.csv");

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{s, Run};
+use common::{s, well1, Run, WELL1_SITE};
 use host_sim::survey::listing::plot::{ELLIPSE_COLOUR, SIZE};
 use std::path::{Path, PathBuf};
 
@@ -17,22 +17,6 @@ fn host_sim(args: &[&str]) -> Run {
 fn scratch(name: &str) -> PathBuf {
     common::scratch("survey-plot", name)
 }
-
-fn well1() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa/well1_stations.csv")
-}
-
-/// Well #1's site (tests/data/iscwsa/wells.json).
-const WELL1_SITE: [&str; 8] = [
-    "--lat",
-    "60",
-    "--b-total-nt",
-    "50000",
-    "--dip-deg",
-    "72",
-    "--declination-deg",
-    "-4",
-];
 
 /// Runs well #1 with `model` and `--plot`, and returns the plot directory
 /// and the number of stations the JSON export gives a covariance.

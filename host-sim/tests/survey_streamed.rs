@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{s, Run};
+use common::{s, well1, Run, WELL1_SITE};
 use std::path::{Path, PathBuf};
 
 fn survey(args: &[&str]) -> Run {
@@ -17,10 +17,6 @@ fn survey(args: &[&str]) -> Run {
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch("survey-streamed", name)
-}
-
-fn well1() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa/well1_stations.csv")
 }
 
 /// The listing and CSV of the streamed run and of the in-memory run (made
@@ -44,16 +40,7 @@ fn both_ways(name: &str, stations: &Path, extra: &[&str]) -> [(String, Vec<u8>);
 
 #[test]
 fn the_streamed_survey_is_the_survey_held_in_memory() {
-    let lat = ["--lat", "60"];
-    let field = [
-        "--b-total-nt",
-        "50000",
-        "--dip-deg",
-        "72",
-        "--declination-deg",
-        "-4",
-    ];
-    let mwd: Vec<&str> = [&["--error-model", "ISCWSA MWD Rev5"][..], &lat, &field].concat();
+    let mwd: Vec<&str> = [&["--error-model", "ISCWSA MWD Rev5"][..], &WELL1_SITE].concat();
     let cases: Vec<(&str, Vec<&str>)> = vec![
         ("positions only", vec![]),
         ("mwd", mwd.clone()),
@@ -120,18 +107,7 @@ fn ten_thousand_stations_stream_as_they_are_held() {
     let [(streamed_text, streamed_csv), (held_text, held_csv)] = both_ways(
         "10001",
         &path,
-        &[
-            "--error-model",
-            "ISCWSA MWD Rev5",
-            "--lat",
-            "60",
-            "--b-total-nt",
-            "50000",
-            "--dip-deg",
-            "72",
-            "--declination-deg",
-            "-4",
-        ],
+        &[&["--error-model", "ISCWSA MWD Rev5"][..], &WELL1_SITE].concat(),
     );
     assert_eq!(streamed_text.lines().count(), 10_001 + 4);
     assert!(streamed_csv == held_csv, "the CSVs differ");

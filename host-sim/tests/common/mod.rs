@@ -102,3 +102,21 @@ pub fn simulate_tied_in_on(dir: &Path, plan_name: &str) -> (PathBuf, PathBuf, Pa
     assert_eq!(sim.code, Some(0), "{}", sim.stderr);
     (bin, depth, job)
 }
+
+/// ISCWSA test well #1's stations in the tool's format
+/// (`tests/data/iscwsa/well1_stations.csv`).
+pub fn well1() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/iscwsa/well1_stations.csv")
+}
+
+/// Well #1's site (`tests/data/iscwsa/wells.json`) as `survey` flags.
+pub const WELL1_SITE: [&str; 8] = [
+    "--lat",
+    "60",
+    "--b-total-nt",
+    "50000",
+    "--dip-deg",
+    "72",
+    "--declination-deg",
+    "-4",
+];
