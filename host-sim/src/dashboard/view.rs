@@ -77,7 +77,7 @@ pub fn attitude_channels(nav: &NavSolution) -> [f32; ATTITUDE_CHANNELS] {
     .map(|v| v as f32)
 }
 
-const NAV_FLAG_NAMES: [(u16, &str); 9] = [
+const NAV_FLAG_NAMES: [(u16, &str); 10] = [
     (nav_flags::ZUPT_APPLIED, "zero-velocity update"),
     (nav_flags::TOOL_AXIS_RATE_INVALID, "near vertical"),
     (nav_flags::SENSOR_DEGRADED, "sensor degraded"),
@@ -87,6 +87,10 @@ const NAV_FLAG_NAMES: [(u16, &str); 9] = [
     (nav_flags::SINGLE_PART, "single part"),
     (nav_flags::STILL, "still (station)"),
     (nav_flags::HEADING_LOST, "heading lost: needs a tie-in"),
+    (
+        nav_flags::UNCALIBRATED,
+        "UNCALIBRATED: sigmas leave out the parts' turn-on errors",
+    ),
 ];
 
 /// The latest solution for people: each angle with its 1-sigma.

@@ -157,6 +157,7 @@ pub fn station_text(s: &StationSurvey) -> String {
         (station_flags::INDEXING_DWELL, "indexing dwell"),
         (station_flags::MOTION_SEEN, "gyros saw it turn"),
         (station_flags::HEADING_LOST, "heading lost"),
+        (station_flags::UNCALIBRATED, "uncalibrated"),
     ];
     let flags: Vec<&str> = names
         .iter()

@@ -133,9 +133,10 @@ pub mod nav_flags {
     /// finite or not positive, or growth beyond its bound): the sigmas it
     /// would give are sent as NaN. Bit 3 was "covariance reset", never set.
     pub const COVARIANCE_INVALID: u16 = 1 << 3;
-    /// The solution is not to be used: its covariance is invalid, or the
-    /// small-angle error model no longer holds (a tilt sigma beyond the
-    /// limit `docs/protocol.md` states).
+    /// The solution is not to be used: there is none yet (the coarse
+    /// alignment: its fields are NaN placeholders), its covariance is
+    /// invalid, or the small-angle error model no longer holds (a tilt
+    /// sigma beyond the limit `docs/protocol.md` states).
     pub const SOLUTION_INVALID: u16 = 1 << 4;
     /// Propagated through missing or invalid samples and not aided since.
     pub const COASTING: u16 = 1 << 5;
@@ -151,6 +152,11 @@ pub mod nav_flags {
     /// sent as +inf until the next tie-in: unlike a heading the alignment
     /// never found, no station brings it back.
     pub const HEADING_LOST: u16 = 1 << 8;
+    /// The probe runs without a calibration (the identity correction it
+    /// boots with): its sigmas cover the residual errors of a calibrated
+    /// part only, not the parts' turn-on biases, scale factors and
+    /// misalignments, which may exceed them many times.
+    pub const UNCALIBRATED: u16 = 1 << 9;
 }
 
 /// Bits of [`StationSurvey::flags`]; the rest are reserved (sent as 0).
@@ -191,6 +197,9 @@ pub mod station_flags {
     /// at this station or before it: the azimuth is undetermined (bit 1)
     /// until a new tie-in.
     pub const HEADING_LOST: u16 = 1 << 8;
+    /// Surveyed without a calibration (as navigation bit 9): the sigmas
+    /// do not cover the parts' uncalibrated errors.
+    pub const UNCALIBRATED: u16 = 1 << 9;
 }
 
 /// A station survey (kind 4): the attitude at the end of a still period

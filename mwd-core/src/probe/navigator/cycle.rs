@@ -151,7 +151,11 @@ impl<T: FilterScalar> Navigator<T> {
     }
 
     fn step_reading(&mut self, time_us: u64, sample_counter: u32, reading: Reading) -> NavSolution {
-        self.flags = 0;
+        self.flags = if self.is_uncalibrated() {
+            nav_flags::UNCALIBRATED
+        } else {
+            0
+        };
         self.time_us = time_us;
         self.sample_counter = sample_counter;
         let still = match reading {

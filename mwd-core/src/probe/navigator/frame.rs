@@ -57,7 +57,12 @@ impl<T: FilterScalar> Navigator<T> {
             position_std_ned: [f32::NAN; 3],
         };
         solution.mode = match self.phase {
-            Phase::Coarse(_) => return solution,
+            Phase::Coarse(_) => {
+                // No solution yet: the NaN placeholders come with the bit
+                // that says not to use them.
+                solution.flags |= nav_flags::SOLUTION_INVALID;
+                return solution;
+            }
             Phase::Fine { .. } => nav_mode::FINE_ALIGNMENT,
             Phase::Navigating => nav_mode::NAVIGATING,
         };

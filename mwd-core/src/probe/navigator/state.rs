@@ -359,6 +359,14 @@ impl<T: FilterScalar> Navigator<T> {
     pub fn is_navigating(&self) -> bool {
         matches!(self.phase, Phase::Navigating)
     }
+
+    /// True while the probe corrects its samples with the identity (no
+    /// calibration configured): its error budget is a calibrated part's,
+    /// so every frame says its sigmas leave the parts' turn-on errors out
+    /// (navigation and station bit 9).
+    pub fn is_uncalibrated(&self) -> bool {
+        self.calibration == ProbeCalibration::default()
+    }
 }
 
 /// `v` squared (the navigator's files share it).

@@ -105,7 +105,9 @@ fn a_stop_in_navigation_gives_zero_updates_and_one_station() {
     // the azimuth is undetermined, as in the navigation frames.
     assert_eq!(
         st.flags,
-        station_flags::MAGNETIC_FREE | station_flags::AZIMUTH_UNDETERMINED
+        station_flags::MAGNETIC_FREE
+            | station_flags::AZIMUTH_UNDETERMINED
+            | station_flags::UNCALIBRATED
     );
     assert_eq!(st.angles_std[1], f32::INFINITY);
     assert!(st.correlations[0].is_nan() && st.correlations[2].is_nan());

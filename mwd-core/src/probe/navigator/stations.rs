@@ -310,6 +310,9 @@ impl<T: FilterScalar> Navigator<T> {
         let state = self.filter.state();
         let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
         let mut flags = station_flags::MAGNETIC_FREE;
+        if self.is_uncalibrated() {
+            flags |= station_flags::UNCALIBRATED;
+        }
         let inclination = angles.inclination;
         if !(NEAR_VERTICAL..=core::f64::consts::PI - NEAR_VERTICAL).contains(&inclination) {
             flags |= station_flags::NEAR_VERTICAL;

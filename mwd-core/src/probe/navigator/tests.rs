@@ -76,7 +76,15 @@ fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
     let mut navigator = Navigator::new(Position::paper_site());
     for n in 0..ALIGNMENT_SAMPLES - 1 {
         let s = navigator.step(&level_sample(n));
-        assert_eq!((s.mode, s.flags), (nav_mode::COARSE_ALIGNMENT, 0));
+        // No solution yet: said by the invalid bit that comes with every
+        // NaN sigma; the probe has no calibration (bit 9).
+        assert_eq!(
+            (s.mode, s.flags),
+            (
+                nav_mode::COARSE_ALIGNMENT,
+                nav_flags::SOLUTION_INVALID | nav_flags::UNCALIBRATED
+            )
+        );
         assert!(s.velocity_std[0].is_nan());
         // No solution yet: the attitude and velocity are placeholders,
         // and look like them.
@@ -87,7 +95,10 @@ fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
     bad.parts[0].flags = 0;
     bad.parts[1].flags = 0;
     let s = navigator.step(&bad);
-    assert_eq!(s.flags, nav_flags::SENSOR_DEGRADED);
+    assert_eq!(
+        s.flags,
+        nav_flags::SENSOR_DEGRADED | nav_flags::SOLUTION_INVALID | nav_flags::UNCALIBRATED
+    );
     assert!(!navigator.is_aligned());
 
     // The coarse alignment ends: the filter takes over.
@@ -102,7 +113,11 @@ fn coarse_then_fine_alignment_then_navigation_on_a_still_level_probe() {
         assert!(last.attitude[0].abs() < 1e-3 && last.attitude[1].abs() < 1e-3);
         if n < ALL_ALIGNMENT {
             assert_eq!(last.mode, nav_mode::FINE_ALIGNMENT, "sample {n}");
-            assert_eq!(last.flags, nav_flags::ZUPT_APPLIED, "sample {n}");
+            assert_eq!(
+                last.flags,
+                nav_flags::ZUPT_APPLIED | nav_flags::UNCALIBRATED,
+                "sample {n}"
+            );
         }
     }
     // After 60 s the probe navigates; the zero updates are over.
@@ -247,7 +262,11 @@ fn a_gap_in_the_fine_alignment_coasts_until_the_next_zero_update() {
     assert_ne!(s.flags & nav_flags::COASTING, 0, "{s:?}");
     assert_eq!(s.flags & nav_flags::ZUPT_APPLIED, 0, "{s:?}");
     let s = navigator.step(&level_sample(ALIGNMENT_SAMPLES + 51));
-    assert_eq!(s.flags, nav_flags::ZUPT_APPLIED, "{s:?}");
+    assert_eq!(
+        s.flags,
+        nav_flags::ZUPT_APPLIED | nav_flags::UNCALIBRATED,
+        "{s:?}"
+    );
 }
 
 /// With part 1 dead from boot the probe stayed in
@@ -373,4 +392,21 @@ fn an_f64_filter_gives_the_probes_f32_solutions_to_their_rounding() {
     // Measured: 1.8e-7 rad and 1.2e-5.
     assert!(worst_angle < 1e-6, "{worst_angle} rad");
     assert!(worst_sigma < 1e-4, "{worst_sigma}");
+}
+
+/// Bit 9 says whether the probe corrects its samples: set on every frame
+/// of a probe without a calibration, on none of a calibrated one.
+#[test]
+fn only_an_uncalibrated_probe_flags_its_frames_uncalibrated() {
+    let mut calibration = ProbeCalibration::default();
+    calibration.gyro[0].bias = 1e-5;
+    let mut calibrated = Navigator::with_calibration(Position::paper_site(), calibration);
+    let mut uncalibrated = Navigator::new(Position::paper_site());
+    assert!(uncalibrated.is_uncalibrated() && !calibrated.is_uncalibrated());
+    for n in 0..ALIGNMENT_SAMPLES + 20 {
+        let a = calibrated.step(&level_sample(n));
+        let b = uncalibrated.step(&level_sample(n));
+        assert_eq!(a.flags & nav_flags::UNCALIBRATED, 0, "sample {n}: {a:?}");
+        assert_eq!(b.flags, a.flags | nav_flags::UNCALIBRATED, "sample {n}");
+    }
 }
