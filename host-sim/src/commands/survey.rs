@@ -16,7 +16,8 @@ use host_sim::survey::iscwsa::Site;
 use host_sim::survey::job::{Job, SurveyJob, WellNames};
 use host_sim::survey::listing::separation as sep;
 use host_sim::survey::listing::{
-    self as listing, drilling, AzimuthReference, KnownModel, LengthUnit, TieOnInput,
+    self as listing, drilling, AzimuthReference, KnownModel, LengthUnit, StationReading,
+    TieOnInput,
 };
 use host_sim::survey::outputs::{listing_text, write_outputs, OutputPaths};
 use host_sim::survey::streamed::{survey_streamed, StreamOutputs};
@@ -162,6 +163,10 @@ pub struct Args {
     /// figures in the file's unit.
     #[arg(long, value_enum)]
     pub units: Option<Units>,
+    /// Wrap station azimuths within one turn of 0..360 (-360..720 deg: -30
+    /// is read as 330, 400 as 40) instead of refusing them.
+    #[arg(long)]
+    pub wrap_azimuth: bool,
     /// Vertical-section azimuth, deg (default: closure of the last station).
     #[arg(long, value_parser = azimuth_deg)]
     pub vsec_azimuth_deg: Option<f64>,
@@ -326,13 +331,14 @@ pub fn run(args: Args) -> Result<ExitCode> {
         return super::survey_capture::run(&args.capture, &inputs, &outputs, &site_for);
     }
     let units = args.units.map(Units::unit);
+    let reading = station_reading(&args);
     let whole_survey_outputs = [&args.json, &args.witsml, &args.plot, &args.sep.offset];
     if whole_survey_outputs.iter().all(|o| o.is_none()) {
         // the listing and the CSV only: row by row, in constant memory
-        run_streamed(&args, &resolved, units, &site_for)?;
+        run_streamed(&args, &resolved, reading, &site_for)?;
         return Ok(ExitCode::from(super::status::COMPLETE));
     }
-    let file = read_station_file(&args.stations, units)?;
+    let file = read_station_file(&args.stations, reading)?;
     let inputs = SurveyInputs {
         reference: azimuth_reference(&args)?,
         tie: resolved.tie_on(&args, file.unit),
@@ -361,18 +367,27 @@ pub fn run(args: Args) -> Result<ExitCode> {
     Ok(ExitCode::from(super::status::COMPLETE))
 }
 
+/// How the station files are read: `--units` for an MD column that names
+/// none, `--wrap-azimuth`.
+fn station_reading(args: &Args) -> StationReading {
+    StationReading {
+        unit: args.units.map(Units::unit),
+        wrap_azimuth: args.wrap_azimuth,
+    }
+}
+
 /// The survey of a station file of any length, its listing and CSV
 /// written as the stations are read (`survey::streamed`); a CSV left
 /// incomplete by an error is removed.
 fn run_streamed(
     args: &Args,
     resolved: &Resolved,
-    units: Option<LengthUnit>,
+    reading: StationReading,
     site_for: SiteFor,
 ) -> Result<()> {
     let path = &args.stations;
     let input = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    let file_unit = file_unit(input, units).with_context(|| format!("{}", path.display()))?;
+    let file_unit = file_unit(input, reading).with_context(|| format!("{}", path.display()))?;
     let inputs = SurveyInputs {
         reference: azimuth_reference(args)?,
         tie: resolved.tie_on(args, file_unit),
@@ -387,7 +402,7 @@ fn run_streamed(
         csv: csv.as_mut().map(|w| w as &mut dyn std::io::Write),
     };
     // An error drops the CSV unfinished: no partial file, the error says why.
-    survey_streamed(path, units, &inputs, site_for, units, outputs)?;
+    survey_streamed(path, reading, &inputs, site_for, reading.unit, outputs)?;
     if let Some(csv) = csv {
         csv.finish()?;
     }
@@ -501,7 +516,7 @@ fn offset_inputs<'a>(args: &'a Args, path: &'a Path) -> Result<OffsetInputs<'a>>
             covariance: None,
         },
         model_name: args.sep.offset_error_model.as_deref(),
-        declared_unit: args.units.map(Units::unit),
+        reading: station_reading(args),
         rule: sep::Rule {
             k: sep::K,
             surface_margin_m: args.sep.surface_margin_m,

@@ -12,7 +12,7 @@
 //! ([`WellSurvey::compute`]) number for number, and the tables the same
 //! bytes ([`crate::survey::outputs::table`]).
 
-use crate::formats::station_csv::{for_each_station, InputStation, LengthUnit};
+use crate::formats::station_csv::{for_each_station, InputStation, LengthUnit, StationReading};
 use crate::survey::listing::{
     self, closure_azimuth, plus_tie_on, row, tie_on_m, true_station, ModelRun, Row,
 };
@@ -39,12 +39,12 @@ pub struct StreamedSurvey {
     pub validity_note: Option<String>,
 }
 
-/// Surveys the station file at `path` (its MD unit `declared` if the
-/// header names none), writing the listing and the CSV row by row in
+/// Surveys the station file at `path` (read as `reading` says: its MD
+/// unit if the header names none, azimuths to wrap), writing the listing and the CSV row by row in
 /// `unit` (metres if `None`).
 pub fn survey_streamed(
     path: &Path,
-    declared: Option<LengthUnit>,
+    reading: StationReading,
     inputs: &SurveyInputs,
     site_for: SiteFor,
     unit: Option<LengthUnit>,
@@ -56,7 +56,7 @@ pub fn survey_streamed(
     let mut walker = None;
     let mut last = None;
     let mut stations = 0usize;
-    let file_unit = for_each_station(open()?, declared, |file_unit, s| {
+    let file_unit = for_each_station(open()?, reading, |file_unit, s| {
         stations += 1;
         last = Some(walk(&mut walker, file_unit, s, inputs)?);
         Ok(())
@@ -97,7 +97,7 @@ pub fn survey_streamed(
     // station's covariance needs the station after it).
     let mut table = Tables::new(&head, out)?;
     let mut walker = None;
-    for_each_station(open()?, declared, |file_unit, s| {
+    for_each_station(open()?, reading, |file_unit, s| {
         let r = row(s, &walk(&mut walker, file_unit, s, inputs)?, direction);
         match run.as_mut() {
             None => table.write(&r),

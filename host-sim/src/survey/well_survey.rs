@@ -14,7 +14,7 @@ use crate::survey::job::WellNames;
 use crate::survey::listing::separation as sep;
 use crate::survey::listing::{
     self as listing, AzimuthReference, Invalid, KnownModel, LengthUnit, Row, StationFile,
-    TieOnInput,
+    StationReading, TieOnInput,
 };
 use crate::survey::station_qc::StationQc;
 use anyhow::{bail, Context, Result};
@@ -23,11 +23,11 @@ use std::path::Path;
 /// The site a model runs at, given the model (see the module's doc).
 pub type SiteFor<'a> = &'a dyn Fn(&KnownModel) -> Result<Site>;
 
-/// Reads a station file (CSV), its path in the errors; an MD column
-/// without a unit is in `declared` (`--units`), if given.
-pub fn read_station_file(path: &Path, declared: Option<LengthUnit>) -> Result<StationFile> {
+/// Reads a station file (CSV), its path in the errors, as `reading` says
+/// (an MD column without a unit, azimuths to wrap).
+pub fn read_station_file(path: &Path, reading: StationReading) -> Result<StationFile> {
     let input = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    crate::formats::station_csv::read_stations_in(input, declared)
+    crate::formats::station_csv::read_stations_in(input, reading)
         .with_context(|| format!("{}", path.display()))
 }
 
@@ -68,8 +68,8 @@ pub struct OffsetInputs<'a> {
     pub tie: TieOnInput,
     /// Its error model by name; `None`: the reference well's.
     pub model_name: Option<&'a str>,
-    /// The unit of an MD column without one (`--units`).
-    pub declared_unit: Option<LengthUnit>,
+    /// How its file is read (`--units`, `--wrap-azimuth`).
+    pub reading: StationReading,
     pub rule: sep::Rule,
 }
 
@@ -165,7 +165,7 @@ impl WellSurvey {
     /// separation from every station of this survey.
     pub fn add_offset(&mut self, inputs: &OffsetInputs, site_for: SiteFor) -> Result<()> {
         let path = inputs.path;
-        let file = read_station_file(path, inputs.declared_unit).context("the offset well")?;
+        let file = read_station_file(path, inputs.reading).context("the offset well")?;
         if file.unit != self.unit {
             bail!(
                 "{}: the offset well's length unit differs from the reference well's (give both in m or both in ft)",

@@ -115,6 +115,26 @@ pub struct StationFile {
     pub stations: Vec<InputStation>,
 }
 
+/// How a station file is read: the unit of an MD column that names none
+/// (`--units`), and whether azimuths outside 0..360 are wrapped into it
+/// (`--wrap-azimuth`: those within one turn of it, -360..720) rather than
+/// refused.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StationReading {
+    pub unit: Option<LengthUnit>,
+    pub wrap_azimuth: bool,
+}
+
+impl StationReading {
+    /// Read with `unit` for an MD column that names none.
+    pub fn in_unit(unit: Option<LengthUnit>) -> Self {
+        Self {
+            unit,
+            ..Self::default()
+        }
+    }
+}
+
 /// What a column gives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Quantity {
@@ -368,14 +388,14 @@ fn optional(fields: &[&str], col: Option<usize>, name: &str, line: u64) -> Resul
 
 /// Reads and checks a station file; its MD column names its unit.
 pub fn read_stations<R: Read>(input: R) -> Result<StationFile> {
-    read_stations_in(input, None)
+    read_stations_in(input, StationReading::default())
 }
 
 /// Reads and checks a station file whose MD column may leave its unit to
-/// `declared` (a header's own unit stands).
-pub fn read_stations_in<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<StationFile> {
+/// `reading.unit` (a header's own unit stands).
+pub fn read_stations_in<R: Read>(input: R, reading: StationReading) -> Result<StationFile> {
     let mut stations: Vec<InputStation> = Vec::new();
-    let unit = for_each_station(input, declared, |_, s| {
+    let unit = for_each_station(input, reading, |_, s| {
         stations.push(*s);
         Ok(())
     })?;
@@ -384,7 +404,7 @@ pub fn read_stations_in<R: Read>(input: R, declared: Option<LengthUnit>) -> Resu
 
 /// The length unit of a station file, from its header (and its first
 /// station, checked): what a caller needs before the stations.
-pub fn file_unit<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<LengthUnit> {
+pub fn file_unit<R: Read>(input: R, reading: StationReading) -> Result<LengthUnit> {
     /// Stops the reading at the first station.
     #[derive(Debug)]
     struct Found(LengthUnit);
@@ -394,7 +414,7 @@ pub fn file_unit<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<Leng
         }
     }
     impl std::error::Error for Found {}
-    match for_each_station(input, declared, |unit, _| Err(Found(unit).into())) {
+    match for_each_station(input, reading, |unit, _| Err(Found(unit).into())) {
         Ok(unit) => Ok(unit),
         Err(e) => e.downcast_ref::<Found>().map(|f| f.0).ok_or(e),
     }
@@ -406,14 +426,14 @@ pub fn file_unit<R: Read>(input: R, declared: Option<LengthUnit>) -> Result<Leng
 /// length.
 pub fn for_each_station<R: Read>(
     input: R,
-    declared: Option<LengthUnit>,
+    reading: StationReading,
     mut take: impl FnMut(LengthUnit, &InputStation) -> Result<()>,
 ) -> Result<LengthUnit> {
     let mut cols: Option<Columns> = None;
     let mut previous: Option<InputStation> = None;
     for_each_record_tab_aware(input, |line, fields| {
         let Some(c) = &cols else {
-            cols = Some(columns(fields, line, declared)?);
+            cols = Some(columns(fields, line, reading.unit)?);
             return Ok(());
         };
         if c.station
@@ -422,10 +442,17 @@ pub fn for_each_station<R: Read>(
             return Ok(());
         }
         let [md, inc, azi, toolface, time] = &c.names;
+        let azi_deg = number(fields, c.azi, azi, line)?;
         let s = InputStation {
             md: number(fields, c.md, md, line)?,
             inc_deg: number(fields, c.inc, inc, line)?,
-            azi_deg: number(fields, c.azi, azi, line)?,
+            // Wrapped only when asked (400 read as 40 may hide a typing
+            // error), and only one turn either side: 1e300 stays refused.
+            azi_deg: if reading.wrap_azimuth && (-360.0..720.0).contains(&azi_deg) {
+                azi_deg.rem_euclid(360.0)
+            } else {
+                azi_deg
+            },
             toolface_deg: optional(fields, c.toolface, toolface, line)?,
             time_s: optional(fields, c.time, time, line)?,
         };
@@ -435,7 +462,7 @@ pub fn for_each_station<R: Read>(
         if !(0.0..=360.0).contains(&s.azi_deg) {
             bail!(
                 "line {line}: azimuth {} deg outside 0..360 (give azimuths from north, clockwise, \
-                 in 0..360)",
+                 in 0..360, or survey with --wrap-azimuth to wrap them into it)",
                 shown(s.azi_deg)
             );
         }

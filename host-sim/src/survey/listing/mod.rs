@@ -21,7 +21,7 @@ pub mod station_gaps;
 pub mod trajectory;
 
 pub use crate::formats::station_csv::{
-    read_stations, InputStation, LengthUnit, StationFile, FOOT_M,
+    read_stations, InputStation, LengthUnit, StationFile, StationReading, FOOT_M,
 };
 pub use error_models::{
     apply_model, file_validity, model, model_from_file, terms, Invalid, KnownModel, ModelRun,
