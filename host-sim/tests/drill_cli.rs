@@ -131,6 +131,95 @@ fn the_example_job_runs_from_another_directory_and_surveys_to_the_bit() {
         .unwrap()
         .contains("<trajectoryStation"));
     assert!(plots.join("plan.png").is_file());
+
+    // A 200 s hole in the depth log around station 2: that station alone
+    // flagged in the listing, the CSV, the JSON and the WITSML.
+    let time = col("time_s");
+    let station_2 = csv.lines().nth(2).unwrap().split(',').collect::<Vec<_>>()[time]
+        .parse::<f64>()
+        .unwrap();
+    let log = std::fs::read_to_string(run_dir.join("depth.csv")).unwrap();
+    let holed: String = log
+        .lines()
+        .filter(|l| {
+            l.split(',')
+                .next()
+                .and_then(|t| t.parse::<f64>().ok())
+                .is_none_or(|t| (t - station_2).abs() > 100.0)
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let holed_log = dir.join("holed.csv");
+    std::fs::write(&holed_log, holed).unwrap();
+    let (csv_out, json_out, witsml_out) =
+        (dir.join("h.csv"), dir.join("h.json"), dir.join("h.xml"));
+    let survey_holed = |limit: &str| {
+        run(&[
+            "survey",
+            s(&run_dir.join("capture.bin")),
+            "--depth",
+            s(&holed_log),
+            "--job",
+            s(&example_job()),
+            "--depth-gap-limit",
+            limit,
+            "--csv",
+            s(&csv_out),
+            "--json",
+            s(&json_out),
+            "--witsml",
+            s(&witsml_out),
+        ])
+    };
+    let flagged = survey_holed("30");
+    assert_eq!(flagged.code, Some(0), "{}", flagged.stderr);
+    let gap = "depth interpolated across a gap";
+    let flagged_lines: Vec<&str> = flagged
+        .stdout
+        .lines()
+        .filter(|l| l.ends_with(gap))
+        .collect();
+    assert_eq!(flagged_lines.len(), 1, "{}", flagged.stdout);
+    assert!(
+        flagged_lines[0].trim_start().starts_with("2 "),
+        "{}",
+        flagged.stdout
+    );
+    assert!(
+        flagged.stdout.contains(&format!("{gap}: station 2 (")),
+        "{}",
+        flagged.stdout
+    );
+    let csv_text = std::fs::read_to_string(&csv_out).unwrap();
+    let flags: Vec<&str> = csv_text
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
+    assert_eq!(flags.iter().filter(|f| **f == gap).count(), 1, "{csv_text}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json_out).unwrap()).unwrap();
+    let with_flag: Vec<usize> = json["stations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .filter(|(_, st)| st["flags"] == serde_json::json!([gap]))
+        .map(|(k, _)| k)
+        .collect();
+    assert_eq!(with_flag.len(), 1, "{json}");
+    let witsml = std::fs::read_to_string(&witsml_out).unwrap();
+    assert_eq!(
+        witsml
+            .matches(&format!("<comments>{gap}</comments>"))
+            .count(),
+        1
+    );
+    // A limit longer than the hole: no flag anywhere.
+    let unflagged = survey_holed("1000");
+    assert_eq!(unflagged.code, Some(0), "{}", unflagged.stderr);
+    assert!(!unflagged.stdout.contains(gap), "{}", unflagged.stdout);
+    assert!(!std::fs::read_to_string(&csv_out).unwrap().contains(gap));
 }
 
 #[test]

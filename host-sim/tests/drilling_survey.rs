@@ -8,8 +8,10 @@ mod common;
 use common::{plan, run, s, scratch, simulate_tied_in};
 use host_sim::formats::depth_log::DepthLog;
 use host_sim::survey::iscwsa::Site;
-use host_sim::survey::listing::drilling::{survey, survey_terms, SurveySetup};
-use host_sim::survey::listing::drilling_text::listing;
+use host_sim::survey::listing::drilling::{
+    survey, survey_terms, SurveySetup, DEPTH_GAP_FLAG, DEPTH_GAP_LIMIT_S,
+};
+use host_sim::survey::listing::drilling_text::{listing, stations_csv};
 use host_sim::survey::listing::TieOnInput;
 use mwd_core::protocol::frame::station_flags;
 use mwd_core::protocol::StationSurvey;
@@ -95,6 +97,7 @@ fn setup(sensor_to_bit: Option<f64>) -> SurveySetup {
         sensor_to_bit_m: None,
         first_station: 1,
         uncalibrated: false,
+        depth_gap_limit_s: DEPTH_GAP_LIMIT_S,
     }
     .with_sensor_to_bit(sensor_to_bit)
 }
@@ -265,6 +268,45 @@ fn an_undetermined_azimuth_ends_the_positions_and_is_printed_so() {
     let out = survey(&stations, &[], &[], &log(), &setup(None)).unwrap();
     assert_eq!(out.rows.len(), 3);
     assert!(out.skipped[0].reason.contains("invalid"));
+}
+
+#[test]
+fn a_station_whose_md_spans_a_hole_in_the_depth_log_is_flagged() {
+    // Rows every 10 s, but none from 120 s to 320 s (a 200 s hole).
+    let mut points: Vec<(f64, f64)> = (0..=12).map(|k| (10.0 * k as f64, 1000.0)).collect();
+    points.extend((32..=40).map(|k| (10.0 * k as f64, 1000.0 + (k as f64 - 31.0))));
+    let depth = DepthLog::new(points).unwrap();
+    // Station 1 at a row, station 2 inside the hole, station 3 after it.
+    let stations = [
+        station(1, 100.0, 0.5),
+        station(2, 250.0, 0.5),
+        station(3, 395.0, 0.5),
+    ];
+    let run = |limit: f64| {
+        let setup = SurveySetup {
+            depth_gap_limit_s: limit,
+            ..setup(None)
+        };
+        survey(&stations, &[None; 3], &[None; 3], &depth, &setup).unwrap()
+    };
+    let flagged = run(DEPTH_GAP_LIMIT_S);
+    let gaps: Vec<Option<f64>> = flagged.rows.iter().map(|r| r.depth_gap_s).collect();
+    assert_eq!(gaps, [None, Some(200.0), None]);
+    let text = listing(&flagged, 0.95);
+    assert!(
+        text.contains(&format!("{DEPTH_GAP_FLAG}: station 2 (200 s)"))
+            && text.contains("longer than 30 s"),
+        "{text}"
+    );
+    let csv = stations_csv(&flagged, 0.95);
+    let rows = table(&csv);
+    let flags: Vec<&str> = rows.iter().map(|r| r["flag"].as_str()).collect();
+    assert_eq!(flags, ["", DEPTH_GAP_FLAG, ""], "{csv}");
+    // A longer limit takes the hole as a pause: no flag, no column.
+    let allowed = run(300.0);
+    assert!(allowed.rows.iter().all(|r| r.depth_gap_s.is_none()));
+    assert!(!stations_csv(&allowed, 0.95).contains("flag"));
+    assert!(!listing(&allowed, 0.95).contains(DEPTH_GAP_FLAG));
 }
 
 #[test]

@@ -16,8 +16,7 @@ use host_sim::survey::iscwsa::Site;
 use host_sim::survey::job::{Job, SurveyJob, WellNames};
 use host_sim::survey::listing::separation as sep;
 use host_sim::survey::listing::{
-    self as listing, drilling, AzimuthReference, KnownModel, LengthUnit, StationReading,
-    TieOnInput,
+    self as listing, drilling, AzimuthReference, KnownModel, LengthUnit, StationReading, TieOnInput,
 };
 use host_sim::survey::outputs::{listing_text, write_outputs, OutputPaths};
 use host_sim::survey::streamed::{survey_streamed, StreamOutputs};
@@ -469,6 +468,7 @@ fn capture_inputs(args: &Args, resolved: &Resolved) -> Result<CaptureSurveyInput
             .job
             .sensor_to_bit
             .map(|d| d * resolved.job.tie_on.unit.to_m()),
+        depth_gap_limit_s: args.capture.depth_gap_limit,
     })
 }
 

@@ -12,6 +12,7 @@ use anyhow::Result;
 use host_sim::formats::files::write_text;
 use host_sim::survey::capture::{trajectory_csv, CaptureSurvey, CaptureSurveyInputs};
 use host_sim::survey::job::WellNames;
+use host_sim::survey::listing::drilling::DEPTH_GAP_LIMIT_S;
 use host_sim::survey::outputs::{write_outputs, OutputPaths};
 use host_sim::survey::well_survey::{OffsetInputs, SiteFor};
 use std::path::PathBuf;
@@ -39,6 +40,15 @@ pub struct CaptureArgs {
     /// MD step of the trajectory, m.
     #[arg(long, default_value_t = 1.0, value_parser = step_m, requires = "trajectory")]
     pub trajectory_step_m: f64,
+    /// With --depth: a station whose MD the depth log interpolates across
+    /// a longer interval between its rows, s, is flagged "depth
+    /// interpolated across a gap".
+    #[arg(long, value_name = "S", default_value_t = DEPTH_GAP_LIMIT_S, value_parser = gap_s, requires = "depth")]
+    pub depth_gap_limit: f64,
+}
+
+fn gap_s(text: &str) -> Result<f64, String> {
+    number_in(text, "the depth-log gap limit", (0.0, 86_400.0), "s")
 }
 
 /// What a capture survey writes besides the listing.

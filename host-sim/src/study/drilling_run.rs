@@ -473,6 +473,7 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
         sensor_to_bit_m: None,
         first_station: drilling::FIRST_STATION,
         uncalibrated,
+        depth_gap_limit_s: drilling::DEPTH_GAP_LIMIT_S,
     };
     let survey = collected.survey(&links, &setup, &depth);
     let (td, td_note, method_td_error_ne) = match survey {

@@ -39,6 +39,9 @@ pub struct CaptureSurveyInputs {
     /// From the survey sensors to the bit, m: the survey ends with the
     /// bit's projection.
     pub sensor_to_bit_m: Option<f64>,
+    /// A station whose MD the depth log interpolates across a longer
+    /// interval, s, is flagged (`drilling::DEPTH_GAP_LIMIT_S` by default).
+    pub depth_gap_limit_s: f64,
 }
 
 /// A capture's survey and what its listing says about the capture.
@@ -64,6 +67,10 @@ impl CaptureSurvey {
         let setup = SurveySetup::probe(inputs.tie, inputs.latitude)?
             .with_sensor_to_bit(inputs.sensor_to_bit_m)
             .with_uncalibrated(inputs.probe.is_uncalibrated());
+        let setup = SurveySetup {
+            depth_gap_limit_s: inputs.depth_gap_limit_s,
+            ..setup
+        };
         let links = read.links;
         let mut survey = read
             .collected
@@ -167,6 +174,7 @@ impl CaptureSurvey {
             .take_while(|r| r.position_determined && r.row.cov.is_some())
             .collect();
         let station_qc = exported.iter().map(|r| r.qc).collect();
+        let row_flags = exported.iter().map(|r| r.flags(false)).collect();
         let mut rows: Vec<Row> = exported.iter().map(|r| r.row).collect();
         let left_out = self.survey.rows.len() - rows.len();
         let bit = self
@@ -210,6 +218,7 @@ impl CaptureSurvey {
             output_unit: LengthUnit::Metre,
             station_qc,
             uncalibrated: self.survey.uncalibrated,
+            row_flags,
         })
     }
 

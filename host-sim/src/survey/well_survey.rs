@@ -118,9 +118,23 @@ pub struct WellSurvey {
     /// `DrillingSurvey::uncalibrated`): every output says so on top and
     /// flags every station.
     pub uncalibrated: bool,
+    /// Each row's own flags besides "uncalibrated" (a capture's survey:
+    /// `DrillingRow::flags`), where any (else empty).
+    pub row_flags: Vec<Vec<&'static str>>,
 }
 
 impl WellSurvey {
+    /// Row `k`'s flags: "uncalibrated" for a probe that ran without a
+    /// calibration, then the row's own.
+    pub fn station_flags(&self, k: usize) -> Vec<&'static str> {
+        let mut flags = Vec::new();
+        if self.uncalibrated {
+            flags.push(listing::drilling::UNCALIBRATED_FLAG);
+        }
+        flags.extend(self.row_flags.get(k).into_iter().flatten());
+        flags
+    }
+
     /// The stations of `file` positioned and, with a model, given their
     /// covariance at the site `site_for` gives for it.
     pub fn compute(file: &StationFile, inputs: &SurveyInputs, site_for: SiteFor) -> Result<Self> {
@@ -158,6 +172,7 @@ impl WellSurvey {
             output_unit: LengthUnit::Metre,
             station_qc: Vec::new(),
             uncalibrated: false,
+            row_flags: Vec::new(),
         })
     }
 

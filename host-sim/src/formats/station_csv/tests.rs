@@ -222,10 +222,17 @@ fn lengths_variances_and_dogleg_severity_convert_to_feet() {
 #[test]
 fn an_md_column_without_a_unit_takes_the_declared_one() {
     let text = "MD;Inc;Azi\n0;0;0\n100;3;10\n";
-    let f = read_stations_in(text.as_bytes(), StationReading::in_unit(Some(LengthUnit::Foot))).unwrap();
+    let f = read_stations_in(
+        text.as_bytes(),
+        StationReading::in_unit(Some(LengthUnit::Foot)),
+    )
+    .unwrap();
     assert_eq!(f.unit, LengthUnit::Foot);
     // the header's own unit stands
-    let f = read_stations_in("md_m,inc,azi\n0,0,0\n".as_bytes(), StationReading::in_unit(Some(LengthUnit::Foot)));
+    let f = read_stations_in(
+        "md_m,inc,azi\n0,0,0\n".as_bytes(),
+        StationReading::in_unit(Some(LengthUnit::Foot)),
+    );
     assert_eq!(f.unwrap().unit, LengthUnit::Metre);
     let e = read_stations_in(
         "MD,Inc,Azi,TVD (m)\n0,0,0,0\n".as_bytes(),
@@ -248,10 +255,16 @@ fn wrap_azimuth_wraps_within_one_turn_and_refuses_the_rest() {
     assert_eq!(azimuths, [0.0, 40.0, 330.0, 359.5]);
     // Without the option the same file is refused, naming the option.
     let e = format!("{:#}", read(text).unwrap_err());
-    assert!(e.contains("line 3: azimuth 400") && e.contains("--wrap-azimuth"), "{e}");
+    assert!(
+        e.contains("line 3: azimuth 400") && e.contains("--wrap-azimuth"),
+        "{e}"
+    );
     // Far outside a turn, or not a number: refused even when wrapping.
     for bad in ["1e300", "720", "-361", "NaN"] {
         let text = format!("md_m,inc,azi\n0,0,0\n100,10,{bad}\n");
-        assert!(read_stations_in(text.as_bytes(), wrapping).is_err(), "{bad}");
+        assert!(
+            read_stations_in(text.as_bytes(), wrapping).is_err(),
+            "{bad}"
+        );
     }
 }

@@ -46,7 +46,35 @@ pub struct DrillingRow {
     /// The station's quality checks, where the capture had its samples
     /// ([`crate::survey::station_qc`]).
     pub qc: Option<StationQc>,
+    /// The depth log's interval this station's MD was interpolated
+    /// across, s, where longer than [`SurveySetup::depth_gap_limit_s`].
+    pub depth_gap_s: Option<f64>,
 }
+
+impl DrillingRow {
+    /// The station's flags: [`UNCALIBRATED_FLAG`] for a probe that ran
+    /// without a calibration, [`DEPTH_GAP_FLAG`].
+    pub fn flags(&self, uncalibrated: bool) -> Vec<&'static str> {
+        let mut flags = Vec::new();
+        if uncalibrated {
+            flags.push(UNCALIBRATED_FLAG);
+        }
+        if self.depth_gap_s.is_some() {
+            flags.push(DEPTH_GAP_FLAG);
+        }
+        flags
+    }
+}
+
+/// The flag of a station whose MD the depth log gives only across a
+/// longer interval than [`SurveySetup::depth_gap_limit_s`].
+pub const DEPTH_GAP_FLAG: &str = "depth interpolated across a gap";
+
+/// The longest depth-log interval a station's MD is interpolated across
+/// without a flag, s: a surface system logs every few seconds, and a
+/// stand's connection (the string still) takes minutes, so a longer hole
+/// in the log is lost data, not a pause.
+pub const DEPTH_GAP_LIMIT_S: f64 = 30.0;
 
 /// The site's gravity and the tolerances a capture's stations were checked
 /// against.
@@ -89,6 +117,9 @@ pub struct DrillingSurvey {
     /// every station is flagged, its sigmas do not cover the parts'
     /// uncalibrated errors.
     pub uncalibrated: bool,
+    /// The longest depth-log interval a station's MD was interpolated
+    /// across unflagged, s ([`DrillingRow::depth_gap_s`]).
+    pub depth_gap_limit_s: f64,
 }
 
 /// The bit at the end of the depth log (TD: the log's last MD plus the
@@ -131,6 +162,9 @@ pub struct SurveySetup {
     /// sigmas are the calibrated residual's and do not cover those
     /// errors, so every station is flagged ([`UNCALIBRATED_NOTE`]).
     pub uncalibrated: bool,
+    /// A station whose MD the depth log interpolates across a longer
+    /// interval, s, is flagged ([`DEPTH_GAP_FLAG`]).
+    pub depth_gap_limit_s: f64,
 }
 
 /// What the outputs of a survey whose probe ran without a calibration say
@@ -161,6 +195,7 @@ impl SurveySetup {
             sensor_to_bit_m: None,
             first_station: FIRST_STATION,
             uncalibrated: false,
+            depth_gap_limit_s: DEPTH_GAP_LIMIT_S,
         })
     }
 
@@ -478,6 +513,9 @@ pub fn survey(
                 azimuth_determined: sigmas[k].is_some(),
                 position_determined: k < covs.len(),
                 qc: None,
+                depth_gap_s: depth
+                    .interpolation_span(*time_s)
+                    .filter(|gap| *gap > setup.depth_gap_limit_s),
             }
         })
         .collect();
@@ -490,6 +528,7 @@ pub fn survey(
         tie_on_cov_m2: tie.covariance_m2(LengthUnit::Metre),
         qc_reference: None,
         uncalibrated: setup.uncalibrated,
+        depth_gap_limit_s: setup.depth_gap_limit_s,
     })
 }
 

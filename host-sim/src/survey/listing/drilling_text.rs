@@ -3,7 +3,8 @@
 //! from the first one on, shown as undetermined, never as a number.
 
 use super::drilling::{
-    BitProjection, DrillingRow, DrillingSurvey, UNCALIBRATED_FLAG, UNCALIBRATED_NOTE,
+    BitProjection, DrillingRow, DrillingSurvey, DEPTH_GAP_FLAG, UNCALIBRATED_FLAG,
+    UNCALIBRATED_NOTE,
 };
 use super::ellipse::scale_2d;
 use super::station_gaps::lost_line;
@@ -35,11 +36,17 @@ pub fn top_note(s: &DrillingSurvey) -> String {
 }
 
 /// The listing's stations: one line per station, then the skipped
-/// stations; for a probe that ran without a calibration every station
-/// (and the bit) flagged at the end of its line.
+/// stations; each station's flags at the end of its line (for a probe that
+/// ran without a calibration, every station and the bit).
 pub fn stations_listing(s: &DrillingSurvey, confidence: f64) -> String {
     let mut out = String::new();
     let flag = station_flag(s);
+    let row_flags = |r: &DrillingRow| {
+        r.flags(s.uncalibrated)
+            .iter()
+            .map(|f| format!("  {f}"))
+            .collect::<String>()
+    };
     let _ = writeln!(
         out,
         "{} stations from the probe's station surveys; MD from the depth log{}; N/E along true north, m",
@@ -77,7 +84,7 @@ pub fn stations_listing(s: &DrillingSurvey, confidence: f64) -> String {
         while let Some((first, last)) = lost.next_if(|(first, _)| *first < r.survey.station) {
             let _ = writeln!(out, "{}", lost_line(*first, *last));
         }
-        let _ = writeln!(out, "{}{flag}", line(r, confidence));
+        let _ = writeln!(out, "{}{}", line(r, confidence), row_flags(r));
     }
     for (first, last) in lost {
         let _ = writeln!(out, "{}", lost_line(*first, *last));
@@ -90,6 +97,22 @@ pub fn stations_listing(s: &DrillingSurvey, confidence: f64) -> String {
              {:.2} m straight ahead of station {} (its inclination and azimuth; their errors act \
              over the projection too)",
             bit.sensor_to_bit_m, bit.projected_m, last.survey.station
+        );
+    }
+    let gaps: Vec<String> = s
+        .rows
+        .iter()
+        .filter_map(|r| {
+            r.depth_gap_s
+                .map(|g| format!("{} ({g:.0} s)", r.survey.station))
+        })
+        .collect();
+    if !gaps.is_empty() {
+        let _ = writeln!(
+            out,
+            "{DEPTH_GAP_FLAG}: station {}: the depth log has no row for longer than {:.0} s              around the station's time, and its MD there is a straight line between the rows              each side; check the surface depth record for the interval",
+            gaps.join(", "),
+            s.depth_gap_limit_s
         );
     }
     if let Some(u) = s.rows.iter().find(|r| !r.position_determined) {
@@ -275,13 +298,25 @@ const POSITION_HEADER: &str = "tvd_m,north_m,east_m,sigma_north_m,sigma_east_m,s
 ellipse_semi_major_m,ellipse_semi_minor_m,ellipse_azimuth_deg";
 
 /// The stations as CSV (angles in deg, sigmas 1-sigma; empty cells:
-/// undetermined). A probe that ran without a calibration: one more
-/// column, `flag`, "uncalibrated" on every row.
+/// undetermined). Where a station has a flag: one more column, `flag`,
+/// each row's flags separated by "; " ("uncalibrated" on every row of a
+/// probe that ran without a calibration).
 pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
-    let (flag_header, flag) = if s.uncalibrated {
-        (",flag", format!(",{UNCALIBRATED_FLAG}"))
+    let any_flag = s.uncalibrated || s.rows.iter().any(|r| !r.flags(false).is_empty());
+    let flag_header = if any_flag { ",flag" } else { "" };
+    let row_flag = |r: &DrillingRow| {
+        if any_flag {
+            format!(",{}", r.flags(s.uncalibrated).join("; "))
+        } else {
+            String::new()
+        }
+    };
+    let flag = if s.uncalibrated {
+        format!(",{UNCALIBRATED_FLAG}")
+    } else if any_flag {
+        ",".to_string()
     } else {
-        ("", String::new())
+        String::new()
     };
     let mut out = format!(
         "station,time_s,md_m,inc_deg,sigma_inc_deg,azi_deg,sigma_azi_deg,toolface_deg,sigma_toolface_deg,\
@@ -303,7 +338,7 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
         let rate = qc.and_then(|q| q.earth_rate_deg_h());
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{confidence},{},{},{},{},{}{flag}",
+            "{},{},{},{},{},{},{},{},{},{},{},{confidence},{},{},{},{},{}{}",
             r.survey.station,
             r.time_s,
             r.row.md_m,
@@ -319,7 +354,8 @@ pub fn stations_csv(s: &DrillingSurvey, confidence: f64) -> String {
             opt(qc.map(|q| q.gravity_m_s2)),
             opt(qc.map(|q| q.gravity_error_m_s2)),
             opt(rate.map(|r| r.0)),
-            opt(rate.map(|r| r.1))
+            opt(rate.map(|r| r.1)),
+            row_flag(r)
         );
     }
     if let (Some(bit), Some(last)) = (&s.bit, s.rows.last()) {

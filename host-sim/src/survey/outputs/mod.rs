@@ -130,6 +130,10 @@ pub fn json_text(s: &WellSurvey) -> Result<String> {
         .enumerate()
         .map(|(k, r)| {
             let mut v = json_station(s, r);
+            let flags = s.station_flags(k);
+            if !flags.is_empty() {
+                v["flags"] = serde_json::json!(flags);
+            }
             if let Some(q) = s.station_qc.get(k).copied().flatten() {
                 let rate = q.earth_rate_deg_h();
                 v["qc"] = serde_json::json!({

@@ -7,7 +7,7 @@
 //! The output is not validated against the XSD: Energistics publishes it
 //! on its site only, through no package registry.
 
-use crate::survey::listing::drilling::{UNCALIBRATED_FLAG, UNCALIBRATED_NOTE};
+use crate::survey::listing::drilling::UNCALIBRATED_NOTE;
 use crate::survey::listing::{LengthUnit, Row};
 use crate::survey::well_survey::WellSurvey;
 use std::fmt::Write as _;
@@ -113,11 +113,13 @@ pub fn witsml_text(s: &WellSurvey) -> String {
             u.dls_from_per_30m(r.dls_deg_per_30m)
         );
         x += &matrix_cov(r, u);
-        if s.uncalibrated {
+        let flags = s.station_flags(k);
+        if !flags.is_empty() {
             // TrajectoryStation's commonData comes after its matrixCov
             let _ = writeln!(
                 x,
-                "      <commonData><comments>{UNCALIBRATED_FLAG}</comments></commonData>"
+                "      <commonData><comments>{}</comments></commonData>",
+                escaped(&flags.join("; "))
             );
         }
         x += "    </trajectoryStation>\n";

@@ -91,6 +91,7 @@ impl SimulatedRun {
                 .survey
                 .sensor_to_bit
                 .map(|d| d * job.survey.tie_on.unit.to_m()),
+            depth_gap_limit_s: crate::survey::listing::drilling::DEPTH_GAP_LIMIT_S,
         })?;
         let checks = TruthChecks::new(&survey.survey, &drilling, inputs.confidence);
         let mut drilled = drilled;
