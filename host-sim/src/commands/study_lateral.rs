@@ -222,16 +222,14 @@ pub struct MergeArgs {
 /// `study merge`: the shards checked to make one study, whose outputs
 /// are then written as `study lateral` writes them.
 pub fn merge(args: MergeArgs) -> Result<()> {
-    let mut shards = Vec::new();
-    for path in &args.shards {
+    let shards = args.shards.iter().map(|path| {
         let name = path.display().to_string();
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading the shard {name}"))?;
         let shard = ShardFile::parse(&text, &name)?;
-        shards.push((name, shard));
-    }
-    let merged = shard::merge(&shards)?;
-    drop(shards);
+        Ok((name, shard))
+    });
+    let merged = shard::merge(shards)?;
     let tie_in_sigma_deg = exact_number(
         &merged.spec.tie_in_azimuth_sigma_deg,
         "the tie-in azimuth sigma",

@@ -227,28 +227,36 @@ pub struct Merged {
     pub outcomes: Vec<Option<JobOutcome>>,
 }
 
-/// The shards (each with its name) checked to make one study, whole:
-/// the same configuration and shard count, every shard once, every job
-/// of each.
-pub fn merge(shards: &[(String, ShardFile)]) -> Result<Merged> {
-    let Some((first_name, first)) = shards.first() else {
+/// The shards (each with its name, read one at a time: only the
+/// outcomes stay in memory) checked to make one study, whole: the same
+/// configuration and shard count, every shard once, every job of each.
+pub fn merge(shards: impl IntoIterator<Item = Result<(String, ShardFile)>>) -> Result<Merged> {
+    let mut shards = shards.into_iter();
+    let Some(first) = shards.next() else {
         bail!("no shard to merge");
     };
-    let count = first.shard.count;
-    let mut seen: Vec<Option<&str>> = vec![None; count];
-    let mut outcomes: Vec<Option<JobOutcome>> = (0..first.jobs).map(|_| None).collect();
-    for (name, shard) in shards {
-        if shard.configuration != first.configuration || shard.jobs != first.jobs {
+    let (first_name, first) = first?;
+    let (count, jobs) = (first.shard.count, first.jobs);
+    let mut merged = Merged {
+        spec: first.configuration.clone(),
+        threads: 1,
+        wall_s: 0.0,
+        jobs,
+        outcomes: (0..jobs).map(|_| None).collect(),
+    };
+    let mut seen: Vec<Option<String>> = vec![None; count];
+    for item in std::iter::once(Ok((first_name.clone(), first))).chain(shards) {
+        let (name, shard) = item?;
+        if shard.configuration != merged.spec || shard.jobs != jobs {
             bail!(
                 "{name} is a shard of another study than {first_name} (they differ in: {})",
-                differences(&first.configuration, &shard.configuration).join(", ")
+                differences(&merged.spec, &shard.configuration).join(", ")
             );
         }
         if shard.shard.count != count {
             bail!(
-                "{name} is shard {} but {first_name} is shard {}: not the same split",
-                shard.shard,
-                first.shard
+                "{name} is shard {} but {first_name} is one of {count}: not the same split",
+                shard.shard
             );
         }
         let slot = shard
@@ -260,24 +268,29 @@ pub fn merge(shards: &[(String, ShardFile)]) -> Result<Merged> {
         if let Some(other) = slot {
             bail!("shard {} given twice: {other} and {name}", shard.shard);
         }
-        *slot = Some(name);
-        let expected = shard.shard.jobs(first.jobs);
-        let held: Vec<usize> = shard.outcomes.iter().map(|o| o.job).collect();
-        if held != expected {
+        *slot = Some(name.clone());
+        let expected = shard.shard.jobs(jobs);
+        if !shard
+            .outcomes
+            .iter()
+            .map(|o| o.job)
+            .eq(expected.iter().copied())
+        {
             bail!(
-                "{name}: shard {} holds jobs {} but should hold {} of the study's {}",
+                "{name}: shard {} holds {} jobs, not the {} of its slice of the study's {jobs}",
                 shard.shard,
-                held.len(),
-                expected.len(),
-                first.jobs
+                shard.outcomes.len(),
+                expected.len()
             );
         }
         for o in &shard.outcomes {
-            let bytes = from_hex(&o.outcome)
+            let outcome = from_hex(&o.outcome)
                 .and_then(|b| decode(&b))
                 .with_context(|| format!("{name}: job {}'s outcome is damaged", o.job))?;
-            outcomes[o.job] = Some(bytes);
+            merged.outcomes[o.job] = Some(outcome);
         }
+        merged.threads = merged.threads.max(shard.threads);
+        merged.wall_s += shard.wall_s;
     }
     let missing: Vec<String> = (1..=count)
         .filter(|k| seen[k - 1].is_none())
@@ -289,13 +302,7 @@ pub fn merge(shards: &[(String, ShardFile)]) -> Result<Merged> {
             missing.join(", ")
         );
     }
-    Ok(Merged {
-        spec: first.configuration.clone(),
-        threads: shards.iter().map(|(_, s)| s.threads).max().unwrap_or(1),
-        wall_s: shards.iter().map(|(_, s)| s.wall_s).sum(),
-        jobs: first.jobs,
-        outcomes,
-    })
+    Ok(merged)
 }
 
 impl Merged {
