@@ -22,6 +22,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import uuid
 
 
 def run_shard(host_sim, study_args, index, count):
@@ -106,9 +107,10 @@ def main(argv):
           f"({args.scheduler or 'LocalCluster on 127.0.0.1'})", flush=True)
     started = time.monotonic()
     try:
+        run = uuid.uuid4().hex[:8]  # keys of their own on a shared scheduler
         futures = {
             client.submit(run_shard, args.host_sim, args.study_args, k, n,
-                          key=f"host-sim-shard-{k}-of-{n}", pure=False,
+                          key=f"host-sim-shard-{k}-of-{n}-{run}", pure=False,
                           retries=args.retries): k
             for k in range(1, n + 1)
         }
