@@ -69,5 +69,10 @@ bash scripts/bad-input-matrix.sh target/debug/host-sim
 # The dashboard in headless Chromium (installs Debian's chromium if absent):
 # DOM checks against `host-sim decode` of the same capture, and a screenshot.
 bash scripts/dashboard-browser-test.sh target/debug/host-sim
+# A lateral study in shards on a 2-worker Dask LocalCluster on 127.0.0.1
+# (scripts/study_dask.py; venv from scripts/requirements-dask.txt, about
+# 30 s to install), one shard failing once and retried, merged: the same
+# outputs as one process, compared with cmp (timings aside).
+bash scripts/study-dask-test.sh target/debug/host-sim
 # What the builds took on disk (CI machines have had little to spare).
 du -sh target

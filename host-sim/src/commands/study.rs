@@ -26,9 +26,13 @@ pub enum StudyCommand {
     /// gyro grade, station azimuth and TD position errors against the
     /// predicted sigmas (docs/lateral-study.md).
     Lateral(LateralArgs),
+    /// The outputs of a lateral study run in shards (`study lateral
+    /// --shard K/N --shard-file FILE`, K = 1..N): the same tables, JSON,
+    /// CSV and plots as the study in one process (docs/study-scale-out.md).
+    Merge(MergeArgs),
 }
 
-pub use super::study_lateral::LateralArgs;
+pub use super::study_lateral::{LateralArgs, MergeArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct CoverageArgs {
@@ -65,6 +69,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         StudyCommand::DrillingCoverage(args) => drilling_coverage(args),
         StudyCommand::RinsProbe(args) => rins_probe(args),
         StudyCommand::Lateral(args) => super::study_lateral::run(args),
+        StudyCommand::Merge(args) => super::study_lateral::merge(args),
     }
 }
 

@@ -6,13 +6,19 @@ use super::limits::{azimuth_sigma_deg, number_in};
 use super::runs::{progress_bar, stop_on_ctrl_c, SeedsAndThreads};
 use anyhow::{Context, Result};
 use host_sim::formats::files::{write_json, write_text};
+use host_sim::formats::text_records::read_small_file;
 use host_sim::study::drilling_run::Scalar;
-use host_sim::study::grade;
-use host_sim::study::lateral::covariance::SweepGrid;
+use host_sim::study::grade::{self, Grade};
 use host_sim::study::lateral::figures::plots;
+use host_sim::study::lateral::run::StudyJobs;
+use host_sim::study::lateral::shard::{
+    self, exact_number, exact_text, ShardFile, ShardIndex, SourceText, StudySpec,
+};
 use host_sim::study::lateral::stations::stations_csv;
 use host_sim::study::lateral::table::{csv, table};
-use host_sim::study::lateral::{study, DrillingOverrides, LateralStudy, StudyConfig, Well};
+use host_sim::study::lateral::{
+    study, DrillingOverrides, LateralStudy, StudyConfig, Well, BUILTIN_WELLS,
+};
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]
@@ -71,6 +77,35 @@ pub struct LateralArgs {
     /// 1-sigma of the parent well's azimuth at the tie-in, deg.
     #[arg(long = "tie-in-azimuth-sigma", alias = "tie-in-azimuth-sigma-deg", default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
     pub tie_in_azimuth_sigma_deg: f64,
+    #[command(flatten)]
+    pub outputs: StudyOutputs,
+    /// Covariance analysis only (one error-free run per grade and well,
+    /// seconds to a minute), no Monte Carlo.
+    #[arg(long)]
+    pub covariance_only: bool,
+    /// Also sweep the first grade's gyro bias instability (0.001-10 deg/h)
+    /// and ARW (0.001-3 deg/sqrt(h)) by covariance analysis, this many
+    /// log-spaced values of each.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=20))]
+    pub sweep: Option<u64>,
+    /// The navigator filter's scalar: f64 gives the probe's f32 figures
+    /// (docs/lateral-study.md), faster on x86 hosts.
+    #[arg(long, value_enum, default_value = "f64")]
+    pub scalar: Scalar,
+    /// Run only the K-th of N slices of the study's jobs (K from 1) and
+    /// write them to --shard-file; `host-sim study merge` makes the
+    /// outputs from all N (docs/study-scale-out.md).
+    #[arg(long, value_name = "K/N", value_parser = ShardIndex::parse, requires = "shard_file",
+          conflicts_with_all = ["json", "csv", "stations_csv", "plots"])]
+    pub shard: Option<ShardIndex>,
+    /// The shard's file (JSON), with --shard.
+    #[arg(long, value_name = "FILE", requires = "shard")]
+    pub shard_file: Option<PathBuf>,
+}
+
+/// What a lateral study writes (`study lateral` and `study merge`).
+#[derive(clap::Args, Debug)]
+pub struct StudyOutputs {
     /// Write the results here (JSON: summaries and the along-MD arrays).
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -86,67 +121,47 @@ pub struct LateralArgs {
     /// grade against the predicted sigmas, and the sweep's contour map.
     #[arg(long)]
     pub plots: Option<PathBuf>,
-    /// Covariance analysis only (one error-free run per grade and well,
-    /// seconds to a minute), no Monte Carlo.
-    #[arg(long)]
-    pub covariance_only: bool,
-    /// Also sweep the first grade's gyro bias instability (0.001-10 deg/h)
-    /// and ARW (0.001-3 deg/sqrt(h)) by covariance analysis, this many
-    /// log-spaced values of each.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=20))]
-    pub sweep: Option<u64>,
-    /// The navigator filter's scalar: f64 gives the probe's f32 figures
-    /// (docs/lateral-study.md), faster on x86 hosts.
-    #[arg(long, value_enum, default_value = "f64")]
-    pub scalar: Scalar,
 }
 
 pub fn run(args: LateralArgs) -> Result<()> {
-    let grades = grade::select(&args.grades, &args.grade_files)?;
-    let overrides = DrillingOverrides {
-        rop_m_per_h: args.rop_m_per_h,
-        stand_length_m: args.stand_length_m,
-        connection_still_s: args.connection_still_s,
-    };
-    let wells = wells(&args, &overrides)?;
+    let spec = spec(&args)?;
     let threads = args.seeds.threads();
-    let config = StudyConfig {
-        grades,
-        wells,
-        runs: args.runs as usize,
-        first_seed: args.seeds.first_seed,
-        threads,
-        tie_in_azimuth_sigma: args.tie_in_azimuth_sigma_deg.to_radians(),
-        monte_carlo: !args.covariance_only,
-        sweep: args.sweep.map(|n| SweepGrid::default_grid(n as usize)),
-        scalar: args.scalar,
-    };
+    let config = spec.config(threads)?;
+    if let Some(shard) = args.shard {
+        return run_shard(&args, &spec, &config, shard);
+    }
     let pairs = (config.grades.len() * config.wells.len()) as u64;
     let sweep_points = args.sweep.map_or(0, |n| n * n) * config.wells.len() as u64;
     let runs = if args.covariance_only { 0 } else { args.runs };
     let jobs = pairs * (runs + 1) + sweep_points;
-    let bar = progress_bar(
-        jobs,
-        "{bar:40} {pos}/{len} runs (Monte Carlo, covariance analysis, sweep), {elapsed} (eta {eta})",
-    )?;
+    let bar = progress_bar(jobs, PROGRESS)?;
     let stop = stop_on_ctrl_c(Some(&bar))?;
     let result = study(&config, &|| bar.inc(1), &stop)?;
     bar.finish_and_clear();
-    let names: Vec<&str> = config.grades.iter().map(|g| g.name()).collect();
-    let wells: Vec<&str> = config.wells.iter().map(|w| w.label.as_str()).collect();
+    report(&result, args.tie_in_azimuth_sigma_deg, &args.outputs)
+}
+
+const PROGRESS: &str =
+    "{bar:40} {pos}/{len} runs (Monte Carlo, covariance analysis, sweep), {elapsed} (eta {eta})";
+
+/// The study's first line and tables on standard output, its files, its
+/// errors; an error when it was interrupted.
+pub fn report(result: &LateralStudy, tie_in_sigma_deg: f64, outputs: &StudyOutputs) -> Result<()> {
+    let names: Vec<&str> = result.grades.iter().map(|g| g.file.name.as_str()).collect();
+    let wells: Vec<&str> = result.wells.iter().map(|w| w.label.as_str()).collect();
     outln!(
         "lateral study: grades {}; wells {}; {} runs each from seed {}; tie-in azimuth sigma {} deg; {} threads; filter {}; {:.1} s",
         names.join(", "),
         wells.join(", "),
-        runs,
-        args.seeds.first_seed,
-        args.tie_in_azimuth_sigma_deg,
-        threads,
-        args.scalar.name(),
+        result.runs_per_grade_and_well,
+        result.first_seed,
+        tie_in_sigma_deg,
+        result.threads,
+        result.filter_scalar.name(),
         result.wall_s
     );
-    out!("{}", table(&result));
-    write_outputs(&args, &result)?;
+    out!("{}", table(result));
+    write_outputs(outputs, result)?;
     for e in &result.errors {
         eprintln!("error: {e}");
     }
@@ -160,29 +175,142 @@ pub fn run(args: LateralArgs) -> Result<()> {
     Ok(())
 }
 
-/// The wells: `--plan`s, else the built-in laterals of `--well`.
-fn wells(args: &LateralArgs, overrides: &DrillingOverrides) -> Result<Vec<Well>> {
-    if args.plans.is_empty() {
-        let names: &[&str] = match args.well {
-            WellChoice::Short => &["100m"],
-            WellChoice::Long => &["1000m"],
-            WellChoice::Both => &["100m", "1000m"],
-        };
-        names
-            .iter()
-            .map(|n| Well::builtin(n, overrides))
-            .collect::<Result<_>>()
-    } else {
-        args.plans
-            .iter()
-            .map(|p| Well::load(p, overrides))
-            .collect::<Result<_>>()
+/// `--shard K/N`: the K-th slice of the jobs into `--shard-file`, whole
+/// or not at all (an interrupted shard writes nothing).
+fn run_shard(
+    args: &LateralArgs,
+    spec: &StudySpec,
+    config: &StudyConfig,
+    shard: ShardIndex,
+) -> Result<()> {
+    let path = args
+        .shard_file
+        .as_deref()
+        .context("--shard needs --shard-file")?;
+    let started = std::time::Instant::now();
+    let jobs = StudyJobs::new(config)?;
+    let mine = shard.jobs(jobs.len());
+    let bar = progress_bar(mine.len() as u64, PROGRESS)?;
+    let stop = stop_on_ctrl_c(Some(&bar))?;
+    let outcomes = jobs.run(&mine, &|| bar.inc(1), &stop);
+    bar.finish_and_clear();
+    let wall_s = started.elapsed().as_secs_f64();
+    let Some(file) = ShardFile::new(spec, shard, &outcomes, config.threads, wall_s) else {
+        anyhow::bail!("interrupted: shard {shard} not written");
+    };
+    write_json(path, &file)?;
+    let runs = mine.iter().filter(|&&j| jobs.is_monte_carlo(j)).count();
+    outln!(
+        "lateral study shard {shard}: {} of the study's {} jobs ({runs} Monte Carlo runs), {} threads, {wall_s:.1} s; wrote {}",
+        mine.len(),
+        jobs.len(),
+        config.threads,
+        path.display()
+    );
+    Ok(())
+}
+
+#[derive(clap::Args, Debug)]
+pub struct MergeArgs {
+    /// The shard files, every one of the study (any order).
+    #[arg(required = true, value_name = "SHARD")]
+    pub shards: Vec<PathBuf>,
+    #[command(flatten)]
+    pub outputs: StudyOutputs,
+}
+
+/// `study merge`: the shards checked to make one study, whose outputs
+/// are then written as `study lateral` writes them.
+pub fn merge(args: MergeArgs) -> Result<()> {
+    let shards = args.shards.iter().map(|path| {
+        let name = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading the shard {name}"))?;
+        let shard = ShardFile::parse(&text, &name)?;
+        Ok((name, shard))
+    });
+    let merged = shard::merge(shards)?;
+    let tie_in_sigma_deg = exact_number(
+        &merged.spec.tie_in_azimuth_sigma_deg,
+        "the tie-in azimuth sigma",
+    )?;
+    let result = merged.study()?;
+    report(&result, tie_in_sigma_deg, &args.outputs)
+}
+
+/// The study's inputs whole: grade files and plans read (each checked
+/// as it is read, in the command line's order), numbers as given.
+fn spec(args: &LateralArgs) -> Result<StudySpec> {
+    let mut grade_files = Vec::new();
+    let mut from_files = Vec::new();
+    for path in &args.grade_files {
+        let text = read_small_file(path)
+            .with_context(|| format!("reading the grade file {}", path.display()))?;
+        let name = path.display().to_string();
+        from_files.push(Grade::parse(&text, &name)?);
+        grade_files.push(SourceText { name, text });
     }
+    grade::select_parsed(&args.grades, from_files)?;
+    let overrides = DrillingOverrides {
+        rop_m_per_h: args.rop_m_per_h,
+        stand_length_m: args.stand_length_m,
+        connection_still_s: args.connection_still_s,
+    };
+    let text = |v: Option<f64>| v.map(exact_text);
+    Ok(StudySpec {
+        grades: args.grades.clone(),
+        grade_files,
+        wells: wells(args, &overrides)?,
+        rop_m_per_h: text(args.rop_m_per_h),
+        stand_length_m: text(args.stand_length_m),
+        connection_still_s: text(args.connection_still_s),
+        tie_in_azimuth_sigma_deg: exact_text(args.tie_in_azimuth_sigma_deg),
+        runs: args.runs as usize,
+        first_seed: args.seeds.first_seed,
+        monte_carlo: !args.covariance_only,
+        sweep: args.sweep,
+        scalar: args.scalar,
+    })
+}
+
+/// The wells' plans: `--plan`s, else the built-in laterals of `--well`;
+/// each checked with `overrides` as it is read.
+fn wells(args: &LateralArgs, overrides: &DrillingOverrides) -> Result<Vec<SourceText>> {
+    let source = |name: String, text: String| -> Result<SourceText> {
+        Well::parse(&name, &text, overrides)?;
+        Ok(SourceText { name, text })
+    };
+    if !args.plans.is_empty() {
+        return args
+            .plans
+            .iter()
+            .map(|path| {
+                let text = read_small_file(path)
+                    .with_context(|| format!("reading the plan {}", path.display()))?;
+                source(path.display().to_string(), text)
+            })
+            .collect();
+    }
+    let names: &[&str] = match args.well {
+        WellChoice::Short => &["100m"],
+        WellChoice::Long => &["1000m"],
+        WellChoice::Both => &["100m", "1000m"],
+    };
+    names
+        .iter()
+        .map(|name| {
+            let (label, text) = BUILTIN_WELLS
+                .iter()
+                .find(|(n, _)| n == name)
+                .with_context(|| format!("no built-in well {name:?}"))?;
+            source(label.to_string(), text.to_string())
+        })
+        .collect()
 }
 
 /// `--json`, `--csv`, `--stations-csv` and `--plots` (each file said as
 /// written).
-fn write_outputs(args: &LateralArgs, result: &LateralStudy) -> Result<()> {
+fn write_outputs(args: &StudyOutputs, result: &LateralStudy) -> Result<()> {
     if let Some(path) = &args.json {
         write_json(path, result)?;
     }

@@ -348,15 +348,21 @@ impl Grade {
 /// The grades named in `names` (all built-in ones when empty) with the
 /// files' grades added or replacing a built-in of the same name.
 pub fn select(names: &[String], files: &[std::path::PathBuf]) -> Result<Vec<Grade>> {
+    let from_files = files
+        .iter()
+        .map(|path| Grade::load(path))
+        .collect::<Result<Vec<_>>>()?;
+    select_parsed(names, from_files)
+}
+
+/// [`select`] with the grade files already read, in their order.
+pub fn select_parsed(names: &[String], from_files: Vec<Grade>) -> Result<Vec<Grade>> {
     let mut all = Grade::builtin()?;
-    let mut from_files = Vec::new();
-    for path in files {
-        let grade = Grade::load(path)?;
+    for grade in from_files {
         match all.iter_mut().find(|g| g.name() == grade.name()) {
-            Some(slot) => *slot = grade.clone(),
-            None => all.push(grade.clone()),
+            Some(slot) => *slot = grade,
+            None => all.push(grade),
         }
-        from_files.push(grade.file.name.clone());
     }
     if names.is_empty() {
         return Ok(all);

@@ -21,7 +21,9 @@
 //!   drilling);
 //! - [`table`]: the terminal tables and the CSV, with `csv` (a CSV
 //!   cell's quoting, which the station list shares);
-//! - [`figures`]: the study's figures, drawn by [`plots`].
+//! - [`figures`]: the study's figures, drawn by [`plots`];
+//! - [`shard`]: the study in shards run apart (`--shard K/N`) and merged,
+//!   each job's outcome kept exact by `shard_codec`.
 
 pub mod consistency;
 pub mod correlation;
@@ -30,6 +32,8 @@ mod csv;
 pub mod figures;
 pub mod plots;
 pub mod run;
+pub mod shard;
+mod shard_codec;
 pub mod stations;
 pub mod summary;
 pub mod table;

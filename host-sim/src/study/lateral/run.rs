@@ -106,7 +106,9 @@ enum Job {
     Sweep(usize, usize, usize),
 }
 
-enum JobOutcome {
+/// What one job gave: a run, or a prediction (covariance analysis, sweep
+/// point); the error text when it failed.
+pub enum JobOutcome {
     Run(Result<RunOutcome, String>),
     Prediction(Result<CovariancePrediction, String>),
 }
@@ -121,164 +123,239 @@ pub fn study(
     stop: &AtomicBool,
 ) -> Result<LateralStudy> {
     let started = std::time::Instant::now();
-    let mut configs = Vec::new();
-    for grade in &config.grades {
-        for well in &config.wells {
-            configs.push(RunConfig {
-                scalar: config.scalar,
-                ..RunConfig::new(
-                    well.plan.clone(),
-                    config.tie_in_azimuth_sigma,
-                    grade.clone(),
-                )?
-            });
-        }
-    }
-    let jobs = job_list(config, &configs)?;
-    let sweep_grades = sweep_grades(config)?;
-    let length = |c: usize| configs[c].plan.end_md() - configs[c].plan.tie_on.md();
-    let outcomes = run_jobs_until(jobs.len(), config.threads, progress, stop, |k| {
-        match jobs[k] {
-            Job::MonteCarlo(c, r) => {
-                let seed = config.first_seed + r;
-                JobOutcome::Run(run(&configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}")))
-            }
-            Job::Covariance(c) => {
-                let (g, w) = (c / config.wells.len(), c % config.wells.len());
-                JobOutcome::Prediction(predict(
-                    &configs[c],
-                    &config.grades[g],
-                    &config.wells[w].label,
-                    length(c),
-                    config.first_seed,
-                ))
-            }
-            Job::Sweep(w, i, j) => {
-                let grade = &sweep_grades[i][j];
-                JobOutcome::Prediction(predict(
-                    &configs[w],
-                    grade,
-                    &config.wells[w].label,
-                    length(w),
-                    config.first_seed,
-                ))
+    let plan = StudyJobs::new(config)?;
+    let all: Vec<usize> = (0..plan.jobs.len()).collect();
+    let outcomes = plan.run(&all, progress, stop);
+    Ok(plan.assemble(outcomes, started.elapsed().as_secs_f64(), config.threads))
+}
+
+/// The study's jobs in their fixed order (longest wells first; the same
+/// whatever the threads), the runs' configurations they share and the
+/// sweep's grades: what a whole study or one shard of it runs.
+pub struct StudyJobs<'a> {
+    config: &'a StudyConfig,
+    configs: Vec<RunConfig>,
+    jobs: Vec<Job>,
+    sweep_grades: Vec<Vec<Grade>>,
+}
+
+impl<'a> StudyJobs<'a> {
+    pub fn new(config: &'a StudyConfig) -> Result<Self> {
+        let mut configs = Vec::new();
+        for grade in &config.grades {
+            for well in &config.wells {
+                configs.push(RunConfig {
+                    scalar: config.scalar,
+                    ..RunConfig::new(
+                        well.plan.clone(),
+                        config.tie_in_azimuth_sigma,
+                        grade.clone(),
+                    )?
+                });
             }
         }
-    });
-    let n = configs.len();
-    let mut per_config: Vec<Vec<(u64, Result<RunOutcome, String>)>> =
-        (0..n).map(|_| Vec::new()).collect();
-    let mut covariance: Vec<Option<CovariancePrediction>> = vec![None; n];
-    let mut sweeps: Vec<SweepResult> = Vec::new();
-    let mut errors = Vec::new();
-    if let Some(grid) = &config.sweep {
-        let empty = vec![vec![None; grid.arw_deg_per_sqrt_h.len()]; grid.bias_deg_per_h.len()];
-        for well in &config.wells {
-            sweeps.push(SweepResult {
-                base_grade: config.grades[0].name().to_string(),
-                well: well.label.clone(),
-                grid: grid.clone(),
-                td_sigma_per_1000_m: empty.clone(),
-                azimuth_sigma_deg: empty.clone(),
-                failures: Vec::new(),
-            });
-        }
-    }
-    let interrupted = Interruption::of(outcomes.iter().flatten().count(), jobs.len());
-    for (job, outcome) in jobs.iter().zip(outcomes) {
-        let Some(outcome) = outcome else { continue };
-        match (*job, outcome) {
-            (Job::MonteCarlo(c, r), JobOutcome::Run(o)) => {
-                per_config[c].push((config.first_seed + r, o))
-            }
-            (Job::Covariance(c), JobOutcome::Prediction(p)) => match p {
-                Ok(p) => covariance[c] = Some(p),
-                Err(e) => errors.push(format!("covariance analysis: {e}")),
-            },
-            (Job::Sweep(w, i, j), JobOutcome::Prediction(p)) => match p {
-                Ok(p) => {
-                    sweeps[w].td_sigma_per_1000_m[i][j] = p
-                        .td_horizontal_1_sigma_m
-                        .map(|v| v * 1000.0 / p.lateral_length_m);
-                    sweeps[w].azimuth_sigma_deg[i][j] = p.rms_station_azimuth_sigma_deg;
-                }
-                Err(e) => sweeps[w].failures.push(e),
-            },
-            _ => errors.push("internal: a job's outcome of the wrong kind".into()),
-        }
-    }
-    let mut summaries = Vec::new();
-    if config.monte_carlo {
-        for (c, mut results) in per_config.into_iter().enumerate() {
-            results.sort_by_key(|r| r.0);
-            let (grade, well) = (
-                &config.grades[c / config.wells.len()],
-                &config.wells[c % config.wells.len()],
-            );
-            summaries.push(summarise(
-                grade.name(),
-                &well.label,
-                well.lateral_length_m(),
-                &results,
-            ));
-        }
-    }
-    let covariance: Vec<CovariancePrediction> = covariance.into_iter().flatten().collect();
-    let agreement_rows = summaries
-        .iter()
-        .filter_map(|m| {
-            covariance
-                .iter()
-                .find(|c| c.grade == m.grade && c.well == m.well)
-                .map(|c| agreement(c, m))
+        let jobs = job_list(config, &configs)?;
+        let sweep_grades = sweep_grades(config)?;
+        Ok(Self {
+            config,
+            configs,
+            jobs,
+            sweep_grades,
         })
-        .collect();
-    let mut owsg = Vec::new();
-    for well in &config.wells {
-        let site = crate::study::owsg::study_site(well.plan.site.lat);
-        match crate::study::owsg::predict_all(&well.plan, &site) {
-            Ok(models) => owsg.push(WellOwsg {
-                well: well.label.clone(),
-                models,
-            }),
-            Err(e) => errors.push(format!("OWSG models on {}: {e:#}", well.label)),
+    }
+
+    /// How many jobs the whole study has.
+    pub fn len(&self) -> usize {
+        self.jobs.len()
+    }
+
+    /// Never: a study without jobs is refused by [`Self::new`].
+    pub fn is_empty(&self) -> bool {
+        self.jobs.is_empty()
+    }
+
+    /// Whether job `index` is a Monte Carlo run (the rest are covariance
+    /// analyses and sweep points, one run each).
+    pub fn is_monte_carlo(&self, index: usize) -> bool {
+        matches!(self.jobs.get(index), Some(Job::MonteCarlo(..)))
+    }
+
+    /// Runs the jobs of `selected` (indices into the study's jobs) on the
+    /// configuration's threads; every other job, and those `stop` kept
+    /// from starting, is `None`.
+    pub fn run(
+        &self,
+        selected: &[usize],
+        progress: &(dyn Fn() + Sync),
+        stop: &AtomicBool,
+    ) -> Vec<Option<JobOutcome>> {
+        let config = self.config;
+        let length = |c: usize| self.configs[c].plan.end_md() - self.configs[c].plan.tie_on.md();
+        let ran = run_jobs_until(
+            selected.len(),
+            config.threads,
+            progress,
+            stop,
+            |k| match self.jobs[selected[k]] {
+                Job::MonteCarlo(c, r) => {
+                    let seed = config.first_seed + r;
+                    JobOutcome::Run(
+                        run(&self.configs[c], seed).map_err(|e| format!("seed {seed}: {e:#}")),
+                    )
+                }
+                Job::Covariance(c) => {
+                    let (g, w) = (c / config.wells.len(), c % config.wells.len());
+                    JobOutcome::Prediction(predict(
+                        &self.configs[c],
+                        &config.grades[g],
+                        &config.wells[w].label,
+                        length(c),
+                        config.first_seed,
+                    ))
+                }
+                Job::Sweep(w, i, j) => {
+                    let grade = &self.sweep_grades[i][j];
+                    JobOutcome::Prediction(predict(
+                        &self.configs[w],
+                        grade,
+                        &config.wells[w].label,
+                        length(w),
+                        config.first_seed,
+                    ))
+                }
+            },
+        );
+        let mut outcomes: Vec<Option<JobOutcome>> = (0..self.jobs.len()).map(|_| None).collect();
+        for (&index, outcome) in selected.iter().zip(ran) {
+            outcomes[index] = outcome;
+        }
+        outcomes
+    }
+
+    /// The study's results from every job's outcome (`None`: not run),
+    /// `wall_s` and `threads` as they are reported.
+    pub fn assemble(
+        &self,
+        outcomes: Vec<Option<JobOutcome>>,
+        wall_s: f64,
+        threads: usize,
+    ) -> LateralStudy {
+        let (config, configs, jobs) = (self.config, &self.configs, &self.jobs);
+        let n = configs.len();
+        let mut per_config: Vec<Vec<(u64, Result<RunOutcome, String>)>> =
+            (0..n).map(|_| Vec::new()).collect();
+        let mut covariance: Vec<Option<CovariancePrediction>> = vec![None; n];
+        let mut sweeps: Vec<SweepResult> = Vec::new();
+        let mut errors = Vec::new();
+        if let Some(grid) = &config.sweep {
+            let empty = vec![vec![None; grid.arw_deg_per_sqrt_h.len()]; grid.bias_deg_per_h.len()];
+            for well in &config.wells {
+                sweeps.push(SweepResult {
+                    base_grade: config.grades[0].name().to_string(),
+                    well: well.label.clone(),
+                    grid: grid.clone(),
+                    td_sigma_per_1000_m: empty.clone(),
+                    azimuth_sigma_deg: empty.clone(),
+                    failures: Vec::new(),
+                });
+            }
+        }
+        let interrupted = Interruption::of(outcomes.iter().flatten().count(), jobs.len());
+        for (job, outcome) in jobs.iter().zip(outcomes) {
+            let Some(outcome) = outcome else { continue };
+            match (*job, outcome) {
+                (Job::MonteCarlo(c, r), JobOutcome::Run(o)) => {
+                    per_config[c].push((config.first_seed + r, o))
+                }
+                (Job::Covariance(c), JobOutcome::Prediction(p)) => match p {
+                    Ok(p) => covariance[c] = Some(p),
+                    Err(e) => errors.push(format!("covariance analysis: {e}")),
+                },
+                (Job::Sweep(w, i, j), JobOutcome::Prediction(p)) => match p {
+                    Ok(p) => {
+                        sweeps[w].td_sigma_per_1000_m[i][j] = p
+                            .td_horizontal_1_sigma_m
+                            .map(|v| v * 1000.0 / p.lateral_length_m);
+                        sweeps[w].azimuth_sigma_deg[i][j] = p.rms_station_azimuth_sigma_deg;
+                    }
+                    Err(e) => sweeps[w].failures.push(e),
+                },
+                _ => errors.push("internal: a job's outcome of the wrong kind".into()),
+            }
+        }
+        let mut summaries = Vec::new();
+        if config.monte_carlo {
+            for (c, mut results) in per_config.into_iter().enumerate() {
+                results.sort_by_key(|r| r.0);
+                let (grade, well) = (
+                    &config.grades[c / config.wells.len()],
+                    &config.wells[c % config.wells.len()],
+                );
+                summaries.push(summarise(
+                    grade.name(),
+                    &well.label,
+                    well.lateral_length_m(),
+                    &results,
+                ));
+            }
+        }
+        let covariance: Vec<CovariancePrediction> = covariance.into_iter().flatten().collect();
+        let agreement_rows = summaries
+            .iter()
+            .filter_map(|m| {
+                covariance
+                    .iter()
+                    .find(|c| c.grade == m.grade && c.well == m.well)
+                    .map(|c| agreement(c, m))
+            })
+            .collect();
+        let mut owsg = Vec::new();
+        for well in &config.wells {
+            let site = crate::study::owsg::study_site(well.plan.site.lat);
+            match crate::study::owsg::predict_all(&well.plan, &site) {
+                Ok(models) => owsg.push(WellOwsg {
+                    well: well.label.clone(),
+                    models,
+                }),
+                Err(e) => errors.push(format!("OWSG models on {}: {e:#}", well.label)),
+            }
+        }
+        LateralStudy {
+            runs_per_grade_and_well: if config.monte_carlo { config.runs } else { 0 },
+            first_seed: config.first_seed,
+            threads,
+            tie_in_azimuth_sigma_deg: config.tie_in_azimuth_sigma.to_degrees(),
+            filter_scalar: config.scalar,
+            wall_s,
+            interrupted,
+            grades: config
+                .grades
+                .iter()
+                .map(|g| GradeInfo {
+                    file: g.file.clone(),
+                })
+                .collect(),
+            wells: config
+                .wells
+                .iter()
+                .map(|w| WellInfo {
+                    label: w.label.clone(),
+                    tie_on_md_m: w.plan.tie_on.md(),
+                    td_md_m: w.plan.end_md(),
+                    lateral_length_m: w.lateral_length_m(),
+                    rop_m_per_h: w.plan.drilling.rop_m_per_h,
+                    stand_length_m: w.plan.drilling.stand_length_m,
+                    connection_still_s: w.plan.drilling.connection_still_s,
+                })
+                .collect(),
+            summaries,
+            covariance,
+            agreement: agreement_rows,
+            owsg,
+            sweeps,
+            errors,
         }
     }
-    Ok(LateralStudy {
-        runs_per_grade_and_well: if config.monte_carlo { config.runs } else { 0 },
-        first_seed: config.first_seed,
-        threads: config.threads,
-        tie_in_azimuth_sigma_deg: config.tie_in_azimuth_sigma.to_degrees(),
-        filter_scalar: config.scalar,
-        wall_s: started.elapsed().as_secs_f64(),
-        interrupted,
-        grades: config
-            .grades
-            .iter()
-            .map(|g| GradeInfo {
-                file: g.file.clone(),
-            })
-            .collect(),
-        wells: config
-            .wells
-            .iter()
-            .map(|w| WellInfo {
-                label: w.label.clone(),
-                tie_on_md_m: w.plan.tie_on.md(),
-                td_md_m: w.plan.end_md(),
-                lateral_length_m: w.lateral_length_m(),
-                rop_m_per_h: w.plan.drilling.rop_m_per_h,
-                stand_length_m: w.plan.drilling.stand_length_m,
-                connection_still_s: w.plan.drilling.connection_still_s,
-            })
-            .collect(),
-        summaries,
-        covariance,
-        agreement: agreement_rows,
-        owsg,
-        sweeps,
-        errors,
-    })
 }
 
 /// Every job: the Monte Carlo runs, one covariance analysis per grade and
