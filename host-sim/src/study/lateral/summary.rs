@@ -128,6 +128,13 @@ pub struct GradeWellSummary {
     /// saw none (`station_flags::MOTION_SEEN`: a slide too smooth for the
     /// detector); counted with the others too.
     pub motion_seen_stations: usize,
+    /// How far the heading holds: the measured depth (true MD, m) up to
+    /// which at least 95 % of the runs kept every station valid with a
+    /// determined azimuth; `None` when more than 5 % of the runs had none
+    /// at their first station (or there were no runs).
+    pub heading_held_to_md_m: Option<f64>,
+    /// Runs whose every station had a determined azimuth.
+    pub heading_held_runs: usize,
     pub rms_station_inclination_deg: Option<f64>,
     pub rms_station_azimuth_deg: Option<f64>,
     pub azimuth_within_2_sigma: Fraction,
@@ -231,8 +238,12 @@ pub fn summarise(
     let mut unchecked: BTreeMap<String, usize> = BTreeMap::new();
     let mut by_station: BTreeMap<u16, Tally> = BTreeMap::new();
     let mut cpu = Some(0.0);
+    let mut held_to: Vec<Option<f64>> = Vec::new();
     s.failed_runs = failures(results);
     for o in outcomes(results) {
+        let (held, whole) = heading_held_to(&o.stations);
+        held_to.push(held);
+        s.heading_held_runs += usize::from(whole);
         s.samples += o.samples;
         s.run_wall_s += o.elapsed_s;
         cpu = cpu.zip(o.cpu_s).map(|(a, b)| a + b);
@@ -291,6 +302,7 @@ pub fn summarise(
             (None, _) => *unchecked.entry(o.td_unchecked_kind()).or_default() += 1,
         }
     }
+    s.heading_held_to_md_m = held_by_95_percent(held_to);
     s.rms_station_inclination_deg = rms(&inc);
     s.rms_station_azimuth_deg = rms(&azi);
     s.azimuth_within_2_sigma = Fraction::of(azi_inside, azi.len());
@@ -341,6 +353,37 @@ pub fn summarise(
     s.requirement = requirement(&s);
     s.station_rows = station_rows(results);
     s
+}
+
+/// How far one run's heading held: the true MD of the last station of the
+/// unbroken row of valid stations with a determined azimuth from its
+/// first (`None`: not even the first), and whether that row is all of
+/// them.
+fn heading_held_to(stations: &[crate::study::run_checks::StationCheck]) -> (Option<f64>, bool) {
+    let held = |st: &&crate::study::run_checks::StationCheck| {
+        let sd = st.survey.angles_std.map(f64::from);
+        station_valid(&st.survey)
+            && sd[0].is_finite()
+            && sd[1].is_finite()
+            && st.survey.flags & station_flags::AZIMUTH_UNDETERMINED == 0
+    };
+    let row: Vec<_> = stations.iter().take_while(held).collect();
+    (
+        row.last().map(|st| st.truth_md),
+        row.len() == stations.len(),
+    )
+}
+
+/// The depth at least 95 % of the runs held their heading to: the k-th
+/// smallest of the runs' depths, k = floor(0.05 n) (so n - k >= 0.95 n
+/// runs reached it); `None` (not held at the first station) sorts first.
+fn held_by_95_percent(mut held_to: Vec<Option<f64>>) -> Option<f64> {
+    held_to.sort_by(|a, b| match (a, b) {
+        (Some(a), Some(b)) => a.total_cmp(b),
+        _ => a.is_some().cmp(&b.is_some()),
+    });
+    let k = held_to.len() / 20;
+    held_to.get(k).copied().flatten()
 }
 
 fn requirement(s: &GradeWellSummary) -> Requirement {
@@ -538,5 +581,27 @@ mod tests {
         assert_eq!(s.requirement.attitude_met, None);
         assert_eq!(s.requirement.position_met, None);
         assert_eq!(s.epochs_per_core_second, None);
+    }
+
+    #[test]
+    fn the_heading_holds_to_the_depth_95_percent_of_the_runs_reach() {
+        // station 3 undetermined: the row ends at station 2
+        let mut stations: Vec<StationCheck> = (1..=4).map(|n| station(n, 0.1, 0.5)).collect();
+        assert_eq!(heading_held_to(&stations), (Some(3112.0), true));
+        stations[2].survey.flags |= station_flags::AZIMUTH_UNDETERMINED;
+        assert_eq!(heading_held_to(&stations), (Some(3056.0), false));
+        stations[0].survey.angles_std[1] = f32::INFINITY;
+        assert_eq!(heading_held_to(&stations), (None, false));
+        // 20 runs: one short of TD still leaves 95 % at TD; two do not
+        let mut runs = vec![Some(4000.0); 19];
+        runs.push(Some(3100.0));
+        assert_eq!(held_by_95_percent(runs.clone()), Some(4000.0));
+        runs[0] = Some(3500.0);
+        assert_eq!(held_by_95_percent(runs.clone()), Some(3500.0));
+        // a run that never had it counts as the shortest
+        runs[0] = None;
+        runs[1] = None;
+        assert_eq!(held_by_95_percent(runs), None);
+        assert_eq!(held_by_95_percent(Vec::new()), None);
     }
 }

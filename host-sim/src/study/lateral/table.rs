@@ -71,8 +71,20 @@ fn station_row(s: &GradeWellSummary) -> Vec<String> {
         fraction(&s.azimuth_within_2_sigma),
         num(s.rms_station_inclination_deg, 3),
         fraction(&s.inclination_within_2_sigma),
+        held_to(s),
         met(s.requirement.attitude_met),
     ]
+}
+
+/// How far the heading held in 95 % of the runs: its true MD, "none"
+/// when more than 5 % lost it at the first station; with the count of
+/// runs that held it to their last station.
+fn held_to(s: &GradeWellSummary) -> String {
+    let ok = s.runs - s.failed_runs.len();
+    let depth = s
+        .heading_held_to_md_m
+        .map_or_else(|| "none".to_string(), |md| format!("{md:.0}"));
+    format!("{depth} ({}/{ok} to TD)", s.heading_held_runs)
 }
 
 fn td_row(s: &GradeWellSummary) -> Vec<String> {
@@ -219,7 +231,7 @@ pub fn table(study: &LateralStudy) -> String {
         ));
     }
     out.push_str(&format!(
-        "stations (azimuth over the determined ones; undetermined (of them lost since the tie-in)/invalid counted; attitude: the larger RMS < {ATTITUDE_LIMIT_DEG} deg, no azimuth withheld)\n"
+        "stations (azimuth over the determined ones; undetermined (of them lost since the tie-in)/invalid counted; heading held to: the true MD 95 % of the runs reached with every station's azimuth determined, and the runs that held it to TD; attitude: the larger RMS < {ATTITUDE_LIMIT_DEG} deg, no azimuth withheld)\n"
     ));
     let rows: Vec<Vec<String>> = study.summaries.iter().map(station_row).collect();
     out.push_str(&aligned(
@@ -233,6 +245,7 @@ pub fn table(study: &LateralStudy) -> String {
             "azi within 2 sigma",
             "inc RMS (deg)",
             "inc within 2 sigma",
+            "heading held to, 95 % (MD m)",
             "attitude met",
         ],
         &rows,
@@ -452,6 +465,8 @@ pub fn csv(study: &LateralStudy) -> String {
         "azimuth_undetermined_stations",
         "azimuth_lost_stations",
         "motion_seen_stations",
+        "heading_held_to_md_m",
+        "heading_held_runs",
         "rms_station_azimuth_deg",
         "azimuth_within_2_sigma",
         "azimuth_within_2_sigma_se",
@@ -515,6 +530,8 @@ pub fn csv(study: &LateralStudy) -> String {
             s.azimuth_undetermined_stations.to_string(),
             s.azimuth_lost_stations.to_string(),
             s.motion_seen_stations.to_string(),
+            f(s.heading_held_to_md_m),
+            s.heading_held_runs.to_string(),
             f(s.rms_station_azimuth_deg),
             f(s.azimuth_within_2_sigma.fraction),
             f(s.azimuth_within_2_sigma.standard_error),
