@@ -159,6 +159,14 @@ fn duplicated_reordered_and_dropped_frames_are_counted_apart() {
     );
     let replay = run(&["replay", s(&swapped), "--job", s(&job)]);
     assert_eq!(replay.code, Some(0), "{}{}", replay.stdout, replay.stderr);
+    assert!(
+        replay
+            .stdout
+            .contains("identical, 0 different, 0 not compared")
+            && !replay.stdout.contains("out of step"),
+        "{}",
+        replay.stdout
+    );
 
     // a raw frame after the next raw frame: reordered for the decoder; the
     // replay steps its samples in the order received and, when the later

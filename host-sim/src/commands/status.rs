@@ -35,10 +35,10 @@ pub const HELP_SURVEY: &str =
 /// `decode`'s: a capture with lost frames is incomplete; duplicated and
 /// reordered frames are not (nothing is missing).
 pub const HELP_DECODE: &str =
-    "Exit status: 0 complete (duplicated or reordered frames are counted, nothing is missing); \
-     1 error (bad argument, unreadable input, not a probe capture, a CSV that could not be \
-     written: no success is claimed, no partial file is left); 2 written but incomplete: \
-     frames were lost in the capture (their count said on standard error).";
+    "Exit status: 0 complete; 1 error (bad argument, unreadable input, not a probe capture, a \
+     CSV that could not be written: no success is claimed, no partial file is left); 2 written \
+     but incomplete: frames were lost in the capture (their count said on standard error). \
+     Duplicated and reordered frames are counted and printed but miss nothing: 0.";
 
 /// A command's status: complete, or incomplete with `why` said on
 /// standard error as a warning.
