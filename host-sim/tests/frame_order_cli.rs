@@ -55,7 +55,7 @@ fn is_station(p: &Payload) -> bool {
 
 /// The frames renumbered from 0 after `arrange` changed them (the probe
 /// numbers what it sends): every chunk must be a frame.
-fn renumbered(chunks: &mut Vec<(Vec<u8>, Option<Payload>)>) {
+fn renumbered(chunks: &mut [(Vec<u8>, Option<Payload>)]) {
     let mut seq = 0u16;
     for (chunk, payload) in chunks.iter_mut() {
         let Some(p) = payload else {

@@ -192,7 +192,9 @@ fn a_bad_command_line_is_an_error_not_an_incomplete_output() {
     let help = run(&["decode", "--help"]);
     assert_eq!(help.code, Some(0));
     assert!(help.stdout.contains("Exit status: 0 complete; 1 error"));
-    assert!(help.stdout.contains("2 written but incomplete: frames were lost"));
+    assert!(help
+        .stdout
+        .contains("2 written but incomplete: frames were lost"));
     let help = run(&["survey", "--help"]);
     assert!(help.stdout.contains("2 written but incomplete"));
     let help = run(&["replay", "--help"]);
