@@ -69,8 +69,27 @@ fn renumbered(chunks: &mut [(Vec<u8>, Option<Payload>)]) {
     }
 }
 
-fn decode(capture: &Path) -> Run {
-    run(&["decode", s(capture)])
+/// `decode` of `capture`: exit `code`, and its gaps line reads `gaps`.
+fn decodes_to(capture: &Path, code: i32, gaps: &str) -> Run {
+    runs_to(
+        &["decode", s(capture)],
+        code,
+        &format!("sequence gaps    {gaps}"),
+    )
+}
+
+/// `host-sim args`: exit `code`, and `said` on its standard output or
+/// error.
+fn runs_to(args: &[&str], code: i32, said: &str) -> Run {
+    let out = run(args);
+    assert_eq!(out.code, Some(code), "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains(said) || out.stderr.contains(said),
+        "{said}: {}{}",
+        out.stdout,
+        out.stderr
+    );
+    out
 }
 
 /// The listing's station lines (a number, then MD).
@@ -90,14 +109,10 @@ fn station_lines(listing: &str) -> Vec<String> {
 fn duplicated_reordered_and_dropped_frames_are_counted_apart() {
     let dir = scratch("frame-order", "counts");
     let (bin, depth, job) = simulate_tied_in(&dir);
-    let whole = decode(&bin);
-    assert_eq!(whole.code, Some(0), "{}{}", whole.stdout, whole.stderr);
-    assert!(
-        whole
-            .stdout
-            .contains("sequence gaps    0 frames lost, 0 restarts, 0 duplicated, 0 reordered"),
-        "{}",
-        whole.stdout
+    let whole = decodes_to(
+        &bin,
+        0,
+        "0 frames lost, 0 restarts, 0 duplicated, 0 reordered",
     );
     let whole_survey = run(&["survey", s(&bin), "--depth", s(&depth), "--job", s(&job)]);
     assert_eq!(whole_survey.code, Some(0), "{}", whole_survey.stderr);
@@ -112,13 +127,10 @@ fn duplicated_reordered_and_dropped_frames_are_counted_apart() {
             chunks.insert(k + 1, again);
         }
     });
-    let out = decode(&twice);
-    assert_eq!(out.code, Some(0), "{}{}", out.stdout, out.stderr);
-    assert!(
-        out.stdout
-            .contains("sequence gaps    0 frames lost, 0 restarts, 2 duplicated, 0 reordered"),
-        "{}",
-        out.stdout
+    let out = decodes_to(
+        &twice,
+        0,
+        "0 frames lost, 0 restarts, 2 duplicated, 0 reordered",
     );
     let head = |t: &str| t.lines().nth(2).map(String::from);
     assert_eq!(head(&out.stdout), head(&whole.stdout), "the same frames");
@@ -149,24 +161,14 @@ fn duplicated_reordered_and_dropped_frames_are_counted_apart() {
         assert!(raw > nav, "the next sample's raw frame");
         chunks.swap(nav, raw);
     });
-    let out = decode(&swapped);
-    assert_eq!(out.code, Some(0), "{}{}", out.stdout, out.stderr);
-    assert!(
-        out.stdout
-            .contains("sequence gaps    0 frames lost, 0 restarts, 0 duplicated, 1 reordered"),
-        "{}",
-        out.stdout
+    decodes_to(
+        &swapped,
+        0,
+        "0 frames lost, 0 restarts, 0 duplicated, 1 reordered",
     );
-    let replay = run(&["replay", s(&swapped), "--job", s(&job)]);
-    assert_eq!(replay.code, Some(0), "{}{}", replay.stdout, replay.stderr);
-    assert!(
-        replay
-            .stdout
-            .contains("identical, 0 different, 0 not compared")
-            && !replay.stdout.contains("out of step"),
-        "{}",
-        replay.stdout
-    );
+    let args = ["replay", s(&swapped), "--job", s(&job)];
+    let replay = runs_to(&args, 0, "identical, 0 different, 0 not compared");
+    assert!(!replay.stdout.contains("out of step"), "{}", replay.stdout);
 
     // a raw frame after the next raw frame: reordered for the decoder; the
     // replay steps its samples in the order received and, when the later
@@ -179,29 +181,25 @@ fn duplicated_reordered_and_dropped_frames_are_counted_apart() {
         let moved = chunks.remove(raw);
         chunks.insert(next, moved);
     });
-    let out = decode(&late_raw);
-    assert_eq!(out.code, Some(0), "{}{}", out.stdout, out.stderr);
-    assert!(out
-        .stdout
-        .contains("0 frames lost, 0 restarts, 0 duplicated, 1 reordered"));
-    let replay = run(&["replay", s(&late_raw), "--job", s(&job)]);
-    assert_eq!(replay.code, Some(0), "{}{}", replay.stdout, replay.stderr);
-    assert!(
-        replay
-            .stdout
-            .contains("out of step      run 0: not compared from sample 301 on"),
-        "{}",
-        replay.stdout
+    decodes_to(
+        &late_raw,
+        0,
+        "0 frames lost, 0 restarts, 0 duplicated, 1 reordered",
     );
+    let args = ["replay", s(&late_raw), "--job", s(&job)];
+    let out_of_step = "out of step      run 0: not compared from sample 301 on";
+    let replay = runs_to(&args, 0, out_of_step);
     assert!(replay.stdout.contains("1 reordered"), "{}", replay.stdout);
 
     // a frame dropped: lost, written but incomplete
     let dropped = rearranged(&bin, "dropped.bin", |chunks| {
         chunks.remove(nth(chunks, 50, is_nav));
     });
-    let out = decode(&dropped);
-    assert_eq!(out.code, Some(2), "{}{}", out.stdout, out.stderr);
-    assert!(out.stdout.contains("1 frames lost, 0 restarts"));
+    let out = decodes_to(
+        &dropped,
+        2,
+        "1 frames lost, 0 restarts, 0 duplicated, 0 reordered",
+    );
     assert!(
         out.stderr
             .contains("warning: the capture is incomplete: 1 frames lost"),
@@ -214,10 +212,11 @@ fn duplicated_reordered_and_dropped_frames_are_counted_apart() {
 fn a_station_sent_again_is_taken_once_and_another_under_its_number_refused() {
     let dir = scratch("frame-order", "stations");
     let (bin, depth, job) = simulate_tied_in(&dir);
-    let survey =
-        |capture: &Path| run(&["survey", s(capture), "--depth", s(&depth), "--job", s(&job)]);
-    let whole = survey(&bin);
-    assert_eq!(whole.code, Some(0), "{}", whole.stderr);
+    let survey = |capture: &Path, code: i32, said: &str| {
+        let args = ["survey", s(capture), "--depth", s(&depth), "--job", s(&job)];
+        runs_to(&args, code, said)
+    };
+    let whole = survey(&bin, 0, "station links");
 
     // the probe sent the first station again a few frames later (its own
     // number in the sequence)
@@ -233,25 +232,18 @@ fn a_station_sent_again_is_taken_once_and_another_under_its_number_refused() {
         }
     };
     let sent_again = rearranged(&bin, "sent-again.bin", again(false));
-    let out = decode(&sent_again);
-    assert_eq!(out.code, Some(0), "{}{}", out.stdout, out.stderr);
-    let out = survey(&sent_again);
-    assert_eq!(out.code, Some(0), "{}{}", out.stdout, out.stderr);
-    assert!(
-        out.stdout
-            .contains("1 repeated frames taken once (1 station frames)"),
-        "{}",
-        out.stdout
+    decodes_to(
+        &sent_again,
+        0,
+        "0 frames lost, 0 restarts, 0 duplicated, 0 reordered",
+    );
+    let out = survey(
+        &sent_again,
+        0,
+        "1 repeated frames taken once (1 station frames)",
     );
     assert_eq!(station_lines(&out.stdout), station_lines(&whole.stdout));
 
     let other = rearranged(&bin, "other-station.bin", again(true));
-    let out = survey(&other);
-    assert_eq!(out.code, Some(1), "{}{}", out.stdout, out.stderr);
-    assert!(
-        out.stderr
-            .contains("two different station frames numbered 1"),
-        "{}",
-        out.stderr
-    );
+    survey(&other, 1, "two different station frames numbered 1");
 }

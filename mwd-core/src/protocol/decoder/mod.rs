@@ -16,6 +16,7 @@ mod recent;
 use super::codec::{decode_body, FrameError};
 use super::frame::{EventKind, Frame, FrameKind, Payload, MAX_BODY_LEN};
 use super::wire::{wire_len, DELIMITER};
+use crate::timing::SAMPLE_PERIOD_US;
 use recent::{Behind, RecentFrames};
 
 /// Largest chunk kept between delimiters: the longest valid encoded body.
@@ -72,7 +73,7 @@ impl DecoderStats {
     }
 }
 
-/// The streaming decoder. 320 bytes on the host, its 104-byte chunk buffer
+/// The streaming decoder. 336 bytes on the host, its 104-byte chunk buffer
 /// and 14 counts among them: fits the probe as well as the host.
 #[derive(Debug, Clone)]
 pub struct Decoder {
@@ -87,12 +88,19 @@ pub struct Decoder {
     /// The last few numbers up to `expected_seq - 1`: duplicates and
     /// reordered frames.
     recent: RecentFrames,
-    /// Sequence number and sample counter of the last raw or navigation
-    /// frame of the current run, and what was counted since: the
-    /// cross-check's anchor.
-    last_counted: Option<(u16, u32)>,
+    /// The last raw or navigation frame of the current run, and what was
+    /// counted since: the cross-check's anchor.
+    last_counted: Option<Counted>,
     since_counted: SinceCounted,
     stats: DecoderStats,
+}
+
+/// A frame with a sample counter: its sequence number, counter and time.
+#[derive(Debug, Clone, Copy)]
+struct Counted {
+    seq: u16,
+    counter: u32,
+    time_us: u64,
 }
 
 /// What the sequence rule counted since the last frame with a sample
@@ -319,18 +327,23 @@ impl Decoder {
         }
         self.expected_seq = Some(seq.wrapping_add(1));
         self.recent.advance(seq, crc, skipped, unknown_before);
-        let counter = match payload {
-            Some(Payload::Raw(raw)) => raw.sample_counter,
-            Some(Payload::Nav(nav)) => nav.sample_counter,
+        let (counter, time_us) = match payload {
+            Some(Payload::Raw(raw)) => (raw.sample_counter, raw.time_us),
+            Some(Payload::Nav(nav)) => (nav.sample_counter, nav.time_us),
             _ => {
                 self.since_counted.good_frames += 1;
                 return true;
             }
         };
+        let counted = Counted {
+            seq,
+            counter,
+            time_us,
+        };
         if let Some(anchor) = self.last_counted {
-            self.cross_check(anchor, seq, counter);
+            self.cross_check(anchor, counted);
         }
-        self.last_counted = Some((seq, counter));
+        self.last_counted = Some(counted);
         self.since_counted = SinceCounted::default();
         true
     }
@@ -338,23 +351,28 @@ impl Decoder {
     /// Checks what the sequence counted since the last frame with a sample
     /// counter (`anchor`: its number and counter) against this frame's
     /// counter, when frames were lost from [`CROSS_CHECK_GAP`] on, the
-    /// sequence went backwards, or the counters say the sequence wrapped.
-    fn cross_check(&mut self, (anchor_seq, anchor_counter): (u16, u32), seq: u16, counter: u32) {
+    /// sequence went backwards, or the counters say the sequence wrapped
+    /// (with nothing else to show it: an outage of 65536 k + m frames, m
+    /// under the gap) and the time stamps agree with them.
+    fn cross_check(&mut self, anchor: Counted, now: Counted) {
         let since = self.since_counted;
-        let advance = u64::from(seq.wrapping_sub(anchor_seq));
-        let by_counter = FRAMES_PER_SAMPLE * u64::from(counter.saturating_sub(anchor_counter));
+        let (seq, counter) = (now.seq, now.counter);
+        let advance = u64::from(seq.wrapping_sub(anchor.seq));
+        let samples = counter.saturating_sub(anchor.counter);
+        let by_counter = FRAMES_PER_SAMPLE * u64::from(samples);
         // Whole times the 16-bit sequence wrapped in between, as the
         // counters say (to the nearest: events add frames, the probe's own
         // skips take some away).
         let wraps = (by_counter.saturating_sub(advance) + 0x8000) / 0x1_0000;
-        if since.lost < CROSS_CHECK_GAP && since.restarts == 0 && wraps == 0 {
+        let wrapped = wraps > 0 && time_agrees(anchor.time_us, now.time_us, samples);
+        if since.lost < CROSS_CHECK_GAP && since.restarts == 0 && !wrapped {
             return;
         }
         // Undo what the sequence alone said since the anchor.
         self.stats.lost = self.stats.lost.saturating_sub(since.lost);
         self.stats.sequence_restarts = self.stats.sequence_restarts.saturating_sub(since.restarts);
         let numbers = advance + wraps * 0x1_0000;
-        if counter <= anchor_counter || numbers == 0 {
+        if counter <= anchor.counter || numbers == 0 {
             // The sample counter went back (or stayed): a restart whose
             // boot event was lost; the frames lost around it cannot be
             // counted.
@@ -370,8 +388,8 @@ impl Decoder {
     fn take_back_loss(&mut self, seq: u16) {
         self.stats.lost = self.stats.lost.saturating_sub(1);
         self.stats.reordered += 1;
-        let after_anchor = self.last_counted.is_none_or(|(anchor, _)| {
-            let after = seq.wrapping_sub(anchor);
+        let after_anchor = self.last_counted.is_none_or(|anchor| {
+            let after = seq.wrapping_sub(anchor.seq);
             after != 0 && after < BACKWARDS
         });
         if after_anchor {
@@ -381,6 +399,16 @@ impl Decoder {
             self.since_counted.good_frames += 1;
         }
     }
+}
+
+/// Whether the time stamps `from_us` to `to_us` span `samples` sample
+/// periods, give or take an eighth: the counters alone are not believed
+/// to say that the sequence wrapped with no gap to show it.
+fn time_agrees(from_us: u64, to_us: u64, samples: u32) -> bool {
+    let expected = u64::from(samples) * SAMPLE_PERIOD_US;
+    to_us
+        .checked_sub(from_us)
+        .is_some_and(|elapsed| elapsed.abs_diff(expected) <= expected / 8)
 }
 
 /// The CRC-32C that ends a frame's body (checked already): two frames with
