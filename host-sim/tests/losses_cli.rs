@@ -7,27 +7,9 @@
 //! 2 (written but incomplete), with or without a tie-in job.
 mod common;
 
-use common::{run, s, scratch, simulate_tied_in, simulate_tied_in_on};
-use mwd_core::protocol::{Decoder, Frame, Payload};
+use common::{capture_frames, run, s, scratch, simulate_tied_in, simulate_tied_in_on};
+use mwd_core::protocol::Payload;
 use std::path::{Path, PathBuf};
-
-/// The capture's frames, each with its delimiter and what it decoded to.
-fn frames(bytes: &[u8]) -> Vec<(Vec<u8>, Option<Frame>)> {
-    let mut decoder = Decoder::new();
-    let mut out = Vec::new();
-    let mut chunk = Vec::new();
-    for &b in bytes {
-        chunk.push(b);
-        let frame = decoder.push(b);
-        if b == 0 {
-            out.push((std::mem::take(&mut chunk), frame));
-        }
-    }
-    if !chunk.is_empty() {
-        out.push((chunk, None));
-    }
-    out
-}
 
 /// `capture` without the frames `lose` picks, written to `name` beside
 /// it; how many were taken out.
@@ -35,7 +17,7 @@ fn losing(capture: &Path, name: &str, lose: impl Fn(&Payload) -> bool) -> (PathB
     let bytes = std::fs::read(capture).unwrap();
     let mut kept = Vec::new();
     let mut lost = 0;
-    for (chunk, frame) in frames(&bytes) {
+    for (chunk, frame) in capture_frames(&bytes) {
         if frame.as_ref().is_some_and(|f| lose(&f.payload)) {
             lost += 1;
         } else {
@@ -210,6 +192,9 @@ fn a_bad_command_line_is_an_error_not_an_incomplete_output() {
     let help = run(&["decode", "--help"]);
     assert_eq!(help.code, Some(0));
     assert!(help.stdout.contains("Exit status: 0 complete; 1 error"));
+    assert!(help
+        .stdout
+        .contains("2 written but incomplete: frames were lost"));
     let help = run(&["survey", "--help"]);
     assert!(help.stdout.contains("2 written but incomplete"));
     let help = run(&["replay", "--help"]);

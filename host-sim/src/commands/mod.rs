@@ -97,10 +97,10 @@ pub fn parse() -> Result<Cli, clap::Error> {
 
 fn with_exit_status(command: clap::Command) -> clap::Command {
     let command = if command.get_after_help().is_none() && !command.has_subcommands() {
-        let help = if command.get_name() == "survey" {
-            status::HELP_SURVEY
-        } else {
-            status::HELP_COMPLETE_OR_ERROR
+        let help = match command.get_name() {
+            "survey" => status::HELP_SURVEY,
+            "decode" => status::HELP_DECODE,
+            _ => status::HELP_COMPLETE_OR_ERROR,
         };
         command.after_help(help)
     } else {
@@ -117,7 +117,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Drill(args) => done(drill::run(args)),
         Command::Demo(args) => done(demo::run(args)),
         Command::Simulate(args) => done(simulate::run(args)),
-        Command::Decode(args) => done(decode::run(args)),
+        Command::Decode(args) => decode::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Align(args) => done(align::run(args)),
         Command::Allan(args) => done(allan::run(args)),

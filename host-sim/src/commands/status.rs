@@ -32,6 +32,14 @@ pub const HELP_SURVEY: &str =
      left); 2 written but incomplete: a capture's frames were lost (their count said on \
      standard error; a lost station is listed as lost, the others keep their MD).";
 
+/// `decode`'s: a capture with lost frames is incomplete; duplicated and
+/// reordered frames are not (nothing is missing).
+pub const HELP_DECODE: &str =
+    "Exit status: 0 complete; 1 error (bad argument, unreadable input, not a probe capture, a \
+     CSV that could not be written: no success is claimed, no partial file is left); 2 written \
+     but incomplete: frames were lost in the capture (their count said on standard error). \
+     Duplicated and reordered frames are counted and printed but miss nothing: 0.";
+
 /// A command's status: complete, or incomplete with `why` said on
 /// standard error as a warning.
 pub fn complete_unless(incomplete: Option<String>) -> ExitCode {

@@ -390,6 +390,8 @@ impl DashboardState {
             "crc_errors": s.crc_errors,
             "malformed": s.malformed,
             "restarts": s.sequence_restarts,
+            "duplicated": s.duplicated,
+            "reordered": s.reordered,
             "garbage_bytes": s.garbage_bytes,
             "bytes": s.bytes,
         })

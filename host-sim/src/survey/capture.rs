@@ -19,9 +19,11 @@ use crate::survey::listing::{self, drilling_text, LengthUnit, Row, TieOnInput};
 use crate::survey::station_qc::{CheckedStations, QcCollector, QcTolerances};
 use crate::survey::stations::{StationCollector, SurveySetup};
 use crate::survey::well_survey::WellSurvey;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use mwd_core::probe::StationLink;
-use mwd_core::protocol::{DecoderStats, Frame, Payload};
+use mwd_core::protocol::frame::MAX_BODY_LEN;
+use mwd_core::protocol::{encode_body, DecoderStats, Frame, Payload, StationSurvey};
+use std::collections::hash_map::{Entry, HashMap};
 use std::path::{Path, PathBuf};
 
 /// A capture survey's inputs.
@@ -49,6 +51,8 @@ pub struct CaptureSurvey {
     pub survey: DrillingSurvey,
     /// The capture's decoding: bad frames, frames lost.
     pub stats: DecoderStats,
+    /// Station frames repeated identically, taken once.
+    pub repeated_stations: u64,
     /// Why the stations have no links from the capture's replay, if so.
     pub links_missing: Option<String>,
     capture: PathBuf,
@@ -93,6 +97,7 @@ impl CaptureSurvey {
         Ok(Self {
             survey,
             stats: read.stats,
+            repeated_stations: read.repeated_stations,
             links_missing: links.err(),
             capture: inputs.capture.clone(),
             depth,
@@ -114,10 +119,12 @@ impl CaptureSurvey {
         }
         let s = &self.stats;
         let bad = s.crc_errors + s.malformed + s.unknown_kind;
-        if bad > 0 || s.lost > 0 {
+        let repeated = s.duplicated + self.repeated_stations;
+        if bad > 0 || s.lost > 0 || repeated > 0 || s.reordered > 0 {
             text += &format!(
-                "capture: {bad} bad frames skipped, {} frames lost in sequence gaps\n",
-                s.lost
+                "capture: {bad} bad frames skipped, {} frames lost in sequence gaps, {repeated} \
+                 repeated frames taken once ({} station frames), {} reordered frames\n",
+                s.lost, self.repeated_stations, s.reordered
             );
         }
         text += &match &self.links_missing {
@@ -288,6 +295,9 @@ struct CaptureStations {
     /// (`replay::replayed_station_links`), or why there are none.
     links: Result<Vec<Option<StationLink>>, String>,
     stats: DecoderStats,
+    /// Station frames repeated identically (the probe sent one again),
+    /// taken once.
+    repeated_stations: u64,
     /// The stations' quality checks (station number, last sample, checks)
     /// and what they were made against; `None` where the tool model has no
     /// tolerances.
@@ -301,7 +311,17 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
     let mut collected = StationCollector::default();
     let mut qc = qc_collector(probe)?;
     let mut items = 0usize;
+    let mut taken = StationsTaken::default();
     while let Some(item) = capture.next_item()? {
+        if let Item::Frame(Frame {
+            payload: Payload::Station(station),
+            ..
+        }) = &item
+        {
+            if !taken.take(station)? {
+                continue;
+            }
+        }
         if let Item::Frame(frame) = &item {
             collected.push_frame(frame);
             if let Some(qc) = qc.as_mut() {
@@ -324,6 +344,7 @@ fn read_stations(path: &Path, probe: &ProbeSetup) -> Result<CaptureStations> {
         collected,
         links,
         stats: *capture.stats(),
+        repeated_stations: taken.repeated,
         qc: qc.map(|q| {
             let reference = QcReference {
                 gravity_m_s2: q.gravity(),
@@ -341,4 +362,40 @@ fn qc_collector(probe: &ProbeSetup) -> Result<Option<QcCollector>> {
     let gravity = mwd_core::earth::normal_gravity(probe.site.lat, probe.site.height);
     Ok(QcTolerances::from_terms(&terms, gravity)
         .map(|t| QcCollector::new(probe.calibration, probe.site, t)))
+}
+
+/// The station frames read so far, by number, as their bytes: one repeated
+/// identically (the probe sends a station again for a repeated request) is
+/// taken once; another station under a number already taken is refused.
+#[derive(Default)]
+struct StationsTaken {
+    bodies: HashMap<u16, Vec<u8>>,
+    repeated: u64,
+}
+
+impl StationsTaken {
+    /// Whether `station` is new (false: a repeat, to skip).
+    fn take(&mut self, station: &StationSurvey) -> Result<bool> {
+        let mut body = [0u8; MAX_BODY_LEN];
+        let len = encode_body(0, &Payload::Station(*station), &mut body)
+            .context("encoding a station survey")?;
+        let body = body.get(..len).unwrap_or_default().to_vec();
+        match self.bodies.entry(station.station) {
+            Entry::Vacant(slot) => {
+                slot.insert(body);
+                Ok(true)
+            }
+            Entry::Occupied(slot) if *slot.get() == body => {
+                self.repeated += 1;
+                Ok(false)
+            }
+            Entry::Occupied(_) => bail!(
+                "two different station frames numbered {} (the second at {:.2} s): a station \
+                 number stands for one station of a run; does the capture hold more than one \
+                 run? (split it at the boot event)",
+                station.station,
+                station.time_us as f64 * 1e-6
+            ),
+        }
+    }
 }

@@ -120,3 +120,22 @@ pub const WELL1_SITE: [&str; 8] = [
     "--declination-deg",
     "-4",
 ];
+
+/// A capture's frames, each with its delimiter and what it decoded to
+/// (`None`: a reply, garbage, or a frame the decoder dropped).
+pub fn capture_frames(bytes: &[u8]) -> Vec<(Vec<u8>, Option<mwd_core::protocol::Frame>)> {
+    let mut decoder = mwd_core::protocol::Decoder::new();
+    let mut out = Vec::new();
+    let mut chunk = Vec::new();
+    for &b in bytes {
+        chunk.push(b);
+        let frame = decoder.push(b);
+        if b == 0 {
+            out.push((std::mem::take(&mut chunk), frame));
+        }
+    }
+    if !chunk.is_empty() {
+        out.push((chunk, None));
+    }
+    out
+}

@@ -66,8 +66,8 @@ impl fmt::Display for CaptureSummary {
         )?;
         writeln!(
             f,
-            "sequence gaps    {} frames lost, {} restarts",
-            s.lost, s.sequence_restarts
+            "sequence gaps    {} frames lost, {} restarts, {} duplicated, {} reordered",
+            s.lost, s.sequence_restarts, s.duplicated, s.reordered
         )?;
         writeln!(
             f,
