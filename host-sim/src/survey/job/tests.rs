@@ -229,7 +229,10 @@ fn a_tie_on_uncertainty_that_is_not_one_is_refused_by_name() {
 #[test]
 fn a_longitude_past_360_is_refused_not_wrapped() {
     let with_longitude = |deg: &str| {
-        let text = JOB.replace("\"longitude_deg\": 270.0", &format!("\"longitude_deg\": {deg}"));
+        let text = JOB.replace(
+            "\"longitude_deg\": 270.0",
+            &format!("\"longitude_deg\": {deg}"),
+        );
         assert_ne!(text, JOB);
         Job::parse(&text, Path::new("."))
     };
