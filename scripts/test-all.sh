@@ -66,6 +66,12 @@ cargo test --release -p system-tests --test alignment_classes -- --ignored
 # unified differently: 1.5 min of CI for the same program).
 test -x target/debug/host-sim
 bash scripts/bad-input-matrix.sh target/debug/host-sim
+# The fault matrix: the same binary against the faults of the field (frames
+# and stations lost, outages of 65,536 frames and more, outputs that cannot
+# be written, a closed pipe, values out of range, a hole in the depth log, a
+# foreign Host at the dashboard): exit status and key phrase per case
+# (about 15-45 s; known gaps print KNOWN and do not fail it).
+bash scripts/fault-matrix.sh target/debug/host-sim
 # The dashboard in headless Chromium (installs Debian's chromium if absent):
 # DOM checks against `host-sim decode` of the same capture, and a screenshot.
 bash scripts/dashboard-browser-test.sh target/debug/host-sim

@@ -436,9 +436,10 @@ fn tie_on_covariance(
 }
 
 /// Longitude in (-180, 180] deg, as the uplink carries it (the host also
-/// takes 0..360 east).
+/// takes 0..360 east). Past 360 it is left as it is, for the site's check
+/// to refuse: a longitude of 400 is a typing error, not 40 deg east.
 fn wrapped_longitude(deg: f64) -> f64 {
-    if deg > 180.0 {
+    if deg > 180.0 && deg <= 360.0 {
         deg - 360.0
     } else {
         deg

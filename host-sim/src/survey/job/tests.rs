@@ -225,3 +225,21 @@ fn a_tie_on_uncertainty_that_is_not_one_is_refused_by_name() {
         "covariance.nn",
     );
 }
+
+#[test]
+fn a_longitude_past_360_is_refused_not_wrapped() {
+    let with_longitude = |deg: &str| {
+        let text = JOB.replace(
+            "\"longitude_deg\": 270.0",
+            &format!("\"longitude_deg\": {deg}"),
+        );
+        assert_ne!(text, JOB);
+        Job::parse(&text, Path::new("."))
+    };
+    let east = with_longitude("360").unwrap();
+    assert_eq!(east.site, Position::from_degrees(30.0, 0.0, 12.5));
+    for deg in ["400", "360.5", "1e300"] {
+        let error = format!("{:#}", with_longitude(deg).unwrap_err());
+        assert!(error.contains("longitude"), "{deg}: {error}");
+    }
+}
