@@ -209,17 +209,11 @@ fn check<T, E: Display>(result: Result<T, E>) -> Result<(), TestCaseError> {
 
 /// Also: a refused bad row names where it is. The value may be refused on
 /// its own line, or (a time that is not after the one before) on the next
-/// line; the depth log names the order of times by its data row, one less
-/// than the line (the header is line 1).
+/// line (the header is line 1).
 fn check_names_line<T, E: Display>(result: Result<T, E>, line: usize) -> Result<(), TestCaseError> {
     if let Err(e) = result {
         let message = format!("{e:#}");
-        let named = [
-            format!("line {line}"),
-            format!("line {}", line + 1),
-            format!("row {}", line - 1),
-            format!("row {line}"),
-        ];
+        let named = [format!("line {line}"), format!("line {}", line + 1)];
         prop_assert!(
             named.iter().any(|n| message.contains(n.as_str())),
             "the error for a bad value on line {line} does not name where: {message}"

@@ -103,8 +103,17 @@ fn assert_close(
     for i in 0..NAV_STATES {
         let change = predicted[i] - dx0[i];
         let miss = (actual[i] - predicted[i]).abs();
+        // The strapdown steps the position with each interval's starting
+        // velocity (the first-order transition's own step): against the
+        // continuous model it lags by dt/2 times the velocity error's
+        // change (docs/filter-derivation.md section 5c).
+        let lag = if (POS..POS + 3).contains(&i) {
+            0.5 * DT * (predicted[VEL + i - POS] - dx0[VEL + i - POS]).abs()
+        } else {
+            0.0
+        };
         assert!(
-            miss <= 0.05 * change.abs() + scale[i],
+            miss <= 0.05 * change.abs() + scale[i] + 1.1 * lag,
             "state {i}: actual {:e} predicted {:e} start {:e}",
             actual[i],
             predicted[i],

@@ -9,11 +9,11 @@
 
 use super::limits::number_in;
 use anyhow::Result;
-use host_sim::formats::files::write_text;
+use host_sim::formats::files::OutputSet;
 use host_sim::survey::capture::{trajectory_csv, CaptureSurvey, CaptureSurveyInputs};
 use host_sim::survey::job::WellNames;
 use host_sim::survey::listing::drilling::DEPTH_GAP_LIMIT_S;
-use host_sim::survey::outputs::{write_outputs, OutputPaths};
+use host_sim::survey::outputs::{stage_outputs, OutputPaths};
 use host_sim::survey::well_survey::{OffsetInputs, SiteFor};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -84,8 +84,10 @@ pub fn run(
     for line in exported.separation_summary() {
         outln!("{line}");
     }
+    // Every output or none: staged, named together at the end.
+    let mut set = OutputSet::default();
     if let Some(path) = outputs.paths.csv {
-        write_text(path, &survey.stations_csv(confidence))?;
+        set.stage(path, &survey.stations_csv(confidence))?;
     }
     let others = OutputPaths {
         csv: None,
@@ -95,13 +97,21 @@ pub fn run(
         .capture
         .file_stem()
         .map_or_else(|| "capture".into(), |n| n.to_string_lossy());
-    for f in write_outputs(&exported, &others, &well)? {
+    let figures = stage_outputs(&mut set, &exported, &others, &well)?;
+    let trajectory = match &args.trajectory {
+        Some(path) => {
+            let points = survey.trajectory(args.trajectory_step_m)?;
+            set.stage(path, &trajectory_csv(&points, confidence))?;
+            Some((path, points.len()))
+        }
+        None => None,
+    };
+    set.commit()?;
+    for f in figures {
         outln!("wrote {}", f.display());
     }
-    if let Some(path) = &args.trajectory {
-        let points = survey.trajectory(args.trajectory_step_m)?;
-        write_text(path, &trajectory_csv(&points, confidence))?;
-        outln!("wrote {} ({} points)", path.display(), points.len());
+    if let Some((path, points)) = trajectory {
+        outln!("wrote {} ({points} points)", path.display());
     }
     Ok(super::status::complete_unless(survey.incomplete()))
 }

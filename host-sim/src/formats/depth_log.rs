@@ -72,6 +72,14 @@ impl DepthLog {
             if !(0.0..=MAX_MD_M).contains(&md) {
                 bail!("line {line}: md_m {} outside 0..{MAX_MD_M} m", number(md));
             }
+            if let Some(&(previous, _)) = points.last() {
+                if time <= previous {
+                    bail!(
+                        "line {line}: time {time} s not after the previous row's {previous} s \
+                         (time must increase)"
+                    );
+                }
+            }
             points.push((time, md));
             Ok(())
         })?;

@@ -94,6 +94,39 @@ impl Drop for OutputFile {
     }
 }
 
+/// Several outputs of one command written as a set: each staged whole
+/// under its temporary name ([`OutputSet::stage`]), all given their names
+/// together at the end ([`OutputSet::commit`]). A set dropped uncommitted
+/// (a later output failed) leaves none of them.
+#[derive(Default)]
+pub struct OutputSet {
+    staged: Vec<OutputFile>,
+}
+
+impl OutputSet {
+    /// Writes `text` for `path` under its temporary name, flushed (a full
+    /// disk fails here, "writing PATH").
+    pub fn stage(&mut self, path: &Path, text: &str) -> Result<()> {
+        let stage = || -> Result<OutputFile> {
+            let mut out = OutputFile::create(path)?;
+            out.write_all(text.as_bytes())?;
+            out.flush()?;
+            Ok(out)
+        };
+        let staged = stage().with_context(|| format!("writing {}", path.display()))?;
+        self.staged.push(staged);
+        Ok(())
+    }
+
+    /// Gives every staged output its name.
+    pub fn commit(self) -> Result<()> {
+        for file in self.staged {
+            file.finish()?;
+        }
+        Ok(())
+    }
+}
+
 /// Writes `value` as pretty JSON (with a final newline) to `path`, the
 /// path named in the error: the studies' `--json` outputs.
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {

@@ -3,6 +3,7 @@
 //! 1.4.1.1 trajectory, and the plan and section figures. Lengths in
 //! metres, azimuths along true north, whatever the input.
 
+use crate::formats::files::OutputSet;
 use crate::survey::listing::drilling::{UNCALIBRATED_FLAG, UNCALIBRATED_NOTE};
 use crate::survey::listing::separation as sep;
 use crate::survey::listing::{plot, tie_on_note};
@@ -29,15 +30,29 @@ pub struct OutputPaths<'a> {
 /// Writes the outputs asked for, in the order CSV, JSON, WITSML, figures;
 /// `well` names the well in the figures. Returns the figures' files.
 pub fn write_outputs(s: &WellSurvey, paths: &OutputPaths, well: &str) -> Result<Vec<PathBuf>> {
-    use crate::formats::files::write_text;
+    let mut set = OutputSet::default();
+    let figures = stage_outputs(&mut set, s, paths, well)?;
+    set.commit()?;
+    Ok(figures)
+}
+
+/// [`write_outputs`] as part of a command's set of outputs: the CSV, JSON
+/// and WITSML staged in `set` (named when the set is committed), the
+/// figures written; the figures' paths.
+pub fn stage_outputs(
+    set: &mut OutputSet,
+    s: &WellSurvey,
+    paths: &OutputPaths,
+    well: &str,
+) -> Result<Vec<PathBuf>> {
     if let Some(p) = paths.csv {
-        write_text(p, &csv_text(s))?;
+        set.stage(p, &csv_text(s))?;
     }
     if let Some(p) = paths.json {
-        write_text(p, &json_text(s)?)?;
+        set.stage(p, &json_text(s)?)?;
     }
     if let Some(p) = paths.witsml {
-        write_text(p, &witsml_text(s))?;
+        set.stage(p, &witsml_text(s))?;
     }
     let Some(dir) = paths.plot else {
         return Ok(Vec::new());
