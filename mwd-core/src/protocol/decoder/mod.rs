@@ -285,7 +285,11 @@ impl Decoder {
     /// rather than a restart. Whether the frame is handed on: all but
     /// duplicates.
     fn note_sequence(&mut self, seq: u16, payload: Option<&Payload>, crc: u32) -> bool {
-        if let Some(expected) = self.expected_seq {
+        // A boot event always starts a run: a probe that boots again soon
+        // after sends the same bytes (number 0, time 0), and hiding a
+        // restart as a duplicate would lose it.
+        let starts_run = payload.is_some_and(|p| starts_a_run(seq, p));
+        if let (Some(expected), false) = (self.expected_seq, starts_run) {
             match self.recent.behind(expected.wrapping_sub(1), seq, crc) {
                 Some(Behind::Duplicate) => {
                     self.stats.duplicated += 1;
@@ -298,7 +302,7 @@ impl Decoder {
                 None => {}
             }
         }
-        if payload.is_some_and(|p| starts_a_run(seq, p)) {
+        if starts_run {
             // The probe numbers its first frame, the boot event, 0: a new
             // run. What its previous run sent after the last frame seen
             // cannot be known.
