@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{refused, s, Run};
+use common::{refused, s, Run, WELL1_SITE};
 use std::path::PathBuf;
 
 fn host_sim(args: &[&str]) -> Run {
@@ -27,19 +27,6 @@ fn vertical(dir: &std::path::Path, name: &str) -> PathBuf {
     path
 }
 
-const SITE: [&str; 10] = [
-    "--lat",
-    "60",
-    "--b-total-nt",
-    "50000",
-    "--dip-deg",
-    "72",
-    "--declination-deg",
-    "-4",
-    "--error-model",
-    "ISCWSA MWD Rev5",
-];
-
 /// Runs two vertical wells `north` m apart; returns the run and the JSON.
 fn parallel(name: &str, north: &str, model: bool) -> (Run, serde_json::Value) {
     let dir = scratch(name);
@@ -48,7 +35,9 @@ fn parallel(name: &str, north: &str, model: bool) -> (Run, serde_json::Value) {
     let json = dir.join("out.json");
     let mut args = vec![s(&a)];
     if model {
-        args.extend_from_slice(&SITE);
+        // ISCWSA well 1's site, with the model
+        args.extend_from_slice(&WELL1_SITE);
+        args.extend_from_slice(&["--error-model", "ISCWSA MWD Rev5"]);
     }
     args.extend_from_slice(&[
         "--offset",

@@ -94,29 +94,29 @@ impl DepthLog {
         (self.times[0], self.times[self.times.len() - 1])
     }
 
+    /// The first row at or after time `t`; `None` outside the log.
+    fn row_at_or_after(&self, t: f64) -> Option<usize> {
+        let (first, last) = self.span();
+        (first..=last)
+            .contains(&t)
+            .then(|| self.times.partition_point(|&x| x < t))
+    }
+
     /// The length of the log's interval `t` falls in, s: 0 at a row's own
     /// time, `None` outside the log. An MD interpolated across a long one
     /// is a guess at what the string did in between.
     pub fn interpolation_span(&self, t: f64) -> Option<f64> {
-        let (first, last) = self.span();
-        if !(first..=last).contains(&t) {
-            return None;
+        let i = self.row_at_or_after(t)?;
+        // At a row (the first row included: t is not before it).
+        if i == 0 || self.times[i] == t {
+            return Some(0.0);
         }
-        let i = self.times.partition_point(|&x| x < t);
-        match (self.times.get(i), i.checked_sub(1)) {
-            (Some(&at), _) if at == t => Some(0.0),
-            (Some(&t1), Some(before)) => self.times.get(before).map(|t0| t1 - t0),
-            _ => Some(0.0),
-        }
+        Some(self.times[i] - self.times[i - 1])
     }
 
     /// MD at time `t` by linear interpolation; `None` outside the log.
     pub fn md_at(&self, t: f64) -> Option<f64> {
-        let (first, last) = self.span();
-        if !(first..=last).contains(&t) {
-            return None;
-        }
-        let i = self.times.partition_point(|&x| x < t);
+        let i = self.row_at_or_after(t)?;
         if i == 0 {
             return Some(self.mds[0]);
         }

@@ -14,7 +14,7 @@ use super::consistency::{azimuth_consistency, AzimuthConsistency};
 use super::correlation::{azimuth_lag_correlations, LagCorrelation};
 use super::stations::{station_rows, StationRow};
 use crate::study::drilling_coverage::Fraction;
-use crate::study::drilling_run::{failures, outcomes, RunOutcome};
+use crate::study::drilling_run::{failures, outcomes, RunOutcome, StationCheck};
 use crate::study::stats::{percentile, rms, rms_and_median_sigma};
 use crate::survey::listing::drilling::station_valid;
 use crate::survey::listing::ellipse::scale_2d;
@@ -253,7 +253,7 @@ pub fn summarise(
                 s.motion_seen_stations += 1;
             }
             let sd = st.survey.angles_std.map(f64::from);
-            if !station_valid(&st.survey) || !sd[0].is_finite() {
+            if !counted(st) {
                 s.invalid_stations += 1;
                 continue;
             }
@@ -264,7 +264,7 @@ pub fn summarise(
             tally
                 .inclination
                 .push((st.error[0].abs().to_degrees(), sd[0].to_degrees()));
-            if st.survey.flags & station_flags::AZIMUTH_UNDETERMINED != 0 || !sd[1].is_finite() {
+            if !azimuth_determined(st) {
                 s.azimuth_undetermined_stations += 1;
                 if st.survey.flags & station_flags::HEADING_LOST != 0 {
                     s.azimuth_lost_stations += 1;
@@ -359,19 +359,26 @@ pub fn summarise(
 /// unbroken row of valid stations with a determined azimuth from its
 /// first (`None`: not even the first), and whether that row is all of
 /// them.
-fn heading_held_to(stations: &[crate::study::run_checks::StationCheck]) -> (Option<f64>, bool) {
-    let held = |st: &&crate::study::run_checks::StationCheck| {
-        let sd = st.survey.angles_std.map(f64::from);
-        station_valid(&st.survey)
-            && sd[0].is_finite()
-            && sd[1].is_finite()
-            && st.survey.flags & station_flags::AZIMUTH_UNDETERMINED == 0
-    };
+fn heading_held_to(stations: &[StationCheck]) -> (Option<f64>, bool) {
+    let held = |st: &&StationCheck| counted(st) && azimuth_determined(st);
     let row: Vec<_> = stations.iter().take_while(held).collect();
     (
         row.last().map(|st| st.truth_md),
         row.len() == stations.len(),
     )
+}
+
+/// A station the summary counts: valid, with an inclination sigma (the
+/// others are counted invalid).
+fn counted(st: &StationCheck) -> bool {
+    station_valid(&st.survey) && st.survey.angles_std[0].is_finite()
+}
+
+/// A counted station's azimuth is determined: not flagged undetermined,
+/// its sigma finite.
+fn azimuth_determined(st: &StationCheck) -> bool {
+    st.survey.flags & station_flags::AZIMUTH_UNDETERMINED == 0
+        && st.survey.angles_std[1].is_finite()
 }
 
 /// The depth at least 95 % of the runs held their heading to: the k-th
@@ -423,7 +430,7 @@ fn requirement(s: &GradeWellSummary) -> Requirement {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::drilling_run::{PositionCheck, StationCheck, TdCheck};
+    use crate::study::drilling_run::{PositionCheck, TdCheck};
     use mwd_core::protocol::StationSurvey;
 
     fn station(number: u16, azimuth_error_deg: f64, sigma_deg: f32) -> StationCheck {
