@@ -20,8 +20,10 @@
 //!
 //! The test command runs 20 seeds of 2 h (past the first station the still
 //! probe navigates free under the moving tool's constraints; about 40 s in
-//! release). The day-long figures (over a day the pitch does not yet hold:
-//! docs/filter-derivation.md section 5c):
+//! release), and gives the figures per 2 h from the start too. The
+//! day-long figures (past about ten hours the pitch does not yet hold:
+//! docs/filter-derivation.md section 5c; `STATIC_CONSISTENCY_SEEDS` sets
+//! the number of seeds):
 //! `STATIC_CONSISTENCY_HOURS=24 cargo test --release -p system-tests --test
 //! static_consistency -- --ignored --nocapture`.
 
@@ -67,8 +69,14 @@ struct Tally {
     worst: f64,
 }
 
+/// Width (h) of the time spans the figures are also given by.
+const SPAN_HOURS: f64 = 2.0;
+
 struct Run {
     tallies: [Tally; 9],
+    /// Per span of [`SPAN_HOURS`] from the start, per state: (printed,
+    /// within 2 sigma).
+    spans: Vec<[(u64, u64); 9]>,
     frames: u64,
     flagged_uncalibrated: u64,
 }
@@ -111,6 +119,7 @@ fn run(seed: u64, hours: f64, calibrated: bool) -> Run {
     let sim = SensorSimulator::new(trajectory, model, 1.0 / SAMPLE_RATE_HZ);
     let mut out = Run {
         tallies: [Tally::default(); 9],
+        spans: vec![[(0, 0); 9]; span_count(hours)],
         frames: 0,
         flagged_uncalibrated: 0,
     };
@@ -136,9 +145,11 @@ fn run(seed: u64, hours: f64, calibrated: bool) -> Run {
         if n % CHECK_EVERY != 0 || nav.mode == nav_mode::COARSE_ALIGNMENT {
             continue;
         }
-        for (tally, (error, sigma)) in out
+        let span = ((n as f64 / SAMPLE_RATE_HZ / 3600.0) / SPAN_HOURS) as usize;
+        for ((tally, in_span), (error, sigma)) in out
             .tallies
             .iter_mut()
+            .zip(out.spans[span].iter_mut())
             .zip(errors_and_sigmas(&nav, &s.truth, &site, &earth))
         {
             if invalid {
@@ -150,6 +161,8 @@ fn run(seed: u64, hours: f64, calibrated: bool) -> Run {
                 let ratio = error.abs() / f64::from(sigma);
                 tally.printed += 1;
                 tally.within_2 += u64::from(ratio <= 2.0);
+                in_span.0 += 1;
+                in_span.1 += u64::from(ratio <= 2.0);
                 tally.worst = tally.worst.max(ratio);
             }
         }
@@ -162,6 +175,7 @@ fn study(hours: f64, calibrated: bool) -> Run {
     let next = AtomicU64::new(1);
     let total = Mutex::new(Run {
         tallies: [Tally::default(); 9],
+        spans: vec![[(0, 0); 9]; span_count(hours)],
         frames: 0,
         flagged_uncalibrated: 0,
     });
@@ -170,7 +184,7 @@ fn study(hours: f64, calibrated: bool) -> Run {
         for _ in 0..threads {
             scope.spawn(|| loop {
                 let seed = next.fetch_add(1, Ordering::Relaxed);
-                if seed > SEEDS {
+                if seed > seeds() {
                     break;
                 }
                 let r = run(seed, hours, calibrated);
@@ -184,6 +198,12 @@ fn study(hours: f64, calibrated: bool) -> Run {
                     a.undetermined += b.undetermined;
                     a.worst = a.worst.max(b.worst);
                 }
+                for (a, b) in t.spans.iter_mut().zip(&r.spans) {
+                    for (x, y) in a.iter_mut().zip(b) {
+                        x.0 += y.0;
+                        x.1 += y.1;
+                    }
+                }
             });
         }
     });
@@ -192,7 +212,8 @@ fn study(hours: f64, calibrated: bool) -> Run {
 
 fn print(title: &str, hours: f64, r: &Run) {
     eprintln!(
-        "{title}: {SEEDS} seeds x {hours} h, sampled every {} s",
+        "{title}: {} seeds x {hours} h, sampled every {} s",
+        seeds(),
         CHECK_EVERY as f64 / SAMPLE_RATE_HZ
     );
     eprintln!("state    printed  within 2 sigma  worst |e|/sigma  flagged invalid  undetermined");
@@ -209,6 +230,36 @@ fn print(title: &str, hours: f64, r: &Run) {
     }
 }
 
+/// The share within 2 sigma per span of [`SPAN_HOURS`] ("-": none printed).
+fn print_spans(r: &Run) {
+    eprintln!("within 2 sigma by time from the start:");
+    eprintln!("hours  {}", STATES.map(|s| format!("{s:>8}")).join(""));
+    for (k, span) in r.spans.iter().enumerate() {
+        let from = k as f64 * SPAN_HOURS;
+        let shares = span.map(|(printed, within)| {
+            if printed == 0 {
+                format!("{:>8}", "-")
+            } else {
+                format!("{:>7.1}%", 100.0 * within as f64 / printed as f64)
+            }
+        });
+        eprintln!("{:>2}-{:<4}{}", from, from + SPAN_HOURS, shares.join(""));
+    }
+}
+
+fn span_count(hours: f64) -> usize {
+    ((hours / SPAN_HOURS).ceil() as usize).max(1)
+}
+
+/// Seeds 1..=N (`STATIC_CONSISTENCY_SEEDS`, default [`SEEDS`]).
+fn seeds() -> u64 {
+    std::env::var("STATIC_CONSISTENCY_SEEDS")
+        .ok()
+        .and_then(|n| n.parse::<u64>().ok())
+        .filter(|n| *n > 0)
+        .unwrap_or(SEEDS)
+}
+
 fn hours() -> f64 {
     std::env::var("STATIC_CONSISTENCY_HOURS")
         .ok()
@@ -223,6 +274,7 @@ fn a_calibrated_probe_holds_every_printed_state_within_2_sigma() {
     let hours = hours();
     let r = study(hours, true);
     print("calibrated probe", hours, &r);
+    print_spans(&r);
     assert_eq!(r.flagged_uncalibrated, 0);
     for (name, t) in STATES.iter().zip(&r.tallies) {
         if *name == "azimuth" && t.printed == 0 {

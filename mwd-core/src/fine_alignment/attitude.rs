@@ -37,6 +37,18 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         }
     }
 
+    /// Makes the heading error independent of every other state, its
+    /// variance kept: the other states' own (marginal) covariance is
+    /// unchanged; what goes is the first-order link through which an
+    /// update of any of them would move the heading, and a heading update
+    /// them. For a heading the filter cannot carry to first order
+    /// (`probe::Navigator`, an undetermined heading).
+    pub fn decouple_heading(&mut self) {
+        let variance = self.filter.p[(ATT + 2, ATT + 2)];
+        self.forget_states(ATT + 2, 1);
+        self.filter.p[(ATT + 2, ATT + 2)] = variance;
+    }
+
     /// Turns the solution about the vertical by `angle` (rad, exact, not a
     /// small-angle correction) and makes the heading error independent of
     /// everything else with variance `variance` (rad^2): a heading given

@@ -45,6 +45,27 @@ impl<T: FilterScalar> Navigator<T> {
         self.coarse_std[2].is_finite() && !within
     }
 
+    /// While the heading is undetermined (never found, or lost past the
+    /// first-order limit), its error is kept apart from every other state
+    /// after each navigating cycle (`FineAlignment::decouple_heading`).
+    /// Such a heading is tens of degrees off (10-150 deg in simulated days
+    /// of a still SCC1300), where the error model's first-order link from
+    /// the heading to the tilt (the earth rate resolved through it, -omega_in x phi in eq. 11)
+    /// no longer holds: the updates then moved heading and tilt together
+    /// by what the estimate believed. In a station's first zero-velocity
+    /// updates after 12 h of still free navigation the heading moved 57
+    /// deg and the pitch 4 mrad, against a 0.86 mrad sigma. Kept apart,
+    /// the still probe's pitch held its error within 2 sigma in 96-99.7 %
+    /// of the epochs of its first ten hours (78-94 % before), its roll in
+    /// 99.5-100 % (docs/filter-derivation.md section 5c). Nothing reported is
+    /// lost: an undetermined heading is not reported until the next tie-in
+    /// or alignment, which gives the heading afresh.
+    pub(super) fn keep_undetermined_heading_apart(&mut self) {
+        if !self.coarse_std[2].is_finite() && !self.covariance_invalid {
+            self.filter.decouple_heading();
+        }
+    }
+
     /// The roll, pitch and heading sigmas of a new source of the attitude
     /// (the coarse alignment, a tie-in): a heading lost before is
     /// forgotten.

@@ -65,6 +65,7 @@ impl<T: FilterScalar> Navigator<T> {
         if let (true, Some(turn)) = (drilling, self.last_roll_turn) {
             self.first_drilling_after_roll(turn);
         }
+        self.keep_undetermined_heading_apart();
         self.remember_roll(&input, still, drilling);
         self.still_gyro = (update && missing_gyro.is_none()).then_some(sample.gyro);
         self.held = Some(input.imu);
