@@ -30,8 +30,15 @@ pub enum StudyCommand {
     /// --shard K/N --shard-file FILE`, K = 1..N): the same tables, JSON,
     /// CSV and plots as the study in one process (docs/study-scale-out.md).
     Merge(MergeArgs),
+    /// README's grade table: the lateral study of every grade on both
+    /// built-in wells, its figures per grade and well and whether the
+    /// paper's requirement is met, between README.md's grade-table markers
+    /// and in docs/results/grade-table.csv (nothing written unless every
+    /// run succeeded).
+    GradeTable(GradeTableArgs),
 }
 
+pub use super::study_grade_table::GradeTableArgs;
 pub use super::study_lateral::{LateralArgs, MergeArgs};
 
 #[derive(clap::Args, Debug)]
@@ -70,6 +77,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         StudyCommand::RinsProbe(args) => rins_probe(args),
         StudyCommand::Lateral(args) => super::study_lateral::run(args),
         StudyCommand::Merge(args) => super::study_lateral::merge(args),
+        StudyCommand::GradeTable(args) => super::study_grade_table::run(args),
     }
 }
 

@@ -32,7 +32,7 @@ pub enum WellChoice {
 
 /// The plan's own ranges (`sim::plan::DrillingParams`), checked here too
 /// so a bad number is refused before any work.
-fn rop(text: &str) -> Result<f64, String> {
+pub(super) fn rop(text: &str) -> Result<f64, String> {
     number_in(text, "the rate of penetration", (0.1, 500.0), "m/h")
 }
 
@@ -40,7 +40,7 @@ fn stand_length(text: &str) -> Result<f64, String> {
     number_in(text, "the stand length", (1.0, 1000.0), "m")
 }
 
-fn connection_still(text: &str) -> Result<f64, String> {
+pub(super) fn connection_still(text: &str) -> Result<f64, String> {
     number_in(text, "the still time at connections", (0.0, 86_400.0), "s")
 }
 
