@@ -194,7 +194,11 @@ fn refuse_incomplete(result: &LateralStudy) -> Result<()> {
     }
     let mut errors = result.errors.clone();
     for s in &result.summaries {
-        errors.extend(s.failed_runs.iter().map(|e| format!("{} {}: {e}", s.grade, s.well)));
+        errors.extend(
+            s.failed_runs
+                .iter()
+                .map(|e| format!("{} {}: {e}", s.grade, s.well)),
+        );
     }
     if let Some(first) = errors.first() {
         bail!("{} failed ({first}): {unwritten}", errors.len());

@@ -305,7 +305,11 @@ mod tests {
         assert_eq!(verdict(&summary(20, 20, Some(true))), Verdict::Met);
         let few = verdict(&summary(4, 4, Some(true)));
         assert_eq!(few.word(), "undetermined", "{few:?}");
-        assert!(few.text().contains("4 runs (fewer than 5)"), "{}", few.text());
+        assert!(
+            few.text().contains("4 runs (fewer than 5)"),
+            "{}",
+            few.text()
+        );
         // a failed attitude half decides, however few the TDs
         assert_eq!(verdict(&summary(2, 2, Some(false))).word(), "not met");
         let unplaced = verdict(&summary(20, 12, Some(true)));

@@ -24,8 +24,9 @@
 //! - [`figures`]: the study's figures, drawn by [`plots`];
 //! - [`grade_table`]: the README's grade table and its CSV
 //!   (`study grade-table`);
-//! - [`shard`]: the study in shards run apart (`--shard K/N`) and merged,
-//!   each job's outcome kept exact by `shard_codec`.
+//! - [`shard`]: the study in shards run apart (`--shard K/N`) and merged
+//!   ([`crate::study::shard`]), each job's outcome kept exact by
+//!   `shard_codec`.
 
 pub mod consistency;
 pub mod correlation;
@@ -36,7 +37,7 @@ pub mod grade_table;
 pub mod plots;
 pub mod run;
 pub mod shard;
-mod shard_codec;
+pub(crate) mod shard_codec;
 pub mod stations;
 pub mod summary;
 pub mod table;
