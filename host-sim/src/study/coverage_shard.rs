@@ -8,10 +8,10 @@
 use super::drilling_coverage::{summary_of, Summary};
 use super::drilling_run::{run, RunConfig, RunOutcome, Scalar};
 use super::lateral::shard_codec::{decode_run, encode_run};
-use super::lateral::wells::{DrillingOverrides, Well};
 use super::shard::{exact_number, Merged, ShardIndex, ShardedStudy, SourceText};
 use super::{run_jobs_until, StudyRuns};
 use crate::sim::plan::Vibration;
+use crate::sim::Plan;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
@@ -40,16 +40,11 @@ impl CoverageSpec {
         exact_number(&self.tie_in_azimuth_sigma_deg, "the tie-in azimuth sigma")
     }
 
-    /// The runs' configuration: the plan parsed as a plan file is, with
+    /// The runs' configuration: the plan checked as a plan file is, with
     /// `vibration` (the level [`Self::vibration`] names) instead of its
     /// own; the SCC1300, the study's gyro.
     pub fn config(&self, vibration: Option<Vibration>) -> Result<RunConfig> {
-        let mut plan = Well::parse(
-            &self.plan.name,
-            &self.plan.text,
-            &DrillingOverrides::default(),
-        )?
-        .plan;
+        let mut plan = Plan::parse(&self.plan.text, &self.plan.name)?;
         if let Some(v) = vibration {
             plan.drilling.vibration = v;
         }
@@ -151,7 +146,11 @@ mod tests {
         assert_eq!(config.plan.drilling.vibration, Vibration::NONE);
         let mut bad = spec();
         bad.plan.text = "{".into();
-        assert!(bad.config(None).is_err());
+        let e = format!("{:#}", bad.config(None).expect_err("refused"));
+        assert!(
+            e.starts_with("the built-in 100 m lateral: not a well plan"),
+            "{e}"
+        );
     }
 
     #[test]
