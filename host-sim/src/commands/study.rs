@@ -7,7 +7,9 @@ use super::limits::{azimuth_sigma_deg, number_in};
 use super::runs::{print_and_write_json, progress_bar, stop_on_ctrl_c, SeedsAndThreads};
 use anyhow::Result;
 use host_sim::sim::Plan;
+use host_sim::study::coverage_shard::COVERAGE_SHARD_FORMAT;
 use host_sim::study::lateral::wells::Well;
+use host_sim::study::shard::shard_format;
 use std::path::PathBuf;
 
 #[derive(clap::Subcommand, Debug)]
@@ -47,9 +49,26 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         StudyCommand::DrillingCoverage(args) => super::study_coverage::run(args),
         StudyCommand::RinsProbe(args) => rins_probe(args),
         StudyCommand::Lateral(args) => super::study_lateral::run(args),
-        StudyCommand::Merge(args) => super::study_lateral::merge(args),
+        StudyCommand::Merge(args) => merge(args),
         StudyCommand::GradeTable(args) => super::study_grade_table::run(args),
     }
+}
+
+/// `study merge`: the study its first shard names (by its "format"), a
+/// lateral study's when it names none (whose merge then says why the file
+/// is no shard).
+fn merge(args: MergeArgs) -> Result<()> {
+    if first_shard_format(&args.shards).as_deref() == Some(COVERAGE_SHARD_FORMAT) {
+        return super::study_coverage::merge(&args.shards, &args.outputs);
+    }
+    super::study_lateral::merge(args)
+}
+
+/// The first shard's "format" (`None` when it is unreadable or has none).
+fn first_shard_format(shards: &[PathBuf]) -> Option<String> {
+    let text = std::fs::read_to_string(shards.first()?).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    shard_format(&value).map(str::to_string)
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]

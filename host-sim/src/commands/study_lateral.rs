@@ -7,7 +7,6 @@ use super::runs::{progress_bar, stop_on_ctrl_c, SeedsAndThreads};
 use anyhow::{Context, Result};
 use host_sim::formats::files::{write_json, write_text};
 use host_sim::formats::text_records::read_small_file;
-use host_sim::study::coverage_shard::COVERAGE_SHARD_FORMAT;
 use host_sim::study::drilling_run::Scalar;
 use host_sim::study::grade::{self, Grade};
 use host_sim::study::lateral::figures::plots;
@@ -20,7 +19,6 @@ use host_sim::study::lateral::table::{csv, table};
 use host_sim::study::lateral::{
     study, DrillingOverrides, LateralStudy, StudyConfig, Well, BUILTIN_WELLS,
 };
-use host_sim::study::shard::shard_format;
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]
@@ -223,12 +221,9 @@ pub struct MergeArgs {
     pub outputs: StudyOutputs,
 }
 
-/// `study merge`: the shards checked to make one study, whose outputs
-/// are then written as `study lateral` writes them.
+/// `study merge` of lateral study shards: the shards checked to make one
+/// study, whose outputs are then written as `study lateral` writes them.
 pub fn merge(args: MergeArgs) -> Result<()> {
-    if first_shard_format(&args.shards).as_deref() == Some(COVERAGE_SHARD_FORMAT) {
-        return super::study_coverage::merge(&args.shards, &args.outputs);
-    }
     let shards = args.shards.iter().map(|path| {
         let name = path.display().to_string();
         let text =
@@ -243,14 +238,6 @@ pub fn merge(args: MergeArgs) -> Result<()> {
     )?;
     let result = merged.study()?;
     report(&result, tie_in_sigma_deg, &args.outputs)
-}
-
-/// The first shard's "format" (`None` when it is unreadable or has none:
-/// the lateral merge then says why it is no shard).
-fn first_shard_format(shards: &[PathBuf]) -> Option<String> {
-    let text = std::fs::read_to_string(shards.first()?).ok()?;
-    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
-    shard_format(&value).map(str::to_string)
 }
 
 /// The study's inputs whole: grade files and plans read (each checked
