@@ -5,7 +5,8 @@
 # outputs compared with the same study in one process, byte for byte
 # (`cmp`): stations.csv and every plot as written; study.txt, study.json
 # and study.csv with their timings (wall and CPU times, speeds) blanked
-# first, the only fields two processes' runs of a study differ in.
+# first, the only fields two processes' runs of a study differ in. Then a
+# drilling-coverage study (`--study drilling-coverage`): table and JSON.
 # The venv (target/study-dask/venv) comes from scripts/requirements-dask.txt.
 # Usage: scripts/study-dask-test.sh HOST_SIM
 set -euo pipefail
@@ -103,3 +104,13 @@ for p in "$RUN/single/plots"/*; do
 done
 [ "$n" -ge 4 ] || { echo "study-dask-test: only $n plots" >&2; exit 1; }
 echo "study-dask-test: 3 shards on 2 Dask workers (one retried) = one process: JSON, CSV, table (timings aside), stations.csv and $n plots byte for byte"
+
+# the drilling-coverage study the same way (--study drilling-coverage):
+# its table and JSON, the wall time the only figure that differs
+COVERAGE=(--runs 3 --first-seed 5 --scalar f64 --threads 1)
+"$HS" study drilling-coverage "${COVERAGE[@]}" --json "$RUN/coverage.json" >"$RUN/coverage.txt"
+"$VENV/bin/python" scripts/study_dask.py "$HS" 3 "$RUN/coverage-dask" \
+  --workers 2 --study drilling-coverage -- "${COVERAGE[@]}" >/dev/null
+cmp <(grep -v '^wall time' "$RUN/coverage.txt") <(grep -v '^wall time' "$RUN/coverage-dask/study.txt")
+cmp <(grep -v '"wall_s":' "$RUN/coverage.json") <(grep -v '"wall_s":' "$RUN/coverage-dask/study.json")
+echo "study-dask-test: a drilling-coverage study in 3 shards on Dask = one process: table and JSON (wall time aside)"

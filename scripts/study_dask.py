@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""A lateral study on a Dask cluster (docs/study-scale-out.md).
+"""A lateral (or drilling-coverage) study on a Dask cluster
+(docs/study-scale-out.md).
 
-One task per shard: each runs `HOST_SIM study lateral STUDY_ARGS --shard
+One task per shard: each runs `HOST_SIM study STUDY STUDY_ARGS --shard
 K/N --shard-file ...` on a worker and sends the shard file back; a failed
 shard is run again (Dask's `retries`). When every shard is in, `HOST_SIM
 study merge` writes the study's outputs into OUT_DIR, the same as the study
-in one process: study.txt (its standard output), study.json, study.csv,
-stations.csv and plots/.
+in one process: study.txt (its standard output) and study.json; for the
+lateral study also study.csv, stations.csv and plots/.
 
     study_dask.py HOST_SIM SHARDS OUT_DIR [options] -- STUDY_ARGS...
 
@@ -25,12 +26,12 @@ import time
 import uuid
 
 
-def run_shard(host_sim, study_args, index, count):
+def run_shard(host_sim, study, study_args, index, count):
     """On a worker: shard INDEX/COUNT of the study; the shard file's bytes
     and the shard's own summary line."""
     with tempfile.TemporaryDirectory(prefix="host-sim-shard-") as tmp:
         path = os.path.join(tmp, "shard.json")
-        cmd = [host_sim, "study", "lateral", *study_args,
+        cmd = [host_sim, "study", study, *study_args,
                "--shard", f"{index}/{count}", "--shard-file", path]
         done = subprocess.run(cmd, capture_output=True, text=True)
         if done.returncode != 0:
@@ -57,8 +58,8 @@ def write_atomically(path, data):
 
 def parse_args(argv):
     p = argparse.ArgumentParser(
-        description="Run a host-sim lateral study in shards on Dask distributed, then merge.",
-        epilog="Everything after -- goes to `host-sim study lateral` (no --shard, "
+        description="Run a host-sim study in shards on Dask distributed, then merge.",
+        epilog="Everything after -- goes to `host-sim study STUDY` (no --shard, "
                "--shard-file or outputs: the merge writes those).")
     p.add_argument("host_sim", help="the host-sim binary (the same path on every worker)")
     p.add_argument("shards", type=int, help="how many shards (tasks)")
@@ -73,6 +74,9 @@ def parse_args(argv):
     p.add_argument("--retries", type=int, default=2,
                    help="times a failed shard is run again (default 2)")
     p.add_argument("--no-plots", action="store_true", help="merge without plots/")
+    p.add_argument("--study", choices=("lateral", "drilling-coverage"), default="lateral",
+                   help="which study (default lateral; drilling-coverage writes "
+                        "study.txt and study.json only)")
     if "--" not in argv:
         p.parse_args(argv)  # --help, or what is missing
         p.error("the study's arguments go after -- (e.g. -- --well 100m --runs 100)")
@@ -109,7 +113,7 @@ def main(argv):
     try:
         run = uuid.uuid4().hex[:8]  # keys of their own on a shared scheduler
         futures = {
-            client.submit(run_shard, args.host_sim, args.study_args, k, n,
+            client.submit(run_shard, args.host_sim, args.study, args.study_args, k, n,
                           key=f"host-sim-shard-{k}-of-{n}-{run}", pure=False,
                           retries=args.retries): k
             for k in range(1, n + 1)
@@ -139,11 +143,12 @@ def main(argv):
         return 1
     out = args.out_dir
     merge = [args.host_sim, "study", "merge", *[paths[k] for k in sorted(paths)],
-             "--json", os.path.join(out, "study.json"),
-             "--csv", os.path.join(out, "study.csv"),
-             "--stations-csv", os.path.join(out, "stations.csv")]
-    if not args.no_plots:
-        merge += ["--plots", os.path.join(out, "plots")]
+             "--json", os.path.join(out, "study.json")]
+    if args.study == "lateral":
+        merge += ["--csv", os.path.join(out, "study.csv"),
+                  "--stations-csv", os.path.join(out, "stations.csv")]
+        if not args.no_plots:
+            merge += ["--plots", os.path.join(out, "plots")]
     done = subprocess.run(merge, capture_output=True, text=True)
     sys.stderr.write(done.stderr)
     if done.returncode != 0:

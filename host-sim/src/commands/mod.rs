@@ -32,6 +32,8 @@ mod simulate;
 mod site;
 pub(crate) mod status;
 mod study;
+mod study_coverage;
+mod study_grade_table;
 mod study_lateral;
 mod survey;
 mod survey_capture;

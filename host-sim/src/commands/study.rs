@@ -1,14 +1,15 @@
-//! `host-sim study drilling-coverage`: the coverage study of the probe's
-//! station sigmas over seeded simulated laterals (docs/drilling-survey.md).
+//! `host-sim study ...`: the studies' subcommands, and `rins-probe`'s
+//! command line (`drilling-coverage` in [`super::study_coverage`],
+//! `lateral` and `merge` in [`super::study_lateral`], `grade-table` in
+//! [`super::study_grade_table`]).
 
 use super::limits::{azimuth_sigma_deg, number_in};
 use super::runs::{print_and_write_json, progress_bar, stop_on_ctrl_c, SeedsAndThreads};
 use anyhow::Result;
 use host_sim::sim::Plan;
-use host_sim::study::drilling_coverage::{study, table};
-use host_sim::study::drilling_run::{RunConfig, Scalar};
-use host_sim::study::grade::Grade;
+use host_sim::study::coverage_shard::COVERAGE_SHARD_FORMAT;
 use host_sim::study::lateral::wells::Well;
+use host_sim::study::shard::shard_format;
 use std::path::PathBuf;
 
 #[derive(clap::Subcommand, Debug)]
@@ -26,96 +27,48 @@ pub enum StudyCommand {
     /// gyro grade, station azimuth and TD position errors against the
     /// predicted sigmas (docs/lateral-study.md).
     Lateral(LateralArgs),
-    /// The outputs of a lateral study run in shards (`study lateral
-    /// --shard K/N --shard-file FILE`, K = 1..N): the same tables, JSON,
-    /// CSV and plots as the study in one process (docs/study-scale-out.md).
+    /// The outputs of a lateral or drilling-coverage study run in shards
+    /// (`study lateral` or `study drilling-coverage` with `--shard K/N
+    /// --shard-file FILE`, K = 1..N): the same tables and files as the
+    /// study in one process (docs/study-scale-out.md).
     Merge(MergeArgs),
+    /// README's grade table: the lateral study of every grade on both
+    /// built-in wells, its figures per grade and well and whether the
+    /// paper's requirement is met, between README.md's grade-table markers
+    /// and in docs/results/grade-table.csv (nothing written unless every
+    /// run succeeded).
+    GradeTable(GradeTableArgs),
 }
 
+pub use super::study_coverage::CoverageArgs;
+pub use super::study_grade_table::GradeTableArgs;
 pub use super::study_lateral::{LateralArgs, MergeArgs};
-
-#[derive(clap::Args, Debug)]
-pub struct CoverageArgs {
-    /// Well plan (JSON, docs/drilling-simulation.md); default: the
-    /// built-in 100 m lateral (host-sim/data/plans/lateral-100m.json).
-    #[arg(long)]
-    pub plan: Option<PathBuf>,
-    /// Number of runs (seeds first-seed, first-seed + 1, ...).
-    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
-    pub runs: u64,
-    #[command(flatten)]
-    pub seeds: SeedsAndThreads,
-    /// 1-sigma of the parent well's azimuth at the tie-in, deg.
-    #[arg(long, default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
-    pub tie_in_azimuth_sigma_deg: f64,
-    /// Vibration level instead of the plan's.
-    #[arg(long, value_enum)]
-    pub vibration: Option<super::simulate::VibrationLevel>,
-    /// Run the probe without the calibration of the simulated parts'
-    /// deterministic errors (as `simulate`'s captures and the QEMU probe).
-    #[arg(long)]
-    pub uncalibrated: bool,
-    /// The navigator filter's scalar: f32 computes as the probe does (this
-    /// study stands for it); f64 is faster on x86 hosts.
-    #[arg(long, value_enum, default_value = "f32")]
-    pub scalar: Scalar,
-    /// Write the summary here (JSON).
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-}
 
 pub fn run(cmd: StudyCommand) -> Result<()> {
     match cmd {
-        StudyCommand::DrillingCoverage(args) => drilling_coverage(args),
+        StudyCommand::DrillingCoverage(args) => super::study_coverage::run(args),
         StudyCommand::RinsProbe(args) => rins_probe(args),
         StudyCommand::Lateral(args) => super::study_lateral::run(args),
-        StudyCommand::Merge(args) => super::study_lateral::merge(args),
+        StudyCommand::Merge(args) => merge(args),
+        StudyCommand::GradeTable(args) => super::study_grade_table::run(args),
     }
 }
 
-fn drilling_coverage(args: CoverageArgs) -> Result<()> {
-    let mut plan = study_plan(args.plan.as_deref())?;
-    if let Some(level) = args.vibration {
-        plan.drilling.vibration = level.vibration();
+/// `study merge`: the study its first shard names (by its "format"), a
+/// lateral study's when it names none (whose merge then says why the file
+/// is no shard).
+fn merge(args: MergeArgs) -> Result<()> {
+    if first_shard_format(&args.shards).as_deref() == Some(COVERAGE_SHARD_FORMAT) {
+        return super::study_coverage::merge(&args.shards, &args.outputs);
     }
-    let mut config = RunConfig::new(
-        plan,
-        args.tie_in_azimuth_sigma_deg.to_radians(),
-        Grade::scc1300()?,
-    )?;
-    config.uncalibrated = args.uncalibrated;
-    config.scalar = args.scalar;
-    let threads = args.seeds.threads();
-    let bar = progress_bar(
-        args.runs,
-        "{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
-    )?;
-    let stop = stop_on_ctrl_c(Some(&bar))?;
-    let summary = study(&config, &args.seeds.runs(args.runs, &|| bar.inc(1), &stop));
-    bar.finish_and_clear();
-    outln!(
-        "drilling coverage: {} ({} runs from seed {}, tie-in azimuth sigma {} deg, {} threads, filter {}{})",
-        plan_name(args.plan.as_deref()),
-        args.runs,
-        args.seeds.first_seed,
-        args.tie_in_azimuth_sigma_deg,
-        threads,
-        args.scalar.name(),
-        if args.uncalibrated {
-            ", uncalibrated"
-        } else {
-            ""
-        }
-    );
-    print_and_write_json(&table(&summary), args.json.as_deref(), &summary)?;
-    if let Some(i) = summary.interrupted {
-        anyhow::bail!(
-            "interrupted after {} of {} runs: the outputs above hold the runs done",
-            i.jobs_done,
-            i.jobs
-        );
-    }
-    Ok(())
+    super::study_lateral::merge(args)
+}
+
+/// The first shard's "format" (`None` when it is unreadable or has none).
+fn first_shard_format(shards: &[PathBuf]) -> Option<String> {
+    let text = std::fs::read_to_string(shards.first()?).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    shard_format(&value).map(str::to_string)
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq)]

@@ -32,7 +32,7 @@ pub enum WellChoice {
 
 /// The plan's own ranges (`sim::plan::DrillingParams`), checked here too
 /// so a bad number is refused before any work.
-fn rop(text: &str) -> Result<f64, String> {
+pub(super) fn rop(text: &str) -> Result<f64, String> {
     number_in(text, "the rate of penetration", (0.1, 500.0), "m/h")
 }
 
@@ -40,7 +40,7 @@ fn stand_length(text: &str) -> Result<f64, String> {
     number_in(text, "the stand length", (1.0, 1000.0), "m")
 }
 
-fn connection_still(text: &str) -> Result<f64, String> {
+pub(super) fn connection_still(text: &str) -> Result<f64, String> {
     number_in(text, "the still time at connections", (0.0, 86_400.0), "s")
 }
 
@@ -212,15 +212,17 @@ fn run_shard(
 
 #[derive(clap::Args, Debug)]
 pub struct MergeArgs {
-    /// The shard files, every one of the study (any order).
+    /// The shard files, every one of the study (any order): a lateral
+    /// study's, or a drilling-coverage study's (which writes its table and
+    /// --json only).
     #[arg(required = true, value_name = "SHARD")]
     pub shards: Vec<PathBuf>,
     #[command(flatten)]
     pub outputs: StudyOutputs,
 }
 
-/// `study merge`: the shards checked to make one study, whose outputs
-/// are then written as `study lateral` writes them.
+/// `study merge` of lateral study shards: the shards checked to make one
+/// study, whose outputs are then written as `study lateral` writes them.
 pub fn merge(args: MergeArgs) -> Result<()> {
     let shards = args.shards.iter().map(|path| {
         let name = path.display().to_string();

@@ -122,9 +122,20 @@ pub struct StationCoverage {
 pub fn study(config: &RunConfig, runs: &StudyRuns) -> Summary {
     let started = std::time::Instant::now();
     let results = runs.run(|seed| run(config, seed));
-    let mut summary = summarise(&results);
-    summary.interrupted = Interruption::of(results.len(), runs.runs);
-    summary.wall_s = started.elapsed().as_secs_f64();
+    summary_of(&results, runs.runs, started.elapsed().as_secs_f64())
+}
+
+/// The summary of `results` (the runs done, in seed order) of a study of
+/// `runs` runs that took `wall_s`: one process's, or its shards' merged
+/// (`super::coverage_shard`).
+pub fn summary_of(
+    results: &[(u64, Result<RunOutcome, String>)],
+    runs: usize,
+    wall_s: f64,
+) -> Summary {
+    let mut summary = summarise(results);
+    summary.interrupted = Interruption::of(results.len(), runs);
+    summary.wall_s = wall_s;
     summary
 }
 

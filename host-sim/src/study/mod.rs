@@ -1,5 +1,6 @@
 //! Monte Carlo studies over simulated runs (`host-sim study ...`).
 
+pub mod coverage_shard;
 pub mod drilling_coverage;
 pub mod drilling_run;
 pub mod grade;
@@ -7,6 +8,7 @@ pub mod lateral;
 pub mod owsg;
 pub mod rins_probe;
 pub mod run_checks;
+pub mod shard;
 pub mod stats;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

@@ -92,6 +92,16 @@ impl Plan {
             .with_context(|| format!("{}: invalid plan", path.display()))
     }
 
+    /// Checks a plan file's text, `name` (its path) in the errors as
+    /// [`Self::load`] names it: a plan that travels as text (a study's
+    /// shard file).
+    pub fn parse(text: &str, name: &str) -> Result<BuiltPlan> {
+        let plan: Self =
+            serde_json::from_str(text).with_context(|| format!("{name}: not a well plan"))?;
+        plan.build()
+            .with_context(|| format!("{name}: invalid plan"))
+    }
+
     /// Reads a plan file without building it.
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)

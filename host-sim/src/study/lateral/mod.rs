@@ -22,18 +22,22 @@
 //! - [`table`]: the terminal tables and the CSV, with `csv` (a CSV
 //!   cell's quoting, which the station list shares);
 //! - [`figures`]: the study's figures, drawn by [`plots`];
-//! - [`shard`]: the study in shards run apart (`--shard K/N`) and merged,
-//!   each job's outcome kept exact by `shard_codec`.
+//! - [`grade_table`]: the README's grade table and its CSV
+//!   (`study grade-table`);
+//! - [`shard`]: the study in shards run apart (`--shard K/N`) and merged
+//!   ([`crate::study::shard`]), each job's outcome kept exact by
+//!   `shard_codec`.
 
 pub mod consistency;
 pub mod correlation;
 pub mod covariance;
 mod csv;
 pub mod figures;
+pub mod grade_table;
 pub mod plots;
 pub mod run;
 pub mod shard;
-mod shard_codec;
+pub(crate) mod shard_codec;
 pub mod stations;
 pub mod summary;
 pub mod table;

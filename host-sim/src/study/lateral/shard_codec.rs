@@ -45,19 +45,22 @@ pub fn decode(bytes: &[u8]) -> Result<JobOutcome> {
     Ok(outcome)
 }
 
-/// Lower-case hexadecimal, two digits a byte.
-pub fn to_hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
+/// The bytes of one Monte Carlo run's outcome alone (the
+/// drilling-coverage study's job, `crate::study::coverage_shard`).
+pub(crate) fn encode_run(run: &Result<RunOutcome, String>) -> Vec<u8> {
+    let mut e = Encoder(Vec::new());
+    e.result(run, Encoder::run);
+    e.0
 }
 
-pub fn from_hex(text: &str) -> Result<Vec<u8>> {
-    if text.len() % 2 != 0 || !text.is_ascii() {
-        bail!("not hexadecimal bytes");
+/// The run of `bytes`, all of them.
+pub(crate) fn decode_run(bytes: &[u8]) -> Result<Result<RunOutcome, String>> {
+    let mut d = Decoder { bytes, at: 0 };
+    let run = d.result(Decoder::run)?;
+    if d.at != bytes.len() {
+        bail!("{} bytes left after the run", bytes.len() - d.at);
     }
-    (0..text.len())
-        .step_by(2)
-        .map(|i| u8::from_str_radix(&text[i..i + 2], 16).context("not hexadecimal bytes"))
-        .collect()
+    Ok(run)
 }
 
 struct Encoder(Vec<u8>);
@@ -458,6 +461,7 @@ impl Decoder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::shard::{from_hex, to_hex};
     use mwd_core::protocol::frame::station_flags;
 
     fn station(number: u16) -> StationCheck {
@@ -525,6 +529,12 @@ mod tests {
             let text = to_hex(&bytes);
             let back = decode(&from_hex(&text).expect("hex")).expect("decodes");
             assert_eq!(encode(&back), bytes);
+            if let JobOutcome::Run(run) = &back {
+                let alone = encode_run(run);
+                let again = decode_run(&alone).expect("a run alone decodes");
+                assert_eq!(encode_run(&again), alone);
+                assert!(decode_run(&alone[..alone.len() - 1]).is_err());
+            }
         }
     }
 
@@ -543,8 +553,5 @@ mod tests {
         let mut kind = bytes;
         kind[0] = 9;
         assert!(decode(&kind).is_err());
-        assert!(from_hex("0g").is_err());
-        assert!(from_hex("abc").is_err());
-        assert!(from_hex("é0").is_err());
     }
 }

@@ -40,12 +40,12 @@ fn aligned(header: &[&str], rows: &[Vec<String>], left: usize) -> String {
     out
 }
 
-fn num(v: Option<f64>, decimals: usize) -> String {
+pub(super) fn num(v: Option<f64>, decimals: usize) -> String {
     v.map_or_else(|| "-".into(), |v| format!("{v:.decimals$}"))
 }
 
 /// [`Fraction::text`], or "-" without cases.
-fn fraction(f: &Fraction) -> String {
+pub(super) fn fraction(f: &Fraction) -> String {
     f.text().unwrap_or_else(|| "-".into())
 }
 
@@ -79,7 +79,7 @@ fn station_row(s: &GradeWellSummary) -> Vec<String> {
 /// How far the heading held in 95 % of the runs: its true MD, "none"
 /// when more than 5 % lost it at the first station; with the count of
 /// runs that held it to their last station.
-fn held_to(s: &GradeWellSummary) -> String {
+pub(super) fn held_to(s: &GradeWellSummary) -> String {
     let ok = s.runs - s.failed_runs.len();
     let depth = s
         .heading_held_to_md_m
