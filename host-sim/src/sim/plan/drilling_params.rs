@@ -1,8 +1,9 @@
 //! The drilling parameters of a plan (the file's `drilling` object, each
 //! field with a default): rate of penetration, stands and connections, the
 //! orienter's toolface changes, the vibration and shocks while drilling,
-//! and the errors of the surface depth log; with the checks of their
-//! ranges.
+//! the errors of the surface depth log and the hole's tortuosity; with the
+//! checks of their ranges.
+use super::tortuosity::Tortuosity;
 use anyhow::{ensure, Result};
 use serde::{Deserialize, Serialize};
 
@@ -171,6 +172,9 @@ pub struct DrillingParams {
     pub depth_errors: DepthErrors,
     /// Interval of the surface depth log (s).
     pub depth_log_interval_s: f64,
+    /// How the drilled hole wanders around the plan
+    /// ([`super::tortuosity`]).
+    pub tortuosity: Tortuosity,
 }
 
 impl Default for DrillingParams {
@@ -188,6 +192,7 @@ impl Default for DrillingParams {
             vibration: Vibration::default(),
             depth_errors: DepthErrors::default(),
             depth_log_interval_s: 1.0,
+            tortuosity: Tortuosity::default(),
         }
     }
 }
@@ -238,6 +243,7 @@ impl DrillingParams {
             );
         }
         self.vibration.check()?;
+        self.tortuosity.check()?;
         let d = &self.depth_errors;
         ensure!(
             d.scale_ppm.is_finite() && d.scale_ppm.abs() <= 10_000.0,
