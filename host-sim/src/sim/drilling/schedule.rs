@@ -507,6 +507,31 @@ mod tests {
     }
 
     #[test]
+    fn zero_tortuosity_drills_the_plan_exactly_and_two_seeds_two_holes() {
+        let mut straight = hold_then_curve(3010.0, 20.0, 14.0);
+        straight.drilling.tortuosity = crate::sim::plan::Tortuosity::NONE;
+        let sim = Drilling::new(straight.build().expect("valid"), 3);
+        let mut t = 0.0;
+        while t < sim.duration() {
+            let truth = sim.truth(t);
+            assert_eq!(truth.point, sim.plan().at(truth.md), "at {t} s");
+            t += 7.3;
+        }
+        // the default tortuosity: each seed its own hole, the same MD and
+        // schedule, the toolface the plan's section's
+        let (a, b) = (Drilling::new(plan(), 3), Drilling::new(plan(), 4));
+        let end = a.duration();
+        let (ta, tb) = (a.truth(end), b.truth(end));
+        assert_eq!(ta.md, tb.md);
+        assert!((ta.point.nev - tb.point.nev).norm() > 1e-3);
+        assert!((ta.point.nev - a.plan().at(ta.md).nev).norm() > 1e-3);
+        assert_eq!(ta, Drilling::new(plan(), 3).truth(end));
+        // the depth log follows the drilled hole's TVD
+        let (_, logged) = a.depth_log().last().expect("a log");
+        assert_eq!(logged, a.logged_md(ta.md, ta.point.nev.z));
+    }
+
+    #[test]
     fn the_run_reaches_the_plan_end_and_stops() {
         let sim = Drilling::new(plan(), 3);
         let end = sim.truth(sim.duration());

@@ -24,7 +24,9 @@ use serde::{Deserialize, Serialize};
 
 /// The shard file's format name and version (its first two fields).
 pub const SHARD_FORMAT: &str = "host-sim lateral study shard";
-pub const SHARD_VERSION: u32 = 1;
+/// Version 2: the runs drill their own tortuous holes (shards of version
+/// 1 drilled the plan exactly, and hold no tortuosity).
+pub const SHARD_VERSION: u32 = 2;
 
 /// A file given as text: its name (a path, or a built-in well's label)
 /// and content.
@@ -47,6 +49,8 @@ pub struct StudySpec {
     pub rop_m_per_h: Option<String>,
     pub stand_length_m: Option<String>,
     pub connection_still_s: Option<String>,
+    pub tortuosity_deg_per_30m: Option<String>,
+    pub tortuosity_length_m: Option<String>,
     pub tie_in_azimuth_sigma_deg: String,
     pub runs: usize,
     pub first_seed: u64,
@@ -75,6 +79,11 @@ impl StudySpec {
             rop_m_per_h: read(&self.rop_m_per_h, "the rate of penetration")?,
             stand_length_m: read(&self.stand_length_m, "the stand length")?,
             connection_still_s: read(&self.connection_still_s, "the connection still time")?,
+            tortuosity_deg_per_30m: read(&self.tortuosity_deg_per_30m, "the tortuosity")?,
+            tortuosity_length_m: read(
+                &self.tortuosity_length_m,
+                "the tortuosity's correlation length",
+            )?,
         })
     }
 
