@@ -328,7 +328,7 @@ mod tests {
         let apart = (pa.nev - pb.nev).norm();
         assert!(apart > 0.05, "two seeds end {apart} m apart");
         // around the plan: within a few RMS of the steered deviation
-        // (sigma L_s sqrt(L / (L + L_s)) = 0.61 deg per component)
+        // (sigma L_s sqrt(L / (L + L_s)) = 0.74 deg per component)
         let planned = plan.at(end);
         for p in [pa, pb] {
             let turn = (p.inclination - planned.inclination)
