@@ -473,7 +473,8 @@ mod tests {
             );
             // The orienter's steps stay around the section's toolface.
             if !sim.boundary_turning(t, t) {
-                let off = wrap_pi(now.toolface - sim.plan().section_toolface(&now.point));
+                let planned = sim.plan().at(now.md);
+                let off = wrap_pi(now.toolface - sim.plan().section_toolface(&planned));
                 assert!(off.abs() <= 30.0 * DEG + 1e-9, "{} deg off", off / DEG);
             }
             prev = now;
