@@ -25,7 +25,8 @@ pub enum StudyCommand {
     /// 0.1 deg, position error under 1 m per 1000 m): seeded laterals by
     /// gyro grade, station azimuth and TD position errors against the
     /// predicted sigmas (docs/lateral-study.md).
-    Lateral(LateralArgs),
+    // boxed: its options are most of the enum's size
+    Lateral(Box<LateralArgs>),
     /// The outputs of a lateral study run in shards (`study lateral
     /// --shard K/N --shard-file FILE`, K = 1..N): the same tables, JSON,
     /// CSV and plots as the study in one process (docs/study-scale-out.md).
@@ -68,7 +69,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     match cmd {
         StudyCommand::DrillingCoverage(args) => drilling_coverage(args),
         StudyCommand::RinsProbe(args) => rins_probe(args),
-        StudyCommand::Lateral(args) => super::study_lateral::run(args),
+        StudyCommand::Lateral(args) => super::study_lateral::run(*args),
         StudyCommand::Merge(args) => super::study_lateral::merge(args),
     }
 }
