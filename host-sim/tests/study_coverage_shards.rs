@@ -133,7 +133,7 @@ fn four_coverage_shards_merged_equal_the_study_in_one_process() {
     let lateral = dir.join("lateral-shard.json");
     std::fs::write(
         &lateral,
-        r#"{"format": "host-sim lateral study shard", "version": 1}"#,
+        r#"{"format": "host-sim lateral study shard", "version": 2}"#,
     )
     .expect("written");
     let mut a = merge(&[1, 2, 3, 4]);

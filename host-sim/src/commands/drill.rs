@@ -39,6 +39,16 @@ pub struct Args {
     /// vertical: 1-D).
     #[arg(long, default_value_t = 0.95, value_parser = confidence)]
     pub confidence: f64,
+    /// The hole's tortuosity: RMS of each component (build, walk) of its
+    /// curvature's deviation from the plan, deg/30 m; 0 drills the plan
+    /// exactly (default: the plan's, else 1 deg/100 ft;
+    /// docs/drilling-simulation.md).
+    #[arg(long = "tortuosity", value_name = "DEG_PER_30M", value_parser = super::study_lateral::tortuosity)]
+    pub tortuosity_deg_per_30m: Option<f64>,
+    /// The tortuosity's correlation length along MD, m (default: the
+    /// plan's, else 10 m).
+    #[arg(long = "tortuosity-length", value_name = "M", value_parser = super::study_lateral::tortuosity_length)]
+    pub tortuosity_length_m: Option<f64>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -64,6 +74,8 @@ pub fn run(args: Args) -> Result<()> {
         out_dir: &args.out,
         seed: args.seed,
         confidence: args.confidence,
+        tortuosity_deg_per_30m: args.tortuosity_deg_per_30m,
+        tortuosity_length_m: args.tortuosity_length_m,
     })?;
     out!("{}", run.survey.report(args.confidence));
     outln!();

@@ -26,7 +26,8 @@ pub enum StudyCommand {
     /// 0.1 deg, position error under 1 m per 1000 m): seeded laterals by
     /// gyro grade, station azimuth and TD position errors against the
     /// predicted sigmas (docs/lateral-study.md).
-    Lateral(LateralArgs),
+    // boxed: its options are most of the enum's size
+    Lateral(Box<LateralArgs>),
     /// The outputs of a lateral or drilling-coverage study run in shards
     /// (`study lateral` or `study drilling-coverage` with `--shard K/N
     /// --shard-file FILE`, K = 1..N): the same tables and files as the
@@ -48,7 +49,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
     match cmd {
         StudyCommand::DrillingCoverage(args) => super::study_coverage::run(args),
         StudyCommand::RinsProbe(args) => rins_probe(args),
-        StudyCommand::Lateral(args) => super::study_lateral::run(args),
+        StudyCommand::Lateral(args) => super::study_lateral::run(*args),
         StudyCommand::Merge(args) => merge(args),
         StudyCommand::GradeTable(args) => super::study_grade_table::run(args),
     }

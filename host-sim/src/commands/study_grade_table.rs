@@ -114,6 +114,9 @@ impl GradeTableArgs {
             rop_m_per_h: self.rop_m_per_h.map(exact_text),
             stand_length_m: None,
             connection_still_s: self.connection_still_s.map(exact_text),
+            // the wells' own (each run drills its own hole around the plan)
+            tortuosity_deg_per_30m: None,
+            tortuosity_length_m: None,
             tie_in_azimuth_sigma_deg: exact_text(TIE_IN_AZIMUTH_SIGMA_DEG),
             runs,
             first_seed: self.seeds.first_seed,

@@ -44,6 +44,20 @@ pub(super) fn connection_still(text: &str) -> Result<f64, String> {
     number_in(text, "the still time at connections", (0.0, 86_400.0), "s")
 }
 
+/// The tortuosity's ranges (`sim::plan::Tortuosity`), shared with `drill`.
+pub fn tortuosity(text: &str) -> Result<f64, String> {
+    number_in(text, "the tortuosity", (0.0, 10.0), "deg/30 m")
+}
+
+pub fn tortuosity_length(text: &str) -> Result<f64, String> {
+    number_in(
+        text,
+        "the tortuosity's correlation length",
+        (1.0, 1000.0),
+        "m",
+    )
+}
+
 #[derive(clap::Args, Debug)]
 pub struct LateralArgs {
     /// Gyro grades by name (default: all built-in ones and those of
@@ -74,6 +88,16 @@ pub struct LateralArgs {
     /// Still time at each connection, s (default: the plan's).
     #[arg(long = "connection-still", value_parser = connection_still)]
     pub connection_still_s: Option<f64>,
+    /// The hole's tortuosity: RMS of each component (build, walk) of its
+    /// curvature's deviation from the plan, deg/30 m; 0 drills the plan
+    /// exactly (default: the plan's, else 1 deg/100 ft;
+    /// docs/drilling-simulation.md).
+    #[arg(long = "tortuosity", value_name = "DEG_PER_30M", value_parser = tortuosity)]
+    pub tortuosity_deg_per_30m: Option<f64>,
+    /// The tortuosity's correlation length along MD, m (default: the
+    /// plan's, else 10 m).
+    #[arg(long = "tortuosity-length", value_name = "M", value_parser = tortuosity_length)]
+    pub tortuosity_length_m: Option<f64>,
     /// 1-sigma of the parent well's azimuth at the tie-in, deg.
     #[arg(long = "tie-in-azimuth-sigma", alias = "tie-in-azimuth-sigma-deg", default_value_t = 0.5, value_parser = azimuth_sigma_deg)]
     pub tie_in_azimuth_sigma_deg: f64,
@@ -257,6 +281,8 @@ fn spec(args: &LateralArgs) -> Result<StudySpec> {
         rop_m_per_h: args.rop_m_per_h,
         stand_length_m: args.stand_length_m,
         connection_still_s: args.connection_still_s,
+        tortuosity_deg_per_30m: args.tortuosity_deg_per_30m,
+        tortuosity_length_m: args.tortuosity_length_m,
     };
     let text = |v: Option<f64>| v.map(exact_text);
     Ok(StudySpec {
@@ -266,6 +292,8 @@ fn spec(args: &LateralArgs) -> Result<StudySpec> {
         rop_m_per_h: text(args.rop_m_per_h),
         stand_length_m: text(args.stand_length_m),
         connection_still_s: text(args.connection_still_s),
+        tortuosity_deg_per_30m: text(args.tortuosity_deg_per_30m),
+        tortuosity_length_m: text(args.tortuosity_length_m),
         tie_in_azimuth_sigma_deg: exact_text(args.tie_in_azimuth_sigma_deg),
         runs: args.runs as usize,
         first_seed: args.seeds.first_seed,

@@ -3,11 +3,13 @@
 //! period at the connection and an orienter turn; a final still period;
 //! the sliding toolface steps and the shocks drawn from the seed) and the
 //! truth at any instant ([`Truth`]): MD from the schedule, direction and
-//! position at that MD from the plan's minimum-curvature arcs, the gravity
-//! toolface the section's plus the orienter's steps, and C_b^n from them.
-//! Also the surface depth log over the run.
+//! position at that MD on the hole as drilled (the plan's minimum-curvature
+//! arcs with the run's tortuosity drawn around them,
+//! [`DrilledPath`]), the gravity toolface the plan's section's plus the
+//! orienter's steps, and C_b^n from them. Also the surface depth log over
+//! the run.
 use super::phase::{toward_section, Connection, DrillState, Phase, PhaseKind, Ramp};
-use crate::sim::plan::{BuiltPlan, PathPoint};
+use crate::sim::plan::{BuiltPlan, DrilledPath, PathPoint};
 use core::f64::consts::FRAC_PI_2;
 use mwd_core::conventions::{dcm_from_euler, euler_from_dcm, wrap_pi, Euler, DEG};
 use mwd_core::earth::Position;
@@ -54,6 +56,8 @@ impl Truth {
 #[derive(Clone, Debug)]
 pub struct Drilling {
     plan: BuiltPlan,
+    /// The hole as drilled; `None`: the plan's own arcs (no tortuosity).
+    hole: Option<DrilledPath>,
     phases: Vec<Phase>,
     /// Orienter steps (connections and sliding), and the offset before
     /// each.
@@ -70,7 +74,8 @@ pub struct Drilling {
 
 impl Drilling {
     /// The schedule of `plan`; `seed` draws the toolface steps' signs, the
-    /// sliding steps' and the shocks' times.
+    /// sliding steps' and the shocks' times, and (from a stream of its
+    /// own) the hole's tortuosity.
     pub fn new(plan: BuiltPlan, seed: u64) -> Self {
         let p = plan.drilling;
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5EED_D811_0000_0001);
@@ -168,8 +173,10 @@ impl Drilling {
             }
         }
         let duration = t;
+        let hole = DrilledPath::draw(&plan, seed);
         let mut sim = Self {
             plan,
+            hole,
             phases,
             steps,
             offsets,
@@ -260,6 +267,15 @@ impl Drilling {
         &self.plan
     }
 
+    /// The hole as drilled at `md` (clamped to the plan's MD range): the
+    /// plan's arcs with this run's tortuosity; the plan's section there.
+    pub fn hole_at(&self, md: f64) -> PathPoint {
+        match &self.hole {
+            Some(hole) => hole.at(md),
+            None => self.plan.at(md),
+        }
+    }
+
     /// Length of the whole run (s).
     pub fn duration(&self) -> f64 {
         self.duration
@@ -320,8 +336,11 @@ impl Drilling {
         if state == DrillState::Still && self.boundary_turning(t, t) {
             state = DrillState::Connection;
         }
-        let point = self.plan.at(md);
-        let toolface = wrap_pi(self.plan.section_toolface(&point) + self.toolface_offset(t));
+        // the driller sets the plan's toolface; the hole wanders around
+        // the plan whatever it is (docs/drilling-simulation.md)
+        let planned = self.plan.at(md);
+        let point = self.hole.as_ref().map_or(planned, |hole| hole.at(md));
+        let toolface = wrap_pi(self.plan.section_toolface(&planned) + self.toolface_offset(t));
         let c_bn = dcm_from_euler(&Euler::new(
             toolface,
             point.inclination - FRAC_PI_2,
@@ -378,7 +397,7 @@ impl Drilling {
         (0..=n).map(move |i| {
             let t = i as f64 * step;
             let (md, ..) = self.kinematics(t);
-            let tvd = self.plan.at(md).nev.z;
+            let tvd = self.hole_at(md).nev.z;
             (t, self.logged_md(md, tvd))
         })
     }
@@ -454,7 +473,8 @@ mod tests {
             );
             // The orienter's steps stay around the section's toolface.
             if !sim.boundary_turning(t, t) {
-                let off = wrap_pi(now.toolface - sim.plan().section_toolface(&now.point));
+                let planned = sim.plan().at(now.md);
+                let off = wrap_pi(now.toolface - sim.plan().section_toolface(&planned));
                 assert!(off.abs() <= 30.0 * DEG + 1e-9, "{} deg off", off / DEG);
             }
             prev = now;
@@ -485,6 +505,31 @@ mod tests {
             t += dt;
         }
         assert!(turning_at_rest > 10, "{turning_at_rest}");
+    }
+
+    #[test]
+    fn zero_tortuosity_drills_the_plan_exactly_and_two_seeds_two_holes() {
+        let mut straight = hold_then_curve(3010.0, 20.0, 14.0);
+        straight.drilling.tortuosity = crate::sim::plan::Tortuosity::NONE;
+        let sim = Drilling::new(straight.build().expect("valid"), 3);
+        let mut t = 0.0;
+        while t < sim.duration() {
+            let truth = sim.truth(t);
+            assert_eq!(truth.point, sim.plan().at(truth.md), "at {t} s");
+            t += 7.3;
+        }
+        // the default tortuosity: each seed its own hole, the same MD and
+        // schedule, the toolface the plan's section's
+        let (a, b) = (Drilling::new(plan(), 3), Drilling::new(plan(), 4));
+        let end = a.duration();
+        let (ta, tb) = (a.truth(end), b.truth(end));
+        assert_eq!(ta.md, tb.md);
+        assert!((ta.point.nev - tb.point.nev).norm() > 1e-3);
+        assert!((ta.point.nev - a.plan().at(ta.md).nev).norm() > 1e-3);
+        assert_eq!(ta, Drilling::new(plan(), 3).truth(end));
+        // the depth log follows the drilled hole's TVD
+        let (_, logged) = a.depth_log().last().expect("a log");
+        assert_eq!(logged, a.logged_md(ta.md, ta.point.nev.z));
     }
 
     #[test]

@@ -41,7 +41,7 @@ pub struct BuiltPlan {
 /// a simulated run reads the plan twice per sample (each arc's dogleg and
 /// tangents cost a dozen transcendental calls).
 #[derive(Clone, Copy, Debug)]
-struct SectionArc {
+pub(super) struct SectionArc {
     /// `None` if the stations form no segment (`build` rules it out).
     segment: Option<Segment<TrueNorth>>,
     curvature: f64,
@@ -49,7 +49,7 @@ struct SectionArc {
 }
 
 impl SectionArc {
-    fn new(from: TrueStation, to: TrueStation) -> Self {
+    pub(super) fn new(from: TrueStation, to: TrueStation) -> Self {
         match Segment::new(from, to) {
             Ok(segment) => {
                 let cross = segment.start_tangent().cross(&segment.end_tangent());
@@ -69,6 +69,30 @@ impl SectionArc {
                 curvature: 0.0,
                 axis: Vector3::zeros(),
             },
+        }
+    }
+
+    /// The hole at `md` (within the arc) on this arc from `from`, whose
+    /// position is `base`; `section` the plan's section there.
+    pub(super) fn point(
+        &self,
+        from: TrueStation,
+        base: Vector3<f64>,
+        md: f64,
+        section: usize,
+    ) -> PathPoint {
+        let (station, chord) = self
+            .segment
+            .and_then(|seg| seg.at(md).ok())
+            .unwrap_or((from, Vector3::zeros()));
+        PathPoint {
+            md,
+            inclination: station.inclination(),
+            azimuth: station.azimuth(),
+            nev: base + chord,
+            curvature: self.curvature,
+            axis: self.axis,
+            section,
         }
     }
 }
@@ -174,23 +198,7 @@ impl BuiltPlan {
     pub fn at_in_section(&self, md: f64, k: usize) -> PathPoint {
         let k = k.min(self.sections.len() - 1);
         let md = md.clamp(self.sections[k].start_md, self.sections[k].end_md);
-        let from = self.stations[k];
-        let base = self.points[k].nev;
-        let arc = &self.arcs[k];
-        let (station, chord) = arc
-            .segment
-            .and_then(|seg| seg.at(md).ok())
-            .unwrap_or((from, Vector3::zeros()));
-        let (curvature, axis) = (arc.curvature, arc.axis);
-        PathPoint {
-            md,
-            inclination: station.inclination(),
-            azimuth: station.azimuth(),
-            nev: base + chord,
-            curvature,
-            axis,
-            section: k,
-        }
+        self.arcs[k].point(self.stations[k], self.points[k].nev, md, k)
     }
 
     /// The plan's own interpolation (`mwd_core::survey::interpolate`), for

@@ -8,13 +8,16 @@
 //!
 //! Files: `file` (the plan file and its checks, the sections built into
 //! stations), `drilling_params` (the drilling parameters, vibration and
-//! depth errors), `built` (the built plan: arcs, and the hole at any MD).
+//! depth errors), `built` (the built plan: arcs, and the hole at any MD),
+//! `tortuosity` (the hole as drilled around the plan, drawn per run).
 mod built;
 mod drilling_params;
 mod file;
 #[cfg(test)]
 mod tests;
+mod tortuosity;
 
 pub use built::{BuiltPlan, BuiltSection, PathPoint};
-pub use drilling_params::{DepthErrors, DrillingParams, Vibration};
+pub use drilling_params::{DepthErrors, DrillingParams, Tortuosity, Vibration};
 pub use file::{Plan, Section, Site, TieOnSpec, MAX_DLS_DEG_PER_30M, MAX_PLAN_LENGTH_M};
+pub use tortuosity::{CurvatureWalk, DrilledPath};

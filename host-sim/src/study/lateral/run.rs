@@ -58,6 +58,8 @@ pub struct WellInfo {
     pub rop_m_per_h: f64,
     pub stand_length_m: f64,
     pub connection_still_s: f64,
+    /// The hole's tortuosity (`drilling.tortuosity`).
+    pub tortuosity: crate::sim::plan::Tortuosity,
 }
 
 /// The study's results.
@@ -346,6 +348,7 @@ impl<'a> StudyJobs<'a> {
                     rop_m_per_h: w.plan.drilling.rop_m_per_h,
                     stand_length_m: w.plan.drilling.stand_length_m,
                     connection_still_s: w.plan.drilling.connection_still_s,
+                    tortuosity: w.plan.drilling.tortuosity,
                 })
                 .collect(),
             summaries,

@@ -54,6 +54,8 @@ pub struct StudySpec {
     pub rop_m_per_h: Option<String>,
     pub stand_length_m: Option<String>,
     pub connection_still_s: Option<String>,
+    pub tortuosity_deg_per_30m: Option<String>,
+    pub tortuosity_length_m: Option<String>,
     pub tie_in_azimuth_sigma_deg: String,
     pub runs: usize,
     pub first_seed: u64,
@@ -71,6 +73,11 @@ impl StudySpec {
             rop_m_per_h: read(&self.rop_m_per_h, "the rate of penetration")?,
             stand_length_m: read(&self.stand_length_m, "the stand length")?,
             connection_still_s: read(&self.connection_still_s, "the connection still time")?,
+            tortuosity_deg_per_30m: read(&self.tortuosity_deg_per_30m, "the tortuosity")?,
+            tortuosity_length_m: read(
+                &self.tortuosity_length_m,
+                "the tortuosity's correlation length",
+            )?,
         })
     }
 

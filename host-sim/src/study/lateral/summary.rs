@@ -52,6 +52,10 @@ pub struct TdSummary {
     /// predicted 1-sigma (RMS of sqrt(trace)).
     pub method_rms_error_m: Option<f64>,
     pub method_predicted_1_sigma_m: Option<f64>,
+    /// The runs whose method error lies inside the 95 % ellipse of the
+    /// method's terms alone: each run drills its own hole (its tortuosity,
+    /// docs/drilling-simulation.md), so this checks XCLA and XCLH.
+    pub method_inside_95_ellipse: Fraction,
 }
 
 /// The TD statistics without the survey method: the sensors' and the
@@ -233,7 +237,7 @@ pub fn summarise(
     let mut td_inside = 0;
     // the split: (errors, sigmas, inside) without the method; the method's
     let (mut sensor_err, mut sensor_sigma, mut sensor_inside) = (Vec::new(), Vec::new(), 0);
-    let (mut method_err, mut method_sigma) = (Vec::new(), Vec::new());
+    let (mut method_err, mut method_sigma, mut method_inside) = (Vec::new(), Vec::new(), 0);
     let k2 = scale_2d(0.95).powi(2);
     let mut unchecked: BTreeMap<String, usize> = BTreeMap::new();
     let mut by_station: BTreeMap<u16, Tally> = BTreeMap::new();
@@ -297,6 +301,7 @@ pub fn summarise(
                     let own = t.method_only(m);
                     method_err.push(own.error_horizontal());
                     method_sigma.push(own.sigma_horizontal());
+                    method_inside += usize::from(own.mahalanobis2().is_some_and(|d| d <= k2));
                 }
             }
             (None, _) => *unchecked.entry(o.td_unchecked_kind()).or_default() += 1,
@@ -326,6 +331,7 @@ pub fn summarise(
         },
         method_rms_error_m: rms(&method_err),
         method_predicted_1_sigma_m: rms(&method_sigma),
+        method_inside_95_ellipse: Fraction::of(method_inside, method_err.len()),
     };
     s.azimuth_correlation = azimuth_lag_correlations(outcomes(results));
     let by_number;
@@ -529,6 +535,23 @@ mod tests {
             (3, 2)
         );
         assert_eq!(s.azimuth_within_2_sigma.total, 2, "the determined ones");
+    }
+
+    #[test]
+    fn the_methods_own_error_is_checked_against_its_terms_ellipse() {
+        // the method's terms 1 m^2 north and east: 0.5 m north is inside
+        // (d2 0.25), 3 m north outside (d2 9 > 5.991)
+        let run = |seed, north| {
+            let mut o = outcome(seed, [0.0, 0.0], 0.1);
+            o.method_td_error_ne = Some([north, 0.0]);
+            if let Some(t) = o.td.as_mut() {
+                t.method_cov_ne = [1.0, 1.0, 0.0];
+            }
+            (seed, Ok(o))
+        };
+        let s = summarise("g", "w", 100.0, &[run(1, 0.5), run(2, 3.0)]);
+        let f = &s.td.method_inside_95_ellipse;
+        assert_eq!((f.inside, f.total), (1, 2));
     }
 
     #[test]

@@ -27,6 +27,9 @@ pub struct DrillingOverrides {
     pub rop_m_per_h: Option<f64>,
     pub stand_length_m: Option<f64>,
     pub connection_still_s: Option<f64>,
+    /// The hole's tortuosity: RMS (deg/30 m) and correlation length (m).
+    pub tortuosity_deg_per_30m: Option<f64>,
+    pub tortuosity_length_m: Option<f64>,
 }
 
 /// A well of the study.
@@ -57,6 +60,10 @@ impl Well {
         if let Some(v) = overrides.connection_still_s {
             d.connection_still_s = v;
         }
+        d.tortuosity = d.tortuosity.overridden(
+            overrides.tortuosity_deg_per_30m,
+            overrides.tortuosity_length_m,
+        );
         let plan = plan.build().with_context(|| {
             format!("{label}: invalid plan (with the command line's drilling parameters)")
         })?;
@@ -111,6 +118,21 @@ mod tests {
         };
         let e = format!("{:#}", Well::builtin("100m", &bad).unwrap_err());
         assert!(e.contains("drilling.stand_length_m"), "{e}");
+        let straight = DrillingOverrides {
+            tortuosity_deg_per_30m: Some(0.0),
+            ..none
+        };
+        let plan = Well::builtin("100m", &straight).expect("ok").plan;
+        assert_eq!(plan.drilling.tortuosity.rms_deg_per_30m, 0.0);
+        let bad = DrillingOverrides {
+            tortuosity_length_m: Some(0.0),
+            ..none
+        };
+        let e = format!("{:#}", Well::builtin("100m", &bad).unwrap_err());
+        assert!(
+            e.contains("drilling.tortuosity.correlation_length_m"),
+            "{e}"
+        );
         assert!(Well::builtin("10km", &none).is_err());
     }
 }

@@ -42,6 +42,10 @@ pub struct SimulatedRunInputs<'a> {
     pub seed: u64,
     /// Probability held by the ellipses.
     pub confidence: f64,
+    /// The hole's tortuosity instead of the plan's: RMS (deg/30 m) and
+    /// correlation length (m), each optional.
+    pub tortuosity_deg_per_30m: Option<f64>,
+    pub tortuosity_length_m: Option<f64>,
 }
 
 /// The run: its survey, the truth checks and the files written.
@@ -71,6 +75,10 @@ impl SimulatedRun {
             plan.tie_on.east_m -= e[1];
             plan.tie_on.tvd_m -= e[2];
         }
+        plan.drilling.tortuosity = plan
+            .drilling
+            .tortuosity
+            .overridden(inputs.tortuosity_deg_per_30m, inputs.tortuosity_length_m);
         let plan = plan
             .build()
             .with_context(|| format!("{}: invalid plan", plan_path.display()))?;

@@ -182,13 +182,12 @@ fn check(
     }
 }
 
-/// The drilled hole's (north, east, TVD) at `md`: the plan (the simulator
-/// drills it exactly), held straight beyond its end (the bit ahead of a
-/// sensor at the plan's end).
+/// The drilled hole's (north, east, TVD) at `md`: the hole as drilled
+/// (the plan with the run's tortuosity), held straight beyond its end (the
+/// bit ahead of a sensor at the plan's end).
 fn along_hole(drilling: &Drilling, md: f64) -> Vector3<f64> {
-    let plan = drilling.plan();
-    let end = plan.end_md();
-    let p = plan.at(md.min(end));
+    let end = drilling.plan().end_md();
+    let p = drilling.hole_at(md.min(end));
     let beyond = (md - end).max(0.0);
     let (si, ci) = p.inclination.sin_cos();
     let (sa, ca) = p.azimuth.sin_cos();
