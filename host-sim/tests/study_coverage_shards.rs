@@ -6,15 +6,8 @@
 //! among them and the lateral study's outputs.
 mod common;
 
-use common::{plan, refused, run, s, scratch};
+use common::{plan, read, refused, run, s, scratch, succeeded};
 use std::path::Path;
-
-fn host_sim(args: &[String]) -> common::Run {
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = run(&args);
-    assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
-    out
-}
 
 /// The table without its wall time (the only figure two processes of one
 /// study print differently).
@@ -31,10 +24,6 @@ fn untimed_json(text: &str) -> String {
         .filter(|l| !l.trim_start().starts_with("\"wall_s\":"))
         .collect::<Vec<_>>()
         .join("\n")
-}
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 /// The 100 m lateral drilled fast (500 m/h, 2 min connections): a run in
@@ -68,7 +57,7 @@ fn four_coverage_shards_merged_equal_the_study_in_one_process() {
     .to_vec();
     let threads = |n: usize| vec!["--threads".to_string(), n.to_string()];
     let single_json = dir.join("single.json");
-    let one = host_sim(
+    let one = succeeded(
         &[
             study.clone(),
             threads(2),
@@ -87,7 +76,7 @@ fn four_coverage_shards_merged_equal_the_study_in_one_process() {
             "--shard-file".into(),
             s(&shard(k)).into(),
         ]);
-        let out = host_sim(&args);
+        let out = succeeded(&args);
         let said = format!("drilling coverage shard {k}/4: 1 of the study's 4 runs");
         assert!(out.stdout.contains(&said), "{}", out.stdout);
     }
@@ -97,7 +86,7 @@ fn four_coverage_shards_merged_equal_the_study_in_one_process() {
         a
     };
     let merged_json = dir.join("merged.json");
-    let together = host_sim(
+    let together = succeeded(
         &[
             merge(&[3, 1, 4, 2]),
             vec!["--json".into(), s(&merged_json).into()],

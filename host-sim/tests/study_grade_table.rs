@@ -6,15 +6,11 @@
 //! the study, leaves the README as it was and no CSV.
 mod common;
 
-use common::{refused, run, s, scratch};
+use common::{read, refused, run, s, scratch};
 use std::path::Path;
 
 const BEGIN: &str = "<!-- grade-table: begin";
 const END: &str = "<!-- grade-table: end -->";
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
 
 /// The text before the begin marker and after the end marker.
 fn outside(text: &str) -> (String, String) {

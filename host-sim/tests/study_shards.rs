@@ -6,7 +6,7 @@
 //! not a shard.
 mod common;
 
-use common::{refused, run, s, scratch};
+use common::{read, refused, run, s, scratch, succeeded};
 use std::path::Path;
 
 /// The JSON keys and CSV columns that hold a time or a speed: the only
@@ -52,13 +52,6 @@ fn outputs(dir: &Path) -> Vec<String> {
     .iter()
     .flat_map(|(flag, name)| [flag.to_string(), s(&dir.join(name)).to_string()])
     .collect()
-}
-
-fn host_sim(args: &[String]) -> common::Run {
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = run(&args);
-    assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
-    out
 }
 
 /// The standard output without its timings: the first line's wall time,
@@ -122,10 +115,6 @@ fn untimed_csv(text: &str) -> String {
     out.join("\n")
 }
 
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
 #[test]
 fn four_shards_merged_equal_the_study_in_one_process() {
     let dir = scratch("study-shards", "merge");
@@ -135,7 +124,7 @@ fn four_shards_merged_equal_the_study_in_one_process() {
     }
     let study: Vec<String> = STUDY.iter().map(|a| a.to_string()).collect();
     let threads = |n: usize| vec!["--threads".to_string(), n.to_string()];
-    let one = host_sim(&[study.clone(), threads(2), outputs(&single)].concat());
+    let one = succeeded(&[study.clone(), threads(2), outputs(&single)].concat());
     let shard = |k: usize| dir.join(format!("shard-{k}.json"));
     for k in 1..=4 {
         // a shard's threads are its own: they change no result
@@ -146,7 +135,7 @@ fn four_shards_merged_equal_the_study_in_one_process() {
             "--shard-file".into(),
             s(&shard(k)).into(),
         ]);
-        let out = host_sim(&shard_args);
+        let out = succeeded(&shard_args);
         let mine = if k < 4 { 2 } else { 1 };
         let said = format!("shard {k}/4: {mine} of the study's 7 jobs");
         assert!(out.stdout.contains(&said), "{}", out.stdout);
@@ -154,7 +143,7 @@ fn four_shards_merged_equal_the_study_in_one_process() {
     // any order
     let mut merge: Vec<String> = vec!["study".into(), "merge".into()];
     merge.extend([3, 1, 4, 2].map(|k| s(&shard(k)).to_string()));
-    let together = host_sim(&[merge.clone(), outputs(&merged)].concat());
+    let together = succeeded(&[merge.clone(), outputs(&merged)].concat());
 
     // the figures' paths, which the plots' lines name, aside
     assert_eq!(

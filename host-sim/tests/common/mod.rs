@@ -25,6 +25,19 @@ pub fn run(args: &[&str]) -> Run {
     }
 }
 
+/// Runs `host-sim` with owned `args` and asserts it succeeded (exit 0).
+pub fn succeeded(args: &[String]) -> Run {
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = run(&args);
+    assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
+    out
+}
+
+/// A file the test reads whole, its path named if it cannot.
+pub fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// A fresh directory for one test: `<tag>-<pid>-<name>` in the temp dir.
 pub fn scratch(tag: &str, name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("{tag}-{}-{name}", std::process::id()));
