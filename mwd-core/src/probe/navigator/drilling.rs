@@ -74,10 +74,17 @@ impl<T: FilterScalar> Navigator<T> {
     /// attitude error is in the constraint's noise (the misalignment part,
     /// 0.5 m/s x 1 deg; derivation section 4d).
     pub(super) fn constrain_moving_tool(&mut self) {
-        let state = self.filter.state();
-        let mut cross = NonHolonomic::at(state, T::of(DRILLING_VARIANCE));
+        // The rows' axes at the attitude the error model is linearised
+        // at (the estimate's own but on a still tool past its station:
+        // `navigation_step`), so that every Jacobian sits at one point
+        // (derivation section 4e).
+        let state = NavState {
+            attitude: self.filter.linearization_attitude(),
+            ..*self.filter.state()
+        };
+        let mut cross = NonHolonomic::at(&state, T::of(DRILLING_VARIANCE));
         cross.attitude_row = [[T::zero(); 3]; 2];
-        let mut axial = AxialSpeed::at(state, T::of(AXIAL_SPEED_VARIANCE));
+        let mut axial = AxialSpeed::at(&state, T::of(AXIAL_SPEED_VARIANCE));
         axial.attitude_row = [T::zero(); 3];
         // One update: the axial bound's value was computed
         // at the solution before the cross-axis correction,

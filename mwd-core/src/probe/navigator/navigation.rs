@@ -145,12 +145,20 @@ impl<T: FilterScalar> Navigator<T> {
         // A still tool's attitude does not change: once the
         // station's first block has re-levelled it, the error model
         // stays linearised there instead of following each ZUPT's
-        // correction (derivation section 4i).
+        // correction (derivation section 4i). So past the longest
+        // station while the detector still sees a still tool: there
+        // the moving tool's constraints replace the ZUPTs, and a model
+        // that followed the estimate's heading noise (the vertical
+        // gyro's white noise, sample by sample) saw the constraints
+        // from ever new directions and read the tilt apart from the
+        // tool-axis accelerometer bias that it cannot see: the pitch
+        // drifted by ~15 mdeg/h past its sigma (derivation section 5c).
         let settled = still
-            && self
-                .station
-                .as_ref()
-                .is_some_and(|s| s.epochs >= SURVEY_SETTLE_EPOCHS);
+            && (self.station_capped
+                || self
+                    .station
+                    .as_ref()
+                    .is_some_and(|s| s.epochs >= SURVEY_SETTLE_EPOCHS));
         self.filter.fix_linearization(settled);
         let report = self.filter.step_with(imu, &extra);
         if drilling {
