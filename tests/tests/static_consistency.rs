@@ -21,9 +21,9 @@
 //! The test command runs 20 seeds of 2 h (past the first station the still
 //! probe navigates free under the moving tool's constraints; about 40 s in
 //! release), and gives the figures per 2 h from the start too. The
-//! day-long figures (past about ten hours the pitch does not yet hold:
-//! docs/filter-derivation.md section 5c; `STATIC_CONSISTENCY_SEEDS` sets
-//! the number of seeds):
+//! day-long figures (every state within 2 sigma in at least 99 % of the
+//! epochs of 20 seeds of 24 h: docs/filter-derivation.md section 5c;
+//! `STATIC_CONSISTENCY_SEEDS` sets the number of seeds):
 //! `STATIC_CONSISTENCY_HOURS=24 cargo test --release -p system-tests --test
 //! static_consistency -- --ignored --nocapture`.
 

@@ -57,7 +57,9 @@ impl<T: FilterScalar> Navigator<T> {
     /// deg and the pitch 4 mrad, against a 0.86 mrad sigma. Kept apart,
     /// the still probe's pitch held its error within 2 sigma in 96-99.7 %
     /// of the epochs of its first ten hours (78-94 % before), its roll in
-    /// 99.5-100 % (docs/filter-derivation.md section 5c). Nothing reported is
+    /// 99.5-100 % (docs/filter-derivation.md section 5c; the day's rest
+    /// came with the first-estimates linearisation past the longest
+    /// station, `navigation_step`). Nothing reported is
     /// lost: an undetermined heading is not reported until the next tie-in
     /// or alignment, which gives the heading afresh.
     pub(super) fn keep_undetermined_heading_apart(&mut self) {
