@@ -48,14 +48,14 @@ pub fn build_firmware(features: &str, name: &str) -> PathBuf {
 }
 
 /// As [`build_firmware`], for a run of `run_seconds` simulated seconds
-/// (`PROBE_QEMU_RUN_SECONDS`, compiled in) when given: such builds get a
-/// directory of their own, so the default builds are not redone each time.
+/// (`PROBE_QEMU_RUN_SECONDS`, compiled in) when given. Every variant builds
+/// in one directory: the dependencies are cross-compiled once, and a
+/// variant rebuilds only the firmware crate (a directory per run length
+/// cross-compiled the whole dependency tree again, about half a minute of
+/// a 2-core CI machine each).
 pub fn build_firmware_for(features: &str, name: &str, run_seconds: Option<u32>) -> PathBuf {
     let _one_at_a_time = BUILD.lock().unwrap_or_else(|e| e.into_inner());
-    let target_dir = match run_seconds {
-        Some(s) => sub_target_dir(&format!("qemu-probe-{s}s")),
-        None => sub_target_dir("qemu-probe"),
-    };
+    let target_dir = sub_target_dir("qemu-probe");
     let mut command = cargo();
     command
         .args([
@@ -82,14 +82,32 @@ pub fn build_firmware_for(features: &str, name: &str, run_seconds: Option<u32>) 
          `rustup target add {TARGET}`)"
     );
     let built = target_dir.join(TARGET).join("probe").join("probe-qemu");
-    let elf = target_dir.join(format!("probe-qemu-{name}.elf"));
+    let length = run_seconds.map(|s| format!("-{s}s")).unwrap_or_default();
+    let elf = target_dir.join(format!("probe-qemu-{name}{length}.elf"));
     std::fs::copy(&built, &elf).expect("copy the firmware binary");
     elf
 }
 
+/// The variable naming a `host-sim` binary already built from this
+/// workspace: the test command sets it to the one its `cargo test
+/// --workspace` builds for host-sim's own CLI tests, so the system tests
+/// do not build the host tool and its dependencies a second time (about
+/// 3 min of a cold 2-core CI machine).
+pub const HOST_SIM_BINARY_VARIABLE: &str = "SYSTEM_TESTS_HOST_SIM";
+
 /// Builds the `host-sim` command-line tool (a test of another package does
-/// not get it built by cargo) and returns its path.
+/// not get it built by cargo) and returns its path; or the binary named by
+/// [`HOST_SIM_BINARY_VARIABLE`], which must exist.
 pub fn build_host_sim() -> PathBuf {
+    if let Some(given) = std::env::var_os(HOST_SIM_BINARY_VARIABLE) {
+        let path = PathBuf::from(given);
+        assert!(
+            path.is_file(),
+            "{HOST_SIM_BINARY_VARIABLE}={} is not a file",
+            path.display()
+        );
+        return path;
+    }
     let _one_at_a_time = BUILD.lock().unwrap_or_else(|e| e.into_inner());
     let target_dir = sub_target_dir("host-tool");
     let status = cargo()
