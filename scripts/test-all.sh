@@ -59,15 +59,19 @@ SYSTEM_TESTS_HOST_SIM="$PWD/target/debug/host-sim" cargo test --workspace
 # 2 sigma in at least 93 % of epochs; uncalibrated, every frame flagged.
 # Coarse alignment: determined headings covered by their bound in every
 # attitude class (19,200 seeded runs; release).
-# One command, so the release builds of the four run as one build.
+# One command, so the release builds of the four run as one build (the
+# alignment's single-class look, for a closer look by hand, is skipped).
 cargo test --release -p mwd-core -p system-tests --test filter_long_run \
-  --test navigator_long_run --test static_consistency --test alignment_classes -- --ignored
+  --test navigator_long_run --test static_consistency --test alignment_classes -- --ignored \
+  --skip determined_headings_are_covered_in_one_class
 # A day of the calibrated still probe, 4 seeds (about 40 s): what the 2 h
 # runs cannot see, a sigma that holds for hours and then not (the pitch
 # once drifted past its sigma after about ten hours). The 20-seed day is
 # measured with the command in docs/filter-derivation.md section 5c.
-STATIC_CONSISTENCY_HOURS=24 STATIC_CONSISTENCY_SEEDS=4 cargo test --release -p system-tests \
-  --test static_consistency -- --ignored a_calibrated_probe
+# (The same packages as above: another selection unifies the
+# dependencies' features differently and builds them all again.)
+STATIC_CONSISTENCY_HOURS=24 STATIC_CONSISTENCY_SEEDS=4 cargo test --release -p mwd-core \
+  -p system-tests --test static_consistency -- --ignored a_calibrated_probe
 # The bad-input matrix: host-sim over 138 bad files and arguments (and good
 # controls); fails on any panic, silent acceptance or flood of stderr. The
 # binary is the one `cargo test` built for host-sim's own CLI tests (a

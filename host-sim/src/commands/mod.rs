@@ -34,6 +34,7 @@ pub(crate) mod status;
 mod study;
 mod study_coverage;
 mod study_grade_table;
+mod study_indexing;
 mod study_lateral;
 mod survey;
 mod survey_capture;

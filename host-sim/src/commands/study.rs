@@ -39,10 +39,15 @@ pub enum StudyCommand {
     /// and in docs/results/grade-table.csv (nothing written unless every
     /// run succeeded).
     GradeTable(GradeTableArgs),
+    /// Toolface indexing at a connection: the azimuth a still probe
+    /// re-finds when its still time is split into dwells with the toolface
+    /// turned between them, by gyro grade, against its printed sigma.
+    Indexing(IndexingArgs),
 }
 
 pub use super::study_coverage::CoverageArgs;
 pub use super::study_grade_table::GradeTableArgs;
+pub use super::study_indexing::IndexingArgs;
 pub use super::study_lateral::{LateralArgs, MergeArgs};
 
 pub fn run(cmd: StudyCommand) -> Result<()> {
@@ -52,6 +57,7 @@ pub fn run(cmd: StudyCommand) -> Result<()> {
         StudyCommand::Lateral(args) => super::study_lateral::run(*args),
         StudyCommand::Merge(args) => merge(args),
         StudyCommand::GradeTable(args) => super::study_grade_table::run(args),
+        StudyCommand::Indexing(args) => super::study_indexing::run(args),
     }
 }
 

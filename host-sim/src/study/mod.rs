@@ -4,6 +4,7 @@ pub mod coverage_shard;
 pub mod drilling_coverage;
 pub mod drilling_run;
 pub mod grade;
+pub mod indexing;
 pub mod lateral;
 pub mod owsg;
 pub mod rins_probe;
