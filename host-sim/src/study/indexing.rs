@@ -209,7 +209,7 @@ pub fn summarize(
 /// 2 sigma ("-" where no run was determined: no number to give).
 pub fn table(summaries: &[IndexingSummary]) -> String {
     let mut text = String::from(
-        "grade           dwells  turned  determined  azimuth RMS (deg)  median sigma (deg)  within 2 sigma  failed\n",
+        "grade           dwells   turned  determined  azimuth RMS (deg)  median sigma (deg)  within 2 sigma  failed\n",
     );
     let number =
         |v: Option<f64>, digits: usize| v.map_or("-".to_string(), |v| format!("{v:.digits$}"));
@@ -220,7 +220,7 @@ pub fn table(summaries: &[IndexingSummary]) -> String {
             "-".to_string()
         };
         text.push_str(&format!(
-            "{:<15} {:>6}  {:>6}  {:>10}  {:>17}  {:>18}  {:>14}  {:>6}\n",
+            "{:<15} {:>6}  {:>7}  {:>10}  {:>17}  {:>18}  {:>14}  {:>6}\n",
             s.grade,
             s.positions,
             turned,
