@@ -6,9 +6,8 @@
 use super::segments::{AlignmentConfig, MeanSigmas, StaticSegment, MAX_SEGMENTS};
 use crate::attitude::level;
 use crate::conventions::{dcm_from_euler, wrap_pi, Euler};
-use crate::earth::{earth_rate_n, EARTH_RATE};
+use crate::earth::earth_rate_n;
 use crate::probe_sample::GYRO_AXES;
-use crate::sensor_units::STANDARD_GRAVITY;
 use core::f64::consts::TAU;
 use nalgebra::{Matrix3, Vector3};
 
@@ -39,32 +38,6 @@ pub(super) struct Misfit<'a> {
     pub(super) weights: [[f64; 3]; MAX_SEGMENTS],
 }
 
-/// The variance (rad/s)^2 a segment's levelling error puts on each
-/// predicted gyro mean. The prediction resolves the earth rate through
-/// the levelled attitude, whose tilt is off by the accelerometers' error
-/// over g (the residual bias and the mean's noise, the larger axis's), and
-/// a tilt delta moves each predicted rate by at most EARTH_RATE delta per
-/// tilt axis. The heading's sigma already carries this through the
-/// accelerometer inputs (`heading_sigma`); the misfit's weights did not, so
-/// a quiet gyro (a navigation grade's 300 s mean is known to ~0.007 deg/h,
-/// while a 1 mg bias's tilt moves it by up to 0.015 deg/h) read a tilt
-/// error as heading information: a horizontal tool's two mirror headings,
-/// which only the unknown tilt tells apart, were called unambiguous and the
-/// wrong one printed with a 0.075 deg sigma (`host-sim study indexing`, the
-/// navigation grade, 1 run in 20), and near east or west the allowed
-/// interval was too narrow. For the SCC1300 it is 5e-5 of the noise's.
-fn levelling_rate_variance(config: &AlignmentConfig, accel_mean_sigma: &[f64; 3]) -> f64 {
-    let tilt_variance = config
-        .noise
-        .accel
-        .iter()
-        .zip(accel_mean_sigma)
-        .map(|(axis, mean)| axis.residual_bias * axis.residual_bias + mean * mean)
-        .fold(0.0, f64::max)
-        / (STANDARD_GRAVITY * STANDARD_GRAVITY);
-    2.0 * EARTH_RATE * EARTH_RATE * tilt_variance
-}
-
 impl<'a> Misfit<'a> {
     pub(super) fn new(
         segments: &'a [StaticSegment],
@@ -76,7 +49,7 @@ impl<'a> Misfit<'a> {
         for (i, seg) in segments.iter().take(MAX_SEGMENTS).enumerate() {
             let lev = level(&seg.mean.specific_force);
             levelled[i] = dcm_from_euler(&Euler::new(lev.roll, lev.pitch, 0.0));
-            let levelling = levelling_rate_variance(config, &sigmas.accel[i]);
+            let levelling = sigmas.levelling[i];
             for (weight, s) in weights[i].iter_mut().zip(sigmas.gyro[i]) {
                 // A noise-free axis still gets a finite weight so the
                 // misfit stays well defined.

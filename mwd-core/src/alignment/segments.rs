@@ -4,8 +4,10 @@
 //! besides ([`AlignmentConfig`]), and the checks that refuse them
 //! ([`AlignmentError`]).
 
+use crate::earth::EARTH_RATE;
 use crate::probe_sample::ProbeSample;
 use crate::sensor_noise::ImuNoise;
+use crate::sensor_units::STANDARD_GRAVITY;
 use nalgebra::Vector3;
 
 /// Most segments one alignment takes (toolface positions).
@@ -155,6 +157,10 @@ pub(super) fn check_all(segments: &[StaticSegment]) -> Result<(), AlignmentError
 pub(super) struct MeanSigmas {
     pub(super) accel: [[f64; 3]; MAX_SEGMENTS],
     pub(super) gyro: [[f64; 3]; MAX_SEGMENTS],
+    /// What each segment's levelling error adds to the variance of every
+    /// predicted gyro mean ([`levelling_rate_variance`]; the misfit's
+    /// weights take it).
+    pub(super) levelling: [f64; MAX_SEGMENTS],
 }
 
 impl MeanSigmas {
@@ -162,6 +168,7 @@ impl MeanSigmas {
         let mut table = Self {
             accel: [[0.0; 3]; MAX_SEGMENTS],
             gyro: [[0.0; 3]; MAX_SEGMENTS],
+            levelling: [0.0; MAX_SEGMENTS],
         };
         let dt = config.sample_interval;
         for (i, seg) in segments.iter().take(MAX_SEGMENTS).enumerate() {
@@ -169,7 +176,34 @@ impl MeanSigmas {
                 table.accel[i][axis] = config.noise.accel[axis].mean_sigma(seg.samples, dt);
                 table.gyro[i][axis] = config.noise.gyro[axis].mean_sigma(seg.samples, dt);
             }
+            table.levelling[i] = levelling_rate_variance(config, &table.accel[i]);
         }
         table
     }
+}
+
+/// The variance (rad/s)^2 a segment's levelling error puts on each
+/// predicted gyro mean. The prediction resolves the earth rate through
+/// the levelled attitude, whose tilt is off by the accelerometers' error
+/// over g (the residual bias and the mean's noise, the larger axis's), and
+/// a tilt delta moves each predicted rate by at most EARTH_RATE delta per
+/// tilt axis. The heading's sigma already carries this through the
+/// accelerometer inputs (`heading_sigma`); the misfit's weights did not, so
+/// a quiet gyro (a navigation grade's 300 s mean is known to ~0.007 deg/h,
+/// while a 1 mg bias's tilt moves it by up to 0.015 deg/h) read a tilt
+/// error as heading information: a horizontal tool's two mirror headings,
+/// which only the unknown tilt tells apart, were called unambiguous and the
+/// wrong one printed with a 0.075 deg sigma (`host-sim study indexing`, the
+/// navigation grade, 1 run in 20), and near east or west the allowed
+/// interval was too narrow. For the SCC1300 it is 5e-5 of the noise's.
+fn levelling_rate_variance(config: &AlignmentConfig, accel_mean_sigma: &[f64; 3]) -> f64 {
+    let tilt_variance = config
+        .noise
+        .accel
+        .iter()
+        .zip(accel_mean_sigma)
+        .map(|(axis, mean)| axis.residual_bias * axis.residual_bias + mean * mean)
+        .fold(0.0, f64::max)
+        / (STANDARD_GRAVITY * STANDARD_GRAVITY);
+    2.0 * EARTH_RATE * EARTH_RATE * tilt_variance
 }
