@@ -119,24 +119,15 @@ fn sweep(inclinations: &[f64], azimuths: &[f64], kinds: &[Kind], seeds: u64) -> 
                 .flat_map(move |&i| azimuths.iter().map(move |&a| (k, i, a)))
         })
         .collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let results = std::sync::Mutex::new(vec![None; classes.len()]);
+    // The study runner's pool: each thread takes the next class, the
+    // outcomes in class order.
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    std::thread::scope(|scope| {
-        for _ in 0..threads.min(classes.len()) {
-            scope.spawn(|| loop {
-                let c = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(kind, inclination, azimuth)) = classes.get(c) else {
-                    break;
-                };
-                let tally = class(inclination, azimuth, kind, seeds);
-                results.lock().unwrap()[c] = Some(tally);
-            });
-        }
+    let results = host_sim::study::run_seeds(classes.len(), 0, threads, &|| {}, |c| {
+        let (kind, inclination, azimuth) = classes[c as usize];
+        Ok(class(inclination, azimuth, kind, seeds))
     });
-    let results = results.into_inner().unwrap();
     let mut failures = Vec::new();
-    for (&(kind, inclination, azimuth), t) in classes.iter().zip(results) {
+    for (&(kind, inclination, azimuth), (_, t)) in classes.iter().zip(results) {
         let t = t.expect("every class ran");
         let line = format!(
             "{kind:?} incl {inclination} az {azimuth}: determined {} of {}, \
