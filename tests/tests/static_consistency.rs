@@ -27,7 +27,7 @@
 //! `STATIC_CONSISTENCY_HOURS=24 cargo test --release -p system-tests --test
 //! static_consistency -- --ignored --nocapture`.
 
-use host_sim::formats::capture::{raw_sample_from_si, SiSample};
+use host_sim::formats::capture::raw_sample_from_body;
 use host_sim::sim::{SensorModel, SensorSimulator, Trajectory};
 use mwd_core::calibration::ProbeCalibration;
 use mwd_core::conventions::{wrap_pi, DrillingAngles, Euler};
@@ -125,14 +125,7 @@ fn run(seed: u64, hours: f64, calibrated: bool) -> Run {
         flagged_uncalibrated: 0,
     };
     for (n, s) in (0..samples).zip(sim) {
-        let accel = [s.accel.x, s.accel.y, s.accel.z];
-        let raw = raw_sample_from_si(&SiSample {
-            index: n as u32,
-            gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
-            accel_body_m_s2: [accel, accel],
-            temperature_degc: 25.0,
-        });
-        let nav = navigator.step(&raw);
+        let nav = navigator.step(&raw_sample_from_body(n as u32, &s.gyro, &s.accel));
         out.frames += 1;
         if nav.flags & nav_flags::UNCALIBRATED != 0 {
             out.flagged_uncalibrated += 1;
@@ -330,13 +323,7 @@ fn the_vertical_gyros_noise_alone_does_not_walk_the_pitch() {
     let sim = SensorSimulator::new(trajectory, model, 1.0 / SAMPLE_RATE_HZ);
     let mut tied_in = false;
     for (n, s) in (0..20 * hour + 1).zip(sim) {
-        let accel = [s.accel.x, s.accel.y, s.accel.z];
-        let nav = navigator.step(&raw_sample_from_si(&SiSample {
-            index: n as u32,
-            gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
-            accel_body_m_s2: [accel, accel],
-            temperature_degc: 25.0,
-        }));
+        let nav = navigator.step(&raw_sample_from_body(n as u32, &s.gyro, &s.accel));
         if !tied_in && nav.mode == nav_mode::NAVIGATING {
             let given = DrillingAngles::from_euler(&s.truth);
             let sigma = DrillingAngles {

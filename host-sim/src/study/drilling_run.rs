@@ -9,7 +9,7 @@
 
 use super::grade::Grade;
 pub use super::run_checks::{PositionCheck, StationCheck, TdCheck};
-use crate::formats::capture::{raw_sample_from_si, SiSample};
+use crate::formats::capture::raw_sample_from_body;
 use crate::formats::depth_log::DepthLog;
 use crate::sim::{
     BuiltPlan, DeterministicErrors, DrillState, Drilling, DrillingSimulator, SensorErrors,
@@ -269,16 +269,11 @@ pub const TIE_IN_INCLINATION_SIGMA_DEG: f64 = 0.1;
 /// takes; the parent well's survey says nothing of the probe's toolface.
 pub const TIE_IN_TOOLFACE_SIGMA_DEG: f64 = 3.0;
 
-/// The raw frame of sample `index` of measured body rates and force (both
-/// parts' triads see the same force, as `capture::write_simulated_probe`).
+/// The raw frame of sample `index` of measured body rates and force
+/// ([`raw_sample_from_body`]).
 pub(crate) fn raw(index: usize, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> Result<RawSample> {
-    let force = [accel.x, accel.y, accel.z];
-    Ok(raw_sample_from_si(&SiSample {
-        index: u32::try_from(index).context("more than 2^32 samples")?,
-        gyro_body_xz_rad_s: [gyro.x, gyro.z],
-        accel_body_m_s2: [force, force],
-        temperature_degc: 25.0,
-    }))
+    let index = u32::try_from(index).context("more than 2^32 samples")?;
+    Ok(raw_sample_from_body(index, gyro, accel))
 }
 
 /// One measured sample into the navigator: the probe's raw frame for the

@@ -27,7 +27,8 @@ pub use memory::{
 pub use stream::{FrameStream, ProbeCaptureFile};
 pub use summary::CaptureSummary;
 pub use writer::{
-    create_capture, raw_sample_from_si, write_simulated_probe, CaptureWriter, ProbeSetup, SiSample,
+    create_capture, raw_sample_from_body, raw_sample_from_si, write_simulated_probe, CaptureWriter,
+    ProbeSetup, SiSample,
 };
 
 #[cfg(test)]

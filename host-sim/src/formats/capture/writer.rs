@@ -20,6 +20,7 @@ use mwd_core::sensor_units::{
     self, ACCEL_TEMPERATURE, GYRO_TEMPERATURE, PART_COUNT, PART_MOUNTINGS,
 };
 use mwd_core::timing::sample_time_us;
+use nalgebra::Vector3;
 
 use crate::formats::samples_csv::SimSample;
 
@@ -37,6 +38,20 @@ pub struct SiSample {
     pub accel_body_m_s2: [[f64; 3]; PART_COUNT],
     /// Temperature of both parts, degC.
     pub temperature_degc: f64,
+}
+
+/// The raw frame of sample `index` of measured body rates `gyro` (the x
+/// and z gyros sense theirs) and specific force `accel`: both parts'
+/// triads see the same force, both parts at 25 degC, as the simulator's
+/// probe ([`raw_sample_from_si`]).
+pub fn raw_sample_from_body(index: u32, gyro: &Vector3<f64>, accel: &Vector3<f64>) -> RawSample {
+    let force = [accel.x, accel.y, accel.z];
+    raw_sample_from_si(&SiSample {
+        index,
+        gyro_body_xz_rad_s: [gyro.x, gyro.z],
+        accel_body_m_s2: [force, force],
+        temperature_degc: 25.0,
+    })
 }
 
 /// Turns a simulated sample into the raw-sample frame the probe would send:
@@ -214,13 +229,8 @@ pub fn write_simulated_probe<W: Write>(
     for (index, s) in samples.into_iter().enumerate() {
         // Both parts' triads see the same body-frame specific force; the
         // encoder turns each into its part's axes and counts.
-        let accel = [s.accel.x, s.accel.y, s.accel.z];
-        let raw = raw_sample_from_si(&SiSample {
-            index: u32::try_from(index).context("more than 2^32 samples")?,
-            gyro_body_xz_rad_s: [s.gyro.x, s.gyro.z],
-            accel_body_m_s2: [accel, accel],
-            temperature_degc: 25.0,
-        });
+        let index = u32::try_from(index).context("more than 2^32 samples")?;
+        let raw = raw_sample_from_body(index, &s.gyro, &s.accel);
         capture.write(&Payload::Raw(raw))?;
         capture.write(&Payload::Nav(navigator.step(&raw)))?;
         // As the probe: a finished station after its cycle's navigation.
