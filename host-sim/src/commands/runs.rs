@@ -43,6 +43,28 @@ impl SeedsAndThreads {
     }
 }
 
+/// The gyro grades a study by grade runs: built-in ones by name, and
+/// grade files that add or replace one.
+#[derive(clap::Args, Debug, Clone)]
+pub struct GradeChoice {
+    /// Gyro grades by name (default: all built-in ones and those of
+    /// --grade-file): scc1300, high-end-mems, ge-mwd-2020, navigation.
+    #[arg(long, value_delimiter = ',')]
+    pub grades: Vec<String>,
+    /// A grade file (JSON, host-sim/data/grades/): adds a grade, or
+    /// replaces the built-in one of the same name. Repeatable.
+    #[arg(long = "grade-file")]
+    pub grade_files: Vec<std::path::PathBuf>,
+}
+
+impl GradeChoice {
+    /// The grades chosen, the files read and checked in the command
+    /// line's order (`host_sim::study::grade::select`).
+    pub fn select(&self) -> anyhow::Result<Vec<host_sim::study::grade::Grade>> {
+        host_sim::study::grade::select(&self.grades, &self.grade_files)
+    }
+}
+
 /// A study's results: `table` on standard output and, with `--json`, the
 /// results in that file.
 pub fn print_and_write_json<T: serde::Serialize>(

@@ -1,9 +1,10 @@
 //! `host-sim study indexing`'s command line ([`host_sim::study::indexing`]).
 
 use super::limits::number_in;
-use super::runs::{print_and_write_json, progress_bar, stop_on_ctrl_c, SeedsAndThreads};
+use super::runs::{
+    print_and_write_json, progress_bar, stop_on_ctrl_c, GradeChoice, SeedsAndThreads,
+};
 use anyhow::{bail, Result};
-use host_sim::study::grade;
 use host_sim::study::indexing::{indexed_station, summarize, table, IndexingSetup};
 use mwd_core::conventions::DEG;
 use mwd_core::earth::Position;
@@ -28,14 +29,8 @@ fn turn_rate_deg_s(text: &str) -> Result<f64, String> {
 
 #[derive(clap::Args, Debug)]
 pub struct IndexingArgs {
-    /// Gyro grades by name (default: all built-in ones and those of
-    /// --grade-file): scc1300, high-end-mems, ge-mwd-2020, navigation.
-    #[arg(long, value_delimiter = ',')]
-    pub grades: Vec<String>,
-    /// A grade file (JSON, host-sim/data/grades/): adds a grade, or
-    /// replaces the built-in one of the same name. Repeatable.
-    #[arg(long = "grade-file")]
-    pub grade_files: Vec<PathBuf>,
+    #[command(flatten)]
+    pub grade_choice: GradeChoice,
     /// Dwells per connection, each a study (1: no indexing; 2: 180 deg
     /// apart; 4: 90 deg apart).
     #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4],
@@ -70,7 +65,7 @@ pub struct IndexingArgs {
 }
 
 pub fn run(args: IndexingArgs) -> Result<()> {
-    let grades = grade::select(&args.grades, &args.grade_files)?;
+    let grades = args.grade_choice.select()?;
     let mut site = Position::paper_site();
     if let Some(lat) = args.latitude_deg {
         site.lat = lat * DEG;

@@ -3,7 +3,7 @@
 //! progress bar over every job, the tables, CSV and JSON.
 
 use super::limits::{azimuth_sigma_deg, number_in};
-use super::runs::{progress_bar, stop_on_ctrl_c, SeedsAndThreads};
+use super::runs::{progress_bar, stop_on_ctrl_c, GradeChoice, SeedsAndThreads};
 use anyhow::{Context, Result};
 use host_sim::formats::files::{write_json, write_text};
 use host_sim::formats::text_records::read_small_file;
@@ -60,14 +60,8 @@ pub fn tortuosity_length(text: &str) -> Result<f64, String> {
 
 #[derive(clap::Args, Debug)]
 pub struct LateralArgs {
-    /// Gyro grades by name (default: all built-in ones and those of
-    /// --grade-file): scc1300, high-end-mems, ge-mwd-2020, navigation.
-    #[arg(long, value_delimiter = ',')]
-    pub grades: Vec<String>,
-    /// A grade file (JSON, host-sim/data/grades/): adds a grade, or
-    /// replaces the built-in one of the same name. Repeatable.
-    #[arg(long = "grade-file")]
-    pub grade_files: Vec<PathBuf>,
+    #[command(flatten)]
+    pub grade_choice: GradeChoice,
     /// The built-in laterals (ignored when --plan is given).
     #[arg(long, value_enum, default_value = "both")]
     pub well: WellChoice,
@@ -269,14 +263,14 @@ pub fn merge(args: MergeArgs) -> Result<()> {
 fn spec(args: &LateralArgs) -> Result<StudySpec> {
     let mut grade_files = Vec::new();
     let mut from_files = Vec::new();
-    for path in &args.grade_files {
+    for path in &args.grade_choice.grade_files {
         let text = read_small_file(path)
             .with_context(|| format!("reading the grade file {}", path.display()))?;
         let name = path.display().to_string();
         from_files.push(Grade::parse(&text, &name)?);
         grade_files.push(SourceText { name, text });
     }
-    grade::select_parsed(&args.grades, from_files)?;
+    grade::select_parsed(&args.grade_choice.grades, from_files)?;
     let overrides = DrillingOverrides {
         rop_m_per_h: args.rop_m_per_h,
         stand_length_m: args.stand_length_m,
@@ -286,7 +280,7 @@ fn spec(args: &LateralArgs) -> Result<StudySpec> {
     };
     let text = |v: Option<f64>| v.map(exact_text);
     Ok(StudySpec {
-        grades: args.grades.clone(),
+        grades: args.grade_choice.grades.clone(),
         grade_files,
         wells: wells(args, &overrides)?,
         rop_m_per_h: text(args.rop_m_per_h),
