@@ -112,7 +112,14 @@ pub fn dcm_from_euler(e: &Euler) -> Matrix3<f64> {
 /// heading are not separable; the rotation about the vertical is then put
 /// into heading and roll is returned as 0.
 pub fn euler_from_dcm(c_bn: &Matrix3<f64>) -> Euler {
-    let c = c_bn * body_to_frd(); // C_f^n (P is its own inverse)
+    // C_f^n = C_b^n P (P is its own inverse): P swaps the first two columns
+    // and negates the third. Taken by index, not by a 3 x 3 product (27
+    // software multiplications on the probe's single-precision FPU).
+    let c = Matrix3::from_fn(|i, k| match k {
+        0 => c_bn[(i, 1)],
+        1 => c_bn[(i, 0)],
+        _ => -c_bn[(i, 2)],
+    });
     let horizontal = libm::sqrt(c[(0, 0)] * c[(0, 0)] + c[(1, 0)] * c[(1, 0)]);
     let pitch = libm::atan2(-c[(2, 0)], horizontal);
     if horizontal < 1e-12 {

@@ -31,12 +31,18 @@ pub struct AngleUncertainty {
 
 /// J P_phi J^T, as sigmas and correlations.
 pub fn angle_uncertainty(jacobian: &Matrix3<f64>, attitude_cov: &Matrix3<f64>) -> AngleUncertainty {
-    let p = jacobian * attitude_cov * jacobian.transpose();
-    let sigma = [0, 1, 2].map(|i| std_dev_of(p[(i, i)]));
-    let corr = |i: usize, k: usize| p[(i, k)] / (sigma[i] * sigma[k]);
-    AngleUncertainty {
-        sigma,
-        correlation: [corr(0, 1), corr(0, 2), corr(1, 2)],
+    AngleUncertainty::from_covariance(&(jacobian * attitude_cov * jacobian.transpose()))
+}
+
+impl AngleUncertainty {
+    /// The sigmas and correlations of (inc, azi, tf) with covariance `p`.
+    pub fn from_covariance(p: &Matrix3<f64>) -> Self {
+        let sigma = [0, 1, 2].map(|i| std_dev_of(p[(i, i)]));
+        let corr = |i: usize, k: usize| p[(i, k)] / (sigma[i] * sigma[k]);
+        Self {
+            sigma,
+            correlation: [corr(0, 1), corr(0, 2), corr(1, 2)],
+        }
     }
 }
 

@@ -18,6 +18,8 @@ pub struct Summary {
     pub queued: u32,
     pub dropped: u32,
     pub worst_ticks: u32,
+    /// The samples taken when the worst cycle ended (which cycle it was).
+    pub worst_at_sample: u32,
     pub mean_ticks: u32,
     pub stack_bytes: usize,
     pub nav_dropped: u32,
@@ -34,7 +36,8 @@ pub fn finish(summary: &Summary) -> ! {
     hprintln!(
         "probe-qemu: samples={} skipped={} frames_queued={} frames_dropped={} \
          cycle_ticks_worst={} cycle_ticks_mean={} \
-         cycle_instructions_worst={} cycle_instructions_mean={} stack_high_water_bytes={} \
+         cycle_instructions_worst={} cycle_worst_at_sample={} cycle_instructions_mean={} \
+         stack_high_water_bytes={} \
          nav_samples_dropped={} nav_inbox_high_water={} cycle_overruns={} overrun_instructions_longest={} \
          mode_changes={} mode_change_instructions_longest={} \
          uplink_bytes={} uplink_ok={} uplink_crc_failures={} uplink_malformed={} \
@@ -47,6 +50,7 @@ pub fn finish(summary: &Summary) -> ! {
         summary.worst_ticks,
         summary.mean_ticks,
         summary.worst_ticks * INSTRUCTIONS_PER_TICK,
+        summary.worst_at_sample,
         summary.mean_ticks * INSTRUCTIONS_PER_TICK,
         summary.stack_bytes,
         summary.nav_dropped,

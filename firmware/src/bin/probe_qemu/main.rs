@@ -157,6 +157,8 @@ pub fn on_uart_tx() {
 #[derive(Default)]
 struct CycleCost {
     worst: u32,
+    /// The samples taken when the worst cycle ended.
+    worst_at_sample: u32,
     total: u64,
     cycles: u32,
     /// Periods whose work ran into the next period (not in the figures
@@ -261,7 +263,10 @@ impl CycleCost {
             self.overruns += 1;
             self.longest_overrun = self.longest_overrun.max(since_pass_began());
         } else if samples > 0 {
-            self.worst = self.worst.max(elapsed);
+            if elapsed > self.worst {
+                self.worst = elapsed;
+                self.worst_at_sample = samples;
+            }
             self.total += u64::from(elapsed);
             self.cycles += 1;
         }
@@ -317,6 +322,7 @@ fn summary(cost: &CycleCost, uplink: &UplinkService<ConfigFlash>) -> Summary {
         queued: s.probe().queue().queued(),
         dropped: s.probe().queue().dropped(),
         worst_ticks: cost.worst,
+        worst_at_sample: cost.worst_at_sample,
         mean_ticks,
         stack_bytes: stack_paint::high_water_bytes(),
         nav_dropped: s.probe().nav_inbox().dropped(),

@@ -184,11 +184,11 @@ impl<T: FilterScalar> Navigator<T> {
         }
         // After the station's updates, which the frame reports; a station
         // finished above judges its own sigma against the limit.
-        let attitude_std = self.attitude_std();
-        if let Some(std) = &attitude_std {
-            self.note_heading_loss(std.z);
+        let readout = self.solution_readout();
+        if let Some(readout) = readout.filter(|_| !self.covariance_invalid) {
+            self.note_heading_loss(readout.euler_std().z);
         }
-        self.solution(time_us, sample_counter, attitude_std)
+        self.solution(time_us, sample_counter, readout)
     }
 
     /// `sample`, with the gyro of index `missing_gyro` (in `GYRO_AXES`)

@@ -4,12 +4,11 @@
 
 use super::heading::AZIMUTH_SIGMA_LIMIT_RAD;
 use super::state::{Navigator, Phase};
-use crate::conventions::euler_from_quat;
+use super::readout::AttitudeReadout;
 use crate::error_model::{POS, TILT_SIGMA_LIMIT_RAD, VEL};
 use crate::kalman::FilterScalar;
 use crate::protocol::frame::{nav_flags, nav_mode};
 use crate::protocol::NavSolution;
-use nalgebra::Vector3;
 
 /// The covariance health check's bound on every variance, in the states'
 /// own units squared (rad^2, (m/s)^2, m^2, and the sensor-error states'):
@@ -24,20 +23,20 @@ use nalgebra::Vector3;
 pub const VARIANCE_LIMIT: f32 = 1e16;
 
 impl<T: FilterScalar> Navigator<T> {
-    /// The filter's roll, pitch and heading sigmas (rad), once it has a
-    /// solution with a valid covariance: computed once per cycle, for the
-    /// frame and the heading-loss check.
-    pub(super) fn attitude_std(&self) -> Option<Vector3<f64>> {
+    /// The attitude's readout once there is a solution (after the coarse
+    /// alignment): made once per cycle, for the frame and the heading-loss
+    /// check (and the station's survey before them).
+    pub(super) fn solution_readout(&mut self) -> Option<AttitudeReadout> {
         let has_solution = !matches!(self.phase, Phase::Coarse(_));
-        (has_solution && !self.covariance_invalid).then(|| self.filter.euler_std())
+        has_solution.then(|| self.readout())
     }
 
-    /// The cycle's frame; `attitude_std` from [`attitude_std`](Self::attitude_std).
+    /// The cycle's frame; `readout` from [`solution_readout`](Self::solution_readout).
     pub(super) fn solution(
         &self,
         time_us: u64,
         sample_counter: u32,
-        attitude_std: Option<Vector3<f64>>,
+        readout: Option<AttitudeReadout>,
     ) -> NavSolution {
         let mut solution = NavSolution {
             time_us,
@@ -68,7 +67,12 @@ impl<T: FilterScalar> Navigator<T> {
         };
         let filter = &self.filter;
         let state = filter.state();
-        let e = euler_from_quat(&state.attitude);
+        let Some(readout) = readout else {
+            // Not reached: every phase past the coarse one has a readout.
+            solution.flags |= nav_flags::SOLUTION_INVALID;
+            return solution;
+        };
+        let e = readout.euler;
         solution.attitude = [e.roll, e.pitch, e.heading].map(|a| a as f32);
         let v = state.velocity;
         solution.velocity_ned = [v.x, v.y, v.z].map(|v| v as f32);
@@ -81,11 +85,12 @@ impl<T: FilterScalar> Navigator<T> {
         if self.heading_lost {
             solution.flags |= nav_flags::HEADING_LOST;
         }
-        let Some(std) = attitude_std.filter(|_| !self.covariance_invalid) else {
+        let std = readout.euler_std();
+        if self.covariance_invalid {
             solution.flags |= nav_flags::COVARIANCE_INVALID | nav_flags::SOLUTION_INVALID;
             solution.attitude_std = [f32::NAN; 3];
             return solution;
-        };
+        }
         // The azimuth's sigma: infinite while the heading is undetermined
         // (coarse alignment, or lost in navigation) or rests on one gyro
         // (single part).

@@ -61,6 +61,7 @@ mod fine;
 mod frame;
 mod heading;
 mod navigation;
+mod readout;
 mod state;
 mod stations;
 mod tie_in_start;

@@ -4,6 +4,7 @@
 //! what it tells about itself.
 
 use super::commands::CommandState;
+use super::readout::AttitudeReadout;
 use crate::aid_sources::ForceBlock;
 use crate::alignment::SegmentSums;
 use crate::calibration::ProbeCalibration;
@@ -208,6 +209,8 @@ pub struct Navigator<T: FilterScalar = f32> {
     pub(super) sample_counter: u32,
     /// The surface's survey commands' state (`commands`).
     pub(super) commands: CommandState,
+    /// The attitude's readout last made (`readout`).
+    pub(super) readout: Option<AttitudeReadout>,
 }
 
 /// The probe's constructors, f32: on the default type itself, so that
@@ -293,6 +296,7 @@ impl<T: FilterScalar> Navigator<T> {
             time_us: 0,
             sample_counter: 0,
             commands: CommandState::default(),
+            readout: None,
         }
     }
 

@@ -9,11 +9,10 @@ use super::heading::AZIMUTH_SIGMA_LIMIT_RAD;
 use super::state::{Navigator, Station};
 use crate::aid_sources::{long_run_variance, EarthRate};
 use crate::attitude::NEAR_VERTICAL;
-use crate::conventions::dcm_from_quat;
+use crate::conventions::{dcm_from_quat, DrillingAngles};
 use crate::earth::earth_rate_n;
 use crate::error_model::{ATT, TILT_SIGMA_LIMIT_RAD};
 use crate::kalman::{FilterScalar, SparseRow, LINKED};
-use crate::probe::station::{angle_uncertainty, angles_and_jacobian};
 use crate::probe::station_link::{
     link_covariance, link_rows, StationLink, CHECKPOINT, PREVIOUS, SETTLED,
 };
@@ -251,7 +250,7 @@ impl<T: FilterScalar> Navigator<T> {
     /// squared, the attitude process noise's gyro part), to the
     /// [`BLOCK_NOISE`] columns.
     fn add_block_noise(&mut self) {
-        let c_bn = dcm_from_quat(&self.filter.state().attitude);
+        let c_bn = self.readout().c_bn;
         let noise = self.noise.gyro;
         let (_, snapshots) = self.filter.snapshots_mut();
         for (column, axis) in GYRO_AXES.iter().enumerate() {
@@ -306,9 +305,10 @@ impl<T: FilterScalar> Navigator<T> {
     /// angles, their covariance J P_phi J^T (`crate::probe::station`), the flags.
     /// Everything but the station number, start and quality. With the rows
     /// of its link's z (`station_link`) where the covariance is valid.
-    pub(super) fn station_survey(&self) -> (StationSurvey, Option<[SparseRow<T>; LINKED]>) {
-        let state = self.filter.state();
-        let (angles, jacobian) = angles_and_jacobian(&dcm_from_quat(&state.attitude));
+    pub(super) fn station_survey(&mut self) -> (StationSurvey, Option<[SparseRow<T>; LINKED]>) {
+        let readout = self.readout();
+        let angles = DrillingAngles::from_euler(&readout.euler);
+        let jacobian = readout.drilling_jacobian();
         let mut flags = station_flags::MAGNETIC_FREE;
         if self.is_uncalibrated() {
             flags |= station_flags::UNCALIBRATED;
@@ -329,12 +329,12 @@ impl<T: FilterScalar> Navigator<T> {
             survey.flags = flags | station_flags::SOLUTION_INVALID;
             return (survey, None);
         }
-        let u = angle_uncertainty(&jacobian, &self.filter.attitude_error_covariance());
+        let u = readout.drilling_uncertainty();
         survey.angles_std = u.sigma.map(|s| s as f32);
         survey.correlations = u.correlation.map(|r| r as f32);
         // Lost: since the last tie-in, or now by the frames' own test
         // (`note_heading_loss`, which runs after this cycle's station).
-        let euler_std = self.filter.euler_std();
+        let euler_std = readout.euler_std();
         let lost = self.heading_lost || self.loses_heading(euler_std.z);
         if lost {
             flags |= station_flags::HEADING_LOST;
