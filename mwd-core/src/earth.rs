@@ -203,6 +203,26 @@ fn normal_gravity_from_sin(s: f64, height: f64) -> f64 {
             + 3.0 * height * height / (a * a))
 }
 
+/// `position` moved by a small north-east-down offset (m), the sine and
+/// cosine of its latitude at hand: [`LocalEarth::displaced`] with the radii
+/// only (the same bits), for the mechanization's feedback every cycle, which
+/// has no use for the local gravity (software f64 on the probe).
+pub fn displaced_with_trig(
+    position: &Position,
+    sin_lat: f64,
+    cos_lat: f64,
+    ned: &Vector3<f64>,
+) -> Position {
+    let r = radii_from_sin(sin_lat);
+    let meridian = r.meridian + position.height;
+    let transverse = r.transverse + position.height;
+    Position {
+        lat: position.lat + ned.x / meridian,
+        lon: position.lon + ned.y / (transverse * cos_lat),
+        height: position.height - ned.z,
+    }
+}
+
 /// Gravity vector in NED at a position ([`LocalEarth::gravity_n`] without
 /// the rest of the local terms).
 pub fn gravity_n(pos: &Position) -> Vector3<f64> {

@@ -12,7 +12,7 @@
 use crate::attitude::{
     coning_rotation_vector, quat_from_rotation_vector, ToolAxisRate, ToolAxisRateEstimator,
 };
-use crate::earth::{LocalEarth, Position};
+use crate::earth::{displaced_with_trig, LocalEarth, Position};
 use crate::probe_sample::ProbeSample;
 use nalgebra::{UnitQuaternion, Vector3};
 
@@ -197,13 +197,11 @@ impl Strapdown {
         s.velocity -= velocity_error_n;
         // The sine and cosine of the latitude from the last step, if the
         // latitude has not been changed since.
-        let earth = match self.latitude_trig {
-            Some((lat, trig)) if lat == s.position.lat => {
-                LocalEarth::with_latitude_trig(&s.position, trig.sin, trig.cos)
-            }
-            _ => LocalEarth::at(&s.position),
+        let (sin_lat, cos_lat) = match self.latitude_trig {
+            Some((lat, trig)) if lat == s.position.lat => (trig.sin, trig.cos),
+            _ => libm::sincos(s.position.lat),
         };
-        s.position = earth.displaced(&-position_error_ned_m);
+        s.position = displaced_with_trig(&s.position, sin_lat, cos_lat, &-position_error_ned_m);
         self.earth = None;
         self.latitude_trig = None;
     }

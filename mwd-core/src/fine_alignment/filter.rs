@@ -8,7 +8,7 @@ use super::config::{
     SpecificForceInModel, TiltPrior,
 };
 use crate::aid_sources::{ZeroPosition, ZeroVelocity};
-use crate::earth::{gravity_n, LocalEarth, Position};
+use crate::earth::{LocalEarth, Position};
 use crate::error_model::{
     AugmentedTransition, LinearizationPoint, ATT, NAV_STATES, POS, STATES, STATES_WITH_BIASES, VEL,
 };
@@ -188,18 +188,22 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             .unwrap_or(state.attitude)
             .to_rotation_matrix()
             .into_inner();
+        if !self.earth.is_near(&state.position) {
+            self.earth = LocalEarth::at(&state.position);
+        }
         let lp = LinearizationPoint {
             c_bn,
             velocity_n: state.velocity,
             position: state.position,
             specific_force_n: match self.config.specific_force {
                 SpecificForceInModel::MeasuredSample => c_bn * sample.specific_force,
-                SpecificForceInModel::GravityAtRest => -gravity_n(&state.position),
+                // The local earth's gravity (refreshed within ~10 m: 3e-5
+                // m/s^2 at most from the solution's, a linearisation
+                // point's), not Somigliana's formula again every step in
+                // software f64.
+                SpecificForceInModel::GravityAtRest => -self.earth.gravity_n(),
             },
         };
-        if !self.earth.is_near(&state.position) {
-            self.earth = LocalEarth::at(&state.position);
-        }
         let phi: AugmentedTransition<T, N> = self.config.model.transition_with(&self.earth, &lp);
         let mut q = self.q;
         self.scale_bias_walk(&mut q);

@@ -100,8 +100,13 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         at: UnitQuaternion<f64>,
         current: &UnitQuaternion<f64>,
     ) -> UnitQuaternion<f64> {
-        let turn = current * at.inverse();
-        let (w, k) = (turn.w, turn.k);
+        // The scalar and vertical parts of current * at^-1, only (the
+        // product's other two are not needed: half the software f64
+        // multiplications of the whole product on the probe, every still
+        // cycle).
+        let (c, a) = (current.quaternion(), at.quaternion());
+        let w = c.w * a.w + c.i * a.i + c.j * a.j + c.k * a.k;
+        let k = c.k * a.w - c.w * a.k + c.j * a.i - c.i * a.j;
         let twist_sq = w * w + k * k;
         // sin^2(twist / 2) = k^2 / (w^2 + k^2); also a turn of 180 deg
         // about a horizontal axis (twist_sq = 0, k = 0) stays here
