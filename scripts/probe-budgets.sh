@@ -3,8 +3,11 @@
 # (arm-none-eabi-size), and from one simulated static minute under
 # `-icount shift=0,sleep=off` the stack high-water mark (stack painting),
 # instructions per 20 Hz cycle (SysTick counts, 40 instructions each) and
-# the UART bytes per second; then flash and static RAM of the real board's
-# build (`probe-stm32`, linked with the top-level memory.x).
+# the UART bytes per second; then the drilling run (the short plan drilled
+# by the simulator, its sensor stream played to the probe's parts: the
+# busiest cycles, a station's block and the drilling constraints); then
+# flash and static RAM of the real board's build (`probe-stm32`, linked with
+# the top-level memory.x).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -35,6 +38,20 @@ qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic \
   -icount shift=0,sleep=off -kernel "$elf" | grep -o 'probe-qemu: .*' | tr ' ' '\n'
 bytes=$(stat -c %s "$serial")
 echo "uart_bytes=$bytes uart_bytes_per_s=$((bytes / 60)) (of 11520 at 115200 baud 8N1)"
+
+echo "== the drilling run in QEMU (host-sim/data/plans/qemu-short.json, seed 1)"
+run_dir="$(mktemp -d)"
+trap 'rm -f "$serial"; rm -rf "$run_dir"' EXIT
+cargo build -q --release -p host-sim
+"${CARGO_TARGET_DIR:-target}/release/host-sim" simulate --motion lateral --seed 1 \
+  --plan host-sim/data/plans/qemu-short.json --sensor-stream "$run_dir/sensor-stream.bin" \
+  --output "$run_dir/host.bin" >/dev/null
+CARGO_TARGET_DIR="$target_dir" cargo build -q -p firmware --profile probe --target "$target" \
+  --features qemu-drilling --bin probe-qemu
+(cd "$run_dir" && qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic \
+  -semihosting-config enable=on,target=native -serial null \
+  -icount shift=0,sleep=off -kernel "$elf") | grep -o 'probe-qemu: .*' | tr ' ' '\n' |
+  grep -E '^(samples|cycle_|stack_|frames_dropped|nav_samples_dropped)'
 
 stm32_dir="${CARGO_TARGET_DIR:-target}"
 cargo build -q -p firmware --profile probe --target "$target" --features board-stm32 --bin probe-stm32

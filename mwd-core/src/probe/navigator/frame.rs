@@ -23,6 +23,17 @@ use crate::protocol::NavSolution;
 pub const VARIANCE_LIMIT: f32 = 1e16;
 
 impl<T: FilterScalar> Navigator<T> {
+    /// The readout of the filter's attitude now (`readout`): the cycle's,
+    /// when nothing has changed since it was made.
+    pub(super) fn readout(&mut self) -> AttitudeReadout {
+        if let Some(readout) = self.readout.filter(|r| r.is_of(&self.filter)) {
+            return readout;
+        }
+        let readout = AttitudeReadout::of(&self.filter);
+        self.readout = Some(readout);
+        readout
+    }
+
     /// The attitude's readout once there is a solution (after the coarse
     /// alignment): made once per cycle, for the frame and the heading-loss
     /// check (and the station's survey before them).

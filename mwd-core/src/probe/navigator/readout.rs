@@ -12,18 +12,17 @@
 //! command between the station and the frame, say), so a reader never
 //! gets another state's angles.
 
-use super::state::Navigator;
 use crate::conventions::{dcm_from_quat, euler_error_jacobian, euler_from_dcm, Euler};
-use crate::error_model::ATT;
+use crate::error_model::{ATT, STATES_WITH_BIASES};
+use crate::fine_alignment::FineAlignment;
 use crate::kalman::{std_dev_of, FilterScalar};
 use crate::probe::station::AngleUncertainty;
 use nalgebra::{Matrix3, Vector3};
 
 /// One attitude's angles and their first-order covariance.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct AttitudeReadout {
-    /// What it was made from: the attitude quaternion's coordinates and
-    /// the attitude-error covariance, row by row, in f64.
+pub struct AttitudeReadout {
+    /// What it was made from ([`key`]).
     attitude: [f64; 4],
     covariance_phi: [f64; 9],
     /// C_b^n.
@@ -60,34 +59,39 @@ impl AttitudeReadout {
     }
 }
 
-impl<T: FilterScalar> Navigator<T> {
-    /// The readout of the filter's attitude now: the cycle's, when nothing
-    /// has changed since it was made.
-    pub(super) fn readout(&mut self) -> AttitudeReadout {
-        let attitude = self.filter.state().attitude.coords;
-        let attitude = [attitude.x, attitude.y, attitude.z, attitude.w];
-        let p = &self.filter.filter().p;
-        let covariance_phi: [f64; 9] =
-            core::array::from_fn(|k| p[(ATT + k / 3, ATT + k % 3)].as_f64());
-        if let Some(readout) = self.readout.filter(|r| {
-            r.attitude == attitude && r.covariance_phi == covariance_phi
-        }) {
-            return readout;
-        }
-        let c_bn = dcm_from_quat(&self.filter.state().attitude);
+impl AttitudeReadout {
+    /// The readout of `filter`'s attitude now.
+    pub fn of<T: FilterScalar>(filter: &FineAlignment<T, STATES_WITH_BIASES>) -> Self {
+        let (attitude, covariance_phi) = key(filter);
+        let c_bn = dcm_from_quat(&filter.state().attitude);
         let jacobian = euler_error_jacobian(&c_bn);
         let phi = Matrix3::from_row_slice(&covariance_phi);
-        let readout = AttitudeReadout {
+        Self {
             attitude,
             covariance_phi,
             c_bn,
             euler: euler_from_dcm(&c_bn),
             jacobian,
             covariance: jacobian * phi * jacobian.transpose(),
-        };
-        self.readout = Some(readout);
-        readout
+        }
     }
+
+    /// Whether this is the readout of `filter` as it is now: the same
+    /// attitude and attitude covariance, bit for bit.
+    pub fn is_of<T: FilterScalar>(&self, filter: &FineAlignment<T, STATES_WITH_BIASES>) -> bool {
+        key(filter) == (self.attitude, self.covariance_phi)
+    }
+}
+
+/// What a readout is made from: the attitude quaternion's coordinates and
+/// the attitude-error covariance, row by row, in f64.
+fn key<T: FilterScalar>(filter: &FineAlignment<T, STATES_WITH_BIASES>) -> ([f64; 4], [f64; 9]) {
+    let q = filter.state().attitude.coords;
+    let p = &filter.filter().p;
+    (
+        [q.x, q.y, q.z, q.w],
+        core::array::from_fn(|k| p[(ATT + k / 3, ATT + k % 3)].as_f64()),
+    )
 }
 
 #[cfg(test)]
