@@ -73,6 +73,8 @@ fn untimed_text(text: &str) -> String {
         } else if timing_table && !line.starts_with('-') {
             let cut = line.trim_end().rfind(' ').expect("a table row");
             line.truncate(cut);
+            // the value's own width (its digits) pads the column before it
+            line.truncate(line.trim_end().len());
         }
         out.push(line);
     }
