@@ -3,8 +3,8 @@
 //! the covariance is healthy, and the flags that say how far to trust it.
 
 use super::heading::AZIMUTH_SIGMA_LIMIT_RAD;
-use super::state::{Navigator, Phase};
 use super::readout::AttitudeReadout;
+use super::state::{Navigator, Phase};
 use crate::error_model::{POS, TILT_SIGMA_LIMIT_RAD, VEL};
 use crate::kalman::FilterScalar;
 use crate::protocol::frame::{nav_flags, nav_mode};

@@ -116,11 +116,16 @@ mod tests {
         let u = angle_uncertainty(&j, &filter.attitude_error_covariance());
         let v = r.drilling_uncertainty();
         for i in 0..3 {
-            assert!((u.sigma[i] - v.sigma[i]).abs() <= 1e-12 * u.sigma[i], "{u:?} {v:?}");
+            assert!(
+                (u.sigma[i] - v.sigma[i]).abs() <= 1e-12 * u.sigma[i],
+                "{u:?} {v:?}"
+            );
         }
 
         // a changed covariance: made again
-        navigator.filter.add_attitude_noise(&(Matrix3::identity() * 1e-4));
+        navigator
+            .filter
+            .add_attitude_noise(&(Matrix3::identity() * 1e-4));
         let again = navigator.readout();
         assert!(again.euler_std().x > r.euler_std().x);
         assert_eq!(again.euler_std(), navigator.filter.euler_std());

@@ -133,7 +133,8 @@ impl StillDetector {
         let mut mean = [0.0f32; 3];
         let mut rate = 0.0f32;
         for s in &self.window {
-            rate += s[0] * s[0] * w.inverse_rate_variance[0] + s[1] * s[1] * w.inverse_rate_variance[1];
+            rate +=
+                s[0] * s[0] * w.inverse_rate_variance[0] + s[1] * s[1] * w.inverse_rate_variance[1];
             for (m, v) in mean.iter_mut().zip(&s[2..]) {
                 *m += *v;
             }
