@@ -25,8 +25,6 @@ pub struct AttitudeReadout {
     /// What it was made from ([`key`]).
     attitude: [f64; 4],
     covariance_phi: [f64; 9],
-    /// C_b^n.
-    pub c_bn: Matrix3<f64>,
     /// Roll, pitch, heading (rad).
     pub euler: Euler,
     /// d(roll, pitch, heading) / d(phi) (`conventions::euler_error_jacobian`).
@@ -69,7 +67,6 @@ impl AttitudeReadout {
         Self {
             attitude,
             covariance_phi,
-            c_bn,
             euler: euler_from_dcm(&c_bn),
             jacobian,
             covariance: jacobian * phi * jacobian.transpose(),
@@ -108,7 +105,6 @@ mod tests {
         let r = navigator.readout();
         let filter = &navigator.filter;
         let c_bn = dcm_from_quat(&filter.state().attitude);
-        assert_eq!(r.c_bn, c_bn);
         assert_eq!(r.euler, euler_from_dcm(&c_bn));
         assert_eq!(r.euler_std(), filter.euler_std());
         let (_, j) = crate::conventions::angles_and_jacobian(&c_bn);

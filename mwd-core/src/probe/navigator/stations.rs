@@ -250,7 +250,10 @@ impl<T: FilterScalar> Navigator<T> {
     /// squared, the attitude process noise's gyro part), to the
     /// [`BLOCK_NOISE`] columns.
     fn add_block_noise(&mut self) {
-        let c_bn = self.readout().c_bn;
+        // The DCM alone (not the cycle's readout): on a block's last cycle
+        // the rate gyrocompass then moves the attitude, and a readout made
+        // here would be made again after it, in the busiest cycle.
+        let c_bn = dcm_from_quat(&self.filter.state().attitude);
         let noise = self.noise.gyro;
         let (_, snapshots) = self.filter.snapshots_mut();
         for (column, axis) in GYRO_AXES.iter().enumerate() {
