@@ -159,14 +159,17 @@ pub fn euler_error_jacobian(c_bn: &Matrix3<f64>) -> Matrix3<f64> {
     -Matrix3::new(ch / cp, sh / cp, 0.0, -sh, ch, 0.0, tp * ch, tp * sh, 1.0)
 }
 
+/// The Euler order's index (roll 0, pitch 1, heading 2) of inclination,
+/// azimuth and toolface, in that order.
+pub const DRILLING_FROM_EULER: [usize; 3] = [1, 2, 0];
+
 /// Inclination, azimuth, toolface (rad) and d(inc, azi, tf)/d(phi) at
 /// C_b^n `c_bn`: the rows of [`euler_error_jacobian`] for pitch, heading
 /// and roll (`probe::station` has the derivation and the tests).
 pub fn angles_and_jacobian(c_bn: &Matrix3<f64>) -> (DrillingAngles, Matrix3<f64>) {
     let angles = DrillingAngles::from_euler(&euler_from_dcm(c_bn));
     let euler = euler_error_jacobian(c_bn);
-    // Rows of `euler` are roll, pitch, heading.
-    let j = Matrix3::from_fn(|i, k| euler[([1, 2, 0][i], k)]);
+    let j = Matrix3::from_fn(|i, k| euler[(DRILLING_FROM_EULER[i], k)]);
     (angles, j)
 }
 

@@ -12,7 +12,9 @@
 //! command between the station and the frame, say), so a reader never
 //! gets another state's angles.
 
-use crate::conventions::{dcm_from_quat, euler_error_jacobian, euler_from_dcm, Euler};
+use crate::conventions::{
+    dcm_from_quat, euler_error_jacobian, euler_from_dcm, Euler, DRILLING_FROM_EULER,
+};
 use crate::error_model::{ATT, STATES_WITH_BIASES};
 use crate::fine_alignment::FineAlignment;
 use crate::kalman::{std_dev_of, FilterScalar};
@@ -33,10 +35,6 @@ pub struct AttitudeReadout {
     pub covariance: Matrix3<f64>,
 }
 
-/// Rows of the Euler order (roll, pitch, heading) that make the drilling
-/// angles' order (inclination, azimuth, toolface).
-const DRILLING_ROWS: [usize; 3] = [1, 2, 0];
-
 impl AttitudeReadout {
     /// The sigmas of roll, pitch and heading (rad; NaN where a variance is
     /// not valid: never a confident 0).
@@ -46,13 +44,13 @@ impl AttitudeReadout {
 
     /// d(inc, azi, tf) / d(phi): the Jacobian's rows in the drilling order.
     pub fn drilling_jacobian(&self) -> Matrix3<f64> {
-        Matrix3::from_fn(|i, k| self.jacobian[(DRILLING_ROWS[i], k)])
+        Matrix3::from_fn(|i, k| self.jacobian[(DRILLING_FROM_EULER[i], k)])
     }
 
     /// The drilling angles' sigmas and correlations.
     pub fn drilling_uncertainty(&self) -> AngleUncertainty {
         AngleUncertainty::from_covariance(&Matrix3::from_fn(|i, k| {
-            self.covariance[(DRILLING_ROWS[i], DRILLING_ROWS[k])]
+            self.covariance[(DRILLING_FROM_EULER[i], DRILLING_FROM_EULER[k])]
         }))
     }
 }
