@@ -135,12 +135,13 @@ impl LocalEarth {
 
     /// This position moved by a small north-east-down offset (m).
     pub fn displaced(&self, ned: &Vector3<f64>) -> Position {
-        let p = &self.position;
-        Position {
-            lat: p.lat + ned.x / self.meridian,
-            lon: p.lon + ned.y / (self.transverse * self.cos_lat),
-            height: p.height - ned.z,
-        }
+        displace(
+            &self.position,
+            self.meridian,
+            self.transverse,
+            self.cos_lat,
+            ned,
+        )
     }
 
     /// North-east-down offset (m) of `other` from this position, to first
@@ -216,6 +217,18 @@ pub fn displaced_with_trig(
     let r = radii_from_sin(sin_lat);
     let meridian = r.meridian + position.height;
     let transverse = r.transverse + position.height;
+    displace(position, meridian, transverse, cos_lat, ned)
+}
+
+/// `position` moved by `ned` (m) with the radii of curvature plus height
+/// `meridian` and `transverse` (m) and the latitude's cosine there.
+fn displace(
+    position: &Position,
+    meridian: f64,
+    transverse: f64,
+    cos_lat: f64,
+    ned: &Vector3<f64>,
+) -> Position {
     Position {
         lat: position.lat + ned.x / meridian,
         lon: position.lon + ned.y / (transverse * cos_lat),

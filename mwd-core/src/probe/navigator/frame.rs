@@ -67,22 +67,18 @@ impl<T: FilterScalar> Navigator<T> {
             position_std_ned: [f32::NAN; 3],
         };
         solution.mode = match self.phase {
-            Phase::Coarse(_) => {
-                // No solution yet: the NaN placeholders come with the bit
-                // that says not to use them.
-                solution.flags |= nav_flags::SOLUTION_INVALID;
-                return solution;
-            }
+            Phase::Coarse(_) => nav_mode::COARSE_ALIGNMENT,
             Phase::Fine { .. } => nav_mode::FINE_ALIGNMENT,
             Phase::Navigating => nav_mode::NAVIGATING,
         };
-        let filter = &self.filter;
-        let state = filter.state();
         let Some(readout) = readout else {
-            // Not reached: every phase past the coarse one has a readout.
+            // No solution yet (the coarse alignment has no readout): the
+            // NaN placeholders come with the bit that says not to use them.
             solution.flags |= nav_flags::SOLUTION_INVALID;
             return solution;
         };
+        let filter = &self.filter;
+        let state = filter.state();
         let e = readout.euler;
         solution.attitude = [e.roll, e.pitch, e.heading].map(|a| a as f32);
         let v = state.velocity;
