@@ -1,27 +1,17 @@
 //! The sensor-bias states (39-state form): their random walk step by step
 //! ([`BiasWalk`]), the gyros' instability as rate noise in navigation, and
-//! the accelerometer biases taken at rest and put back
-//! ([`AccelBiasSnapshot`]).
+//! the accelerometer biases learned at rest only
+//! ([`FineAlignment::learn_accel_bias`]).
 
 use super::config::BiasWalk;
 use super::filter::FineAlignment;
 use crate::error_model::{ACCEL_BIAS, GYRO_BIAS, STATES_WITH_BIASES};
 use crate::kalman::FilterScalar;
-use nalgebra::{Matrix3, SVector, Vector3};
-
-/// The accelerometer biases' estimate (m/s^2, body axes) and covariance
-/// at one step ([`FineAlignment::accel_bias`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AccelBiasSnapshot {
-    pub estimate: Vector3<f64>,
-    pub covariance: Matrix3<f64>,
-    /// The random-walk variance added per axis up to then.
-    pub(super) walk_added: [f64; 3],
-}
+use nalgebra::{Matrix3, SVector};
 
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
-    /// Sets this step's bias random walk in `q` ([`BiasWalk`]); keeps the
-    /// total added per bias.
+    /// Sets this step's bias random walk in `q` ([`BiasWalk`]), capped for
+    /// the accelerometer biases while they are not learned.
     pub(super) fn scale_bias_walk(&mut self, q: &mut SVector<T, N>) {
         if N != STATES_WITH_BIASES {
             return;
@@ -32,13 +22,23 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             let i = ACCEL_BIAS + k; // the rate biases follow the accelerometers'
             let constant = self.bias_walk == BiasWalk::InstabilityAsRateNoise
                 && (i == GYRO_BIAS || i == GYRO_BIAS + 2);
-            let walk = if constant {
+            let mut walk = if constant {
                 0.0
             } else {
                 bias.variance_per_step
             };
+            // An accelerometer bias the measurements do not update (a
+            // moving tool, `learn_accel_bias`) is not seen either: its
+            // walk is the instability's, which changes by at most 2
+            // sigma^2 in variance over any time (a stationary
+            // Gauss-Markov process: 2 sigma^2 (1 - exp(-T/tau))); the
+            // walk over an hour of drilling would add 72.
+            if k < 3 && !self.filter.consider.is_empty() {
+                let most = 2.0 * bias.instability_sigma * bias.instability_sigma;
+                walk = walk.min((most - self.accel_walk_unlearned[k]).max(0.0));
+                self.accel_walk_unlearned[k] += walk;
+            }
             q[i] = T::of(walk);
-            self.bias_walk_added[k] += walk;
         }
     }
 
@@ -78,57 +78,35 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.add_attitude_noise(&q);
     }
 
-    /// The accelerometer-bias estimate (m/s^2, body axes) and its
-    /// covariance now, to put back later; `None` in the 33-state form,
-    /// which has no bias states.
-    pub fn accel_bias(&self) -> Option<AccelBiasSnapshot> {
-        if N != STATES_WITH_BIASES {
-            return None;
-        }
-        let x = &self.filter.x;
-        Some(AccelBiasSnapshot {
-            estimate: Vector3::from_fn(|i, _| x[ACCEL_BIAS + i].as_f64()),
-            covariance: Matrix3::from_fn(|i, j| {
-                self.filter.p[(ACCEL_BIAS + i, ACCEL_BIAS + j)].as_f64()
-            }),
-            walk_added: [
-                self.bias_walk_added[0],
-                self.bias_walk_added[1],
-                self.bias_walk_added[2],
-            ],
-        })
-    }
-
-    /// Puts back an accelerometer-bias estimate and covariance taken
-    /// earlier ([`accel_bias`](Self::accel_bias)), grown by the random walk
-    /// the filter has added since ([`BiasWalk`]) up to the instability's
-    /// largest change, 2 sigma^2, with no correlation to
-    /// the other states (which keeps P positive semi-definite: a principal
-    /// block and a PSD block). The probe's stations use it: what the filter
-    /// learns of the accelerometers while drilling is the bias plus the
-    /// vibration's rectified share, which is gone at rest (derivation
-    /// section 4f).
-    pub fn restore_accel_bias(&mut self, snapshot: &AccelBiasSnapshot) {
+    /// Whether the measurements update the accelerometer biases (`true`,
+    /// the default), or leave them as consider states (`false`,
+    /// `KalmanFilter::consider`): estimate and variance held, their
+    /// covariance with the rest kept right, the walk capped at the
+    /// instability's 2 sigma^2 ([`scale_bias_walk`](Self::scale_bias_walk)).
+    /// The probe's navigator learns them at rest only: while the tool moves
+    /// the constraints read the vibration's rectified force as bias, which
+    /// is gone at rest and there inseparable from the tilt a station
+    /// measures, so it would go straight into the toolface (derivation
+    /// section 4f). Until 2026-12-07 the navigator put back the estimate of
+    /// the last still cycle instead, uncorrelated with the rest: that
+    /// dropped what the stations had tied between the bias, the tilt and
+    /// the gyro biases, and the next station counted it again (derivation
+    /// section 4l).
+    pub fn learn_accel_bias(&mut self, learn: bool) {
         if N != STATES_WITH_BIASES {
             return;
         }
-        self.forget_states(ACCEL_BIAS, 3);
-        let p = &mut self.filter.p;
-        for i in 0..3 {
-            self.filter.x[ACCEL_BIAS + i] = T::of(snapshot.estimate[i]);
-            for j in 0..3 {
-                p[(ACCEL_BIAS + i, ACCEL_BIAS + j)] = T::of(snapshot.covariance[(i, j)]);
-            }
-            // The instability changes by at most 2 sigma^2 in variance
-            // over any time (stationary Gauss-Markov: 2 sigma^2 (1 -
-            // exp(-T/tau))); the walk over an hour of drilling adds 72.
-            let sigma = self.config.model.biases.accel[i].instability_sigma;
-            // (max and min, not clamp: clamp's check of its bounds panics
-            // with the floats formatted, 24 KiB of the probe's flash)
-            let walk = (self.bias_walk_added[i] - snapshot.walk_added[i])
-                .max(0.0)
-                .min(2.0 * sigma * sigma);
-            p[(ACCEL_BIAS + i, ACCEL_BIAS + i)] += T::of(walk);
+        if learn {
+            self.filter.consider = 0..0;
+        } else if self.filter.consider.is_empty() {
+            self.filter.consider = ACCEL_BIAS..ACCEL_BIAS + 3;
+            self.accel_walk_unlearned = [0.0; 3];
         }
+    }
+
+    /// Whether the accelerometer biases are learned now
+    /// ([`learn_accel_bias`](Self::learn_accel_bias)).
+    pub fn learns_accel_bias(&self) -> bool {
+        self.filter.consider.is_empty()
     }
 }

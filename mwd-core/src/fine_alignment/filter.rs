@@ -76,9 +76,15 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     /// computed attitude of each step.
     pub(super) linearization_attitude: Option<UnitQuaternion<f64>>,
     pub(super) bias_walk: BiasWalk,
-    /// Per bias state (accelerometers x, y, z then rates): the random-walk
-    /// variance added since the start.
-    pub(super) bias_walk_added: [f64; 6],
+    /// Per accelerometer bias: the random-walk variance added since the
+    /// measurements stopped updating them
+    /// ([`learn_accel_bias`](Self::learn_accel_bias)).
+    pub(super) accel_walk_unlearned: [f64; 3],
+    /// The heading turn of the corrections fed back while the model is
+    /// linearised at each step's estimate and not yet turned into the
+    /// covariance: (w, k) of a rotation about the vertical, unnormalised
+    /// ([`turn_with_corrections`](Self::turn_with_corrections)).
+    pub(super) unturned_correction: (f64, f64),
 }
 
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
@@ -97,7 +103,8 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             held_tool_axis: false,
             linearization_attitude: None,
             bias_walk: BiasWalk::EveryStep,
-            bias_walk_added: [0.0; 6],
+            accel_walk_unlearned: [0.0; 3],
+            unturned_correction: (1.0, 0.0),
         };
         alignment.restart(initial, reference, config);
         alignment
@@ -136,6 +143,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.filter.x.fill(T::zero());
         self.filter.cross.clear_all();
         self.filter.gate = config.gate.map(T::of);
+        self.filter.consider = 0..0;
         self.strapdown = Strapdown::new(initial, model.dt);
         self.config = config;
         self.earth = LocalEarth::at(&initial.position);
@@ -145,7 +153,8 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.held_tool_axis = false;
         self.linearization_attitude = None;
         self.bias_walk = BiasWalk::EveryStep;
-        self.bias_walk_added = [0.0; 6];
+        self.accel_walk_unlearned = [0.0; 3];
+        self.unturned_correction = (1.0, 0.0);
     }
 
     /// One sample: mechanization, time update, measurement updates,
@@ -269,8 +278,10 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
                 correction[first + 2],
             )
         };
+        let before = self.strapdown.state().attitude;
         self.strapdown
             .apply_correction(&v3(ATT), &v3(VEL), &v3(POS));
+        self.turn_with_corrections(&before);
         for i in 0..NAV_STATES {
             self.filter.x[i] = T::zero();
         }

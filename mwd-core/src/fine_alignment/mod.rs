@@ -25,7 +25,6 @@ mod filter;
 mod held_axis;
 mod linearization;
 
-pub use bias::AccelBiasSnapshot;
 pub use config::{
     ArInitialCovariance, BiasWalk, FineAlignmentConfig, SpecificForceInModel, TiltPrior,
 };

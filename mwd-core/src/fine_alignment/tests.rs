@@ -258,27 +258,45 @@ fn a_fixed_linearization_follows_the_heading_and_turns_the_covariance() {
     }
 }
 
-/// An accelerometer bias put back at a station grows by the random
-/// walk added since its snapshot, but never by more than the
-/// instability's largest change, 2 sigma^2 (an hour's walk is 72).
+/// Accelerometer biases that are not learned (a moving tool): no
+/// measurement moves their estimate or shrinks their variance, and
+/// their walk adds up to the instability's largest change, 2 sigma^2
+/// (an hour's walk would be 72), however long they are held; learned
+/// again, the next update moves them.
 #[test]
-fn a_restored_accelerometer_bias_grows_by_the_walk_up_to_the_instabilitys_largest_change() {
+fn unlearned_accelerometer_biases_hold_and_walk_up_to_the_instabilitys_largest_change() {
     let noise = ImuNoise::scc1300();
     let (mut fa, at_rest) = level_filter_at_rest(&noise, &[0.01, 0.01, 0.1], |_| {});
     fa.step(&at_rest);
-    let snapshot = fa.accel_bias().unwrap();
-    let sigma = noise.accel[0].bias_instability;
-    // A short walk is added whole; an hour's (72 sigma^2) is capped.
-    for (walk, added) in [(0.5, 0.5), (72.0, 2.0)] {
-        fa.bias_walk_added[0] = snapshot.walk_added[0] + walk * sigma * sigma;
-        fa.restore_accel_bias(&snapshot);
-        let grown = fa.filter.p[(ACCEL_BIAS, ACCEL_BIAS)] - snapshot.covariance[(0, 0)];
-        assert!(
-            (grown / (added * sigma * sigma) - 1.0).abs() < 1e-9,
-            "{grown}"
-        );
-        assert_eq!(fa.filter.x[ACCEL_BIAS], snapshot.estimate[0]);
+    let estimate = fa.filter.x[ACCEL_BIAS + 1];
+    let variance = fa.filter.p[(ACCEL_BIAS + 1, ACCEL_BIAS + 1)];
+    fa.learn_accel_bias(false);
+    assert!(!fa.learns_accel_bias());
+    let sigma = noise.accel[1].bias_instability;
+    let per_step = fa.config.model.biases.accel[1].variance_per_step;
+    let steps_per_sigma_sq = (sigma * sigma / per_step) as usize;
+    // 3 sigma^2 worth of steps: the cap stops it at 2
+    for _ in 0..3 * steps_per_sigma_sq {
+        fa.step(&at_rest);
     }
+    assert_eq!(fa.filter.x[ACCEL_BIAS + 1], estimate, "a held bias moved");
+    let grown = fa.filter.p[(ACCEL_BIAS + 1, ACCEL_BIAS + 1)] - variance;
+    assert!(
+        (grown / (2.0 * sigma * sigma) - 1.0).abs() < 1e-6,
+        "{grown} against {}",
+        2.0 * sigma * sigma
+    );
+    // the held bias stays correlated with the tilt the updates learned
+    assert!(fa.filter.p[(ACCEL_BIAS + 1, 0)].abs() + fa.filter.p[(ACCEL_BIAS + 1, 1)].abs() > 0.0);
+    // a force the bias could explain: held, the estimate does not move;
+    // learned, it does
+    let mut pushed = at_rest;
+    pushed.specific_force.y += 0.01;
+    fa.step(&pushed);
+    assert_eq!(fa.filter.x[ACCEL_BIAS + 1], estimate);
+    fa.learn_accel_bias(true);
+    fa.step(&pushed);
+    assert_ne!(fa.filter.x[ACCEL_BIAS + 1], estimate);
 }
 
 #[test]
@@ -330,4 +348,63 @@ fn navigation_keeps_the_gyro_bias_constant_and_adds_the_instability_as_rate_nois
         relative(grown, expected) < 0.02,
         "{grown} vs {expected} (white {white})"
     );
+}
+
+/// A heading correction fed back while the model follows each step's
+/// estimate turns the navigation-frame errors' covariance with the
+/// estimate's heading (the reset's heading part): P <- T P T^T, T = R_z on
+/// the attitude and velocity blocks. Corrections under the 0.1-deg lag
+/// are summed until they pass it. The turn's sign and size come from the
+/// attitude itself, not from the correction's convention.
+#[test]
+fn heading_corrections_turn_the_navigation_covariance_with_the_estimate() {
+    let noise = ImuNoise::scc1300();
+    let (mut fa, _) = level_filter_at_rest(&noise, &[0.01, 0.01, 0.1], |_| {});
+    let p = &mut fa.filter.p;
+    p.fill(0.0);
+    for (i, v) in [
+        (ATT, 4e-6),
+        (ATT + 1, 1e-6),
+        (ATT + 2, 9e-4),
+        (VEL, 2e-4),
+        (VEL + 1, 1e-4),
+    ] {
+        p[(i, i)] = v;
+    }
+    p[(ATT, ACCEL_BIAS + 1)] = 1e-8;
+    p[(ACCEL_BIAS + 1, ATT)] = 1e-8;
+    let before = fa.filter.p;
+    let heading = |fa: &FineAlignment<f64, STATES_WITH_BIASES>| {
+        euler_from_quat(&fa.strapdown.state().attitude).heading
+    };
+    let start = heading(&fa);
+    // 0.06 deg: under the lag, nothing turns yet
+    fa.filter.x[ATT + 2] = 0.06 * DEG;
+    fa.feed_back();
+    assert_eq!(fa.filter.p, before);
+    // twice: 0.12 deg in all, turned whole
+    fa.filter.x[ATT + 2] = 0.06 * DEG;
+    fa.feed_back();
+    let turn = heading(&fa) - start;
+    assert!((turn.abs() - 0.12 * DEG).abs() < 1e-9, "{}", turn / DEG);
+    let r = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), turn).into_inner();
+    let mut t = SMatrix::<f64, STATES_WITH_BIASES, STATES_WITH_BIASES>::identity();
+    for first in [ATT, VEL] {
+        t.fixed_view_mut::<3, 3>(first, first).copy_from(&r);
+    }
+    let expected = t * before * t.transpose();
+    for i in 0..STATES_WITH_BIASES {
+        for j in 0..STATES_WITH_BIASES {
+            assert!(
+                (fa.filter.p[(i, j)] - expected[(i, j)]).abs() < 1e-15,
+                "P[{i},{j}]"
+            );
+        }
+    }
+    // with a fixed point, the point's own heading follow does it instead
+    fa.fix_linearization(true);
+    let fixed = fa.filter.p;
+    fa.filter.x[ATT + 2] = 0.5 * DEG;
+    fa.feed_back();
+    assert_eq!(fa.filter.p, fixed);
 }

@@ -7,6 +7,7 @@ use super::outcome::{ScalarOutcome, UpdateReport};
 use super::scalar;
 use super::transition::Transition;
 use super::CrossCovariances;
+use core::ops::Range;
 use nalgebra::{SMatrix, SVector};
 
 /// State estimate and covariance of an error-state filter with `N` states.
@@ -22,6 +23,12 @@ pub struct KalmanFilter<T: FilterScalar, const N: usize> {
     /// The state's covariance with snapshots of earlier states, kept
     /// through every time and measurement update here (`cross`).
     pub cross: CrossCovariances<T, N>,
+    /// States no measurement updates: their gain is set to zero, the
+    /// Schmidt-Kalman "consider" states (Schmidt 1966; Simon, Optimal
+    /// State Estimation, 2006, section 7.5). Their estimate and variance
+    /// stay as they were, and the Joseph form keeps their covariance with
+    /// the updated states right for that gain. Empty: every state learns.
+    pub consider: Range<usize>,
 }
 
 impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
@@ -32,6 +39,7 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
             p: p0,
             gate: None,
             cross: CrossCovariances::default(),
+            consider: 0..0,
         }
     }
 
@@ -72,6 +80,7 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
             self.gate,
             &mut self.cross,
             None,
+            self.consider.clone(),
         );
         if outcome.is_accepted() {
             mirror_upper(&mut self.p);
@@ -95,6 +104,7 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
             self.gate,
             &mut self.cross,
             Some(noise_cross),
+            self.consider.clone(),
         );
         if outcome.is_accepted() {
             mirror_upper(&mut self.p);
@@ -115,6 +125,7 @@ impl<T: FilterScalar, const N: usize> KalmanFilter<T, N> {
                     self.gate,
                     &mut self.cross,
                     None,
+                    self.consider.clone(),
                 ),
                 None => ScalarOutcome::NonFinite,
             };

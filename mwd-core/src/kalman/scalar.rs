@@ -2,6 +2,7 @@
 
 use super::measurement::ScalarMeasurement;
 use super::{CrossCovariances, FilterScalar, ScalarOutcome};
+use core::ops::Range;
 use nalgebra::{SMatrix, SVector};
 
 /// Updates `x` and `p` with one scalar; on any rejection both are left as
@@ -16,6 +17,11 @@ use nalgebra::{SMatrix, SVector};
 /// measurement). Then `c = P h + s` and the variance `h^T P h + 2 h^T s +
 /// r` (Simon, Optimal State Estimation, 2006, section 7.1), and the
 /// covariance update below is unchanged in form.
+///
+/// `consider`: states whose gain is set to zero (the Schmidt-Kalman
+/// filter's consider states, `KalmanFilter::consider`): the Joseph form
+/// below holds for any gain, so their covariance with the rest stays
+/// right while their estimate and variance do not move.
 pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     x: &mut SVector<T, N>,
     p: &mut SMatrix<T, N, N>,
@@ -23,6 +29,7 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     gate: Option<T>,
     cross: &mut CrossCovariances<T, N>,
     noise_cross: Option<&[T; N]>,
+    consider: Range<usize>,
 ) -> ScalarOutcome<T> {
     let row_finite = m.h.entries().all(|(i, c)| i < N && c.is_finite());
     if !(m.z.is_finite() && m.r.is_finite() && m.r >= T::zero() && row_finite) {
@@ -95,6 +102,9 @@ pub(super) fn joseph_update<T: FilterScalar, const N: usize>(
     }
     if !finite {
         return ScalarOutcome::Degenerate;
+    }
+    if let Some(held) = k.get_mut(consider) {
+        held.fill(T::zero());
     }
 
     // The snapshots' cross-covariances take the same gain (`cross`).
@@ -252,7 +262,7 @@ mod tests {
         let mut x = SVector::<f64, N>::zeros();
         let mut pc = p;
         let mut cross = CrossCovariances::default();
-        let outcome = joseph_update(&mut x, &mut pc, &m, None, &mut cross, Some(&s));
+        let outcome = joseph_update(&mut x, &mut pc, &m, None, &mut cross, Some(&s), 0..0);
         assert!(outcome.is_accepted());
 
         const A: usize = N + 1;
@@ -276,7 +286,7 @@ mod tests {
         };
         let mut xa = SVector::<f64, A>::zeros();
         let mut cross_a = CrossCovariances::default();
-        let outcome = joseph_update(&mut xa, &mut pa, &ma, None, &mut cross_a, None);
+        let outcome = joseph_update(&mut xa, &mut pa, &ma, None, &mut cross_a, None, 0..0);
         assert!(outcome.is_accepted());
         for i in 0..N {
             assert!((x[i] - xa[i]).abs() < 1e-12, "x[{i}]");
@@ -288,7 +298,7 @@ mod tests {
         // and it differs from the update that ignores the correlation
         let mut xu = SVector::<f64, N>::zeros();
         let mut pu = p;
-        joseph_update(&mut xu, &mut pu, &m, None, &mut cross, None);
+        joseph_update(&mut xu, &mut pu, &m, None, &mut cross, None, 0..0);
         assert!((xu[0] - x[0]).abs() > 1e-3);
     }
 
@@ -300,8 +310,60 @@ mod tests {
         h.push(0, 1.0);
         let m = ScalarMeasurement { z: 1.0, h, r: 1.0 };
         let mut cross = CrossCovariances::default();
-        let outcome = joseph_update(&mut x, &mut p, &m, None, &mut cross, Some(&[f64::NAN, 0.0]));
+        let outcome = joseph_update(
+            &mut x,
+            &mut p,
+            &m,
+            None,
+            &mut cross,
+            Some(&[f64::NAN, 0.0]),
+            0..0,
+        );
         assert!(matches!(outcome, ScalarOutcome::NonFinite));
         assert_eq!(p, SMatrix::<f64, 2, 2>::identity());
+    }
+
+    /// A consider state (Schmidt-Kalman): its estimate and variance do not
+    /// move, and the covariance is the Joseph form's for the gain with
+    /// that row zeroed, (I - k h^T) P (I - k h^T)^T + r k k^T, computed
+    /// densely here.
+    #[test]
+    fn a_consider_state_keeps_its_estimate_and_the_joseph_covariance_of_its_gain() {
+        const N: usize = 4;
+        let p: SMatrix<f64, N, N> = SMatrix::from_row_slice(&[
+            4.0, 1.0, 0.5, 0.6, //
+            1.0, 3.0, 0.2, 0.1, //
+            0.5, 0.2, 2.0, 0.3, //
+            0.6, 0.1, 0.3, 1.0,
+        ]);
+        let r = 0.8;
+        let mut h = SparseRow::empty();
+        h.push(0, 1.0);
+        h.push(3, 0.5);
+        let m = ScalarMeasurement { z: 0.7, h, r };
+        let mut x = SVector::<f64, N>::from_column_slice(&[0.0, 0.0, 0.0, 0.25]);
+        let mut pc = p;
+        let mut cross = CrossCovariances::default();
+        let outcome = joseph_update(&mut x, &mut pc, &m, None, &mut cross, None, 3..4);
+        assert!(outcome.is_accepted());
+        assert_eq!(x[3], 0.25, "a consider state's estimate moved");
+        assert_eq!(pc[(3, 3)], p[(3, 3)], "a consider state's variance moved");
+
+        let hv = SVector::<f64, N>::from_column_slice(&[1.0, 0.0, 0.0, 0.5]);
+        let s = (hv.transpose() * p * hv)[(0, 0)] + r;
+        let mut k = p * hv / s;
+        k[3] = 0.0;
+        let a = SMatrix::<f64, N, N>::identity() - k * hv.transpose();
+        let dense = a * p * a.transpose() + k * k.transpose() * r;
+        for i in 0..N {
+            for j in i..N {
+                assert!((pc[(i, j)] - dense[(i, j)]).abs() < 1e-12, "P[{i},{j}]");
+            }
+        }
+        // the optimal update would have moved it
+        let mut xo = SVector::<f64, N>::zeros();
+        let mut po = p;
+        joseph_update(&mut xo, &mut po, &m, None, &mut cross, None, 0..0);
+        assert!(po[(3, 3)] < p[(3, 3)] - 1e-3);
     }
 }

@@ -50,13 +50,11 @@ pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 impl<T: FilterScalar> Navigator<T> {
     /// Drilling mode starts afresh (a new attitude from an alignment or a
     /// tie-in): no drilling since a station, no drilling cycles, no roll
-    /// turn remembered, no accelerometer biases kept from rest, an empty
-    /// toolface block.
+    /// turn remembered, an empty toolface block.
     pub(super) fn forget_drilling(&mut self) {
         self.drilled_since_station = false;
         self.drilling_cycles = 0;
         self.last_roll_turn = None;
-        self.rest_accel_bias = None;
         self.toolface_block.clear();
     }
 
@@ -113,17 +111,6 @@ impl<T: FilterScalar> Navigator<T> {
         let offset = roll_offset(self.filter.state(), sample);
         let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
         add_tool_axis_variance(&mut self.filter, variance);
-        // The accelerometer biases as the last station (at rest)
-        // left them: while drilling the filter read the
-        // vibration's rectified force as bias, and at rest
-        // that bias is inseparable from the tilt the station
-        // measures, so it would go straight into the toolface
-        // (seen in the simulated lateral: 0.10-0.15 deg of
-        // toolface error, the same sign in every seed, against
-        // 0.035-deg sigmas).
-        if let Some(snapshot) = &self.rest_accel_bias {
-            self.filter.restore_accel_bias(snapshot);
-        }
         self.drilled_since_station = false;
     }
 

@@ -47,6 +47,10 @@ impl<T: FilterScalar> Navigator<T> {
         // No updates past the longest station (see
         // `MAX_STATION_SAMPLES`): free navigation until it moves.
         let update = still && !self.station_capped;
+        // The accelerometer biases are learned at rest only (derivation
+        // sections 4f, 4l): moving, the constraints would read the
+        // vibration's rectified force as bias.
+        self.filter.learn_accel_bias(still);
         let report = self.navigation_step(&input.imu, still, drilling, update, jitter, extra);
         if report.sample_used && !update && !self.covariance_invalid {
             self.constrain_moving_tool();
@@ -169,9 +173,8 @@ impl<T: FilterScalar> Navigator<T> {
     }
 
     /// What the next cycle's roll checks need to know of this one: the
-    /// roll's turn when it followed the accelerometers, whether the tool
-    /// was still or drilled, and the accelerometer biases of a still tool
-    /// that has not drilled since its station.
+    /// roll's turn when it followed the accelerometers, and whether the
+    /// tool was still or drilled.
     fn remember_roll(&mut self, input: &CycleInput, still: bool, drilling: bool) {
         self.last_roll_turn = match (input.source, input.tool_axis) {
             (ToolAxisSource::AccelerometerRoll, ToolAxisRate::Valid(rate)) => {
@@ -181,8 +184,5 @@ impl<T: FilterScalar> Navigator<T> {
         };
         self.was_still = still;
         self.drilled_since_station |= drilling;
-        if still && !self.drilled_since_station {
-            self.rest_accel_bias = self.filter.accel_bias();
-        }
     }
 }

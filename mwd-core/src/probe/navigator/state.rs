@@ -10,7 +10,7 @@ use crate::alignment::SegmentSums;
 use crate::calibration::ProbeCalibration;
 use crate::earth::{normal_gravity, Position};
 use crate::error_model::{AugmentedModel, STATES_WITH_BIASES};
-use crate::fine_alignment::{AccelBiasSnapshot, FineAlignment, FineAlignmentConfig};
+use crate::fine_alignment::{FineAlignment, FineAlignmentConfig};
 use crate::kalman::FilterScalar;
 use crate::mechanization::{ImuSample, NavState, ProbeInput};
 use crate::probe::station_link::StationLink;
@@ -196,11 +196,6 @@ pub struct Navigator<T: FilterScalar = f32> {
     /// The turn about the tool axis (rad) in the last navigation cycle when
     /// it followed the accelerometer roll; `None` when the roll was held.
     pub(super) last_roll_turn: Option<f64>,
-    /// The accelerometer-bias estimate and covariance at the last still
-    /// cycle of the last station: put back at the next station after
-    /// drilling
-    /// (`FineAlignment::restore_accel_bias`).
-    pub(super) rest_accel_bias: Option<AccelBiasSnapshot>,
     /// The drilling samples' force since the last toolface update
     /// (`aid_sources::DrillingToolface`).
     pub(super) toolface_block: ForceBlock,
@@ -291,7 +286,6 @@ impl<T: FilterScalar> Navigator<T> {
             was_still: false,
             drilling_cycles: 0,
             last_roll_turn: None,
-            rest_accel_bias: None,
             toolface_block: ForceBlock::default(),
             time_us: 0,
             sample_counter: 0,
