@@ -278,10 +278,9 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
                 correction[first + 2],
             )
         };
-        let before = self.strapdown.state().attitude;
         self.strapdown
             .apply_correction(&v3(ATT), &v3(VEL), &v3(POS));
-        self.turn_with_corrections(&before);
+        self.turn_with_corrections(correction[ATT + 2]);
         for i in 0..NAV_STATES {
             self.filter.x[i] = T::zero();
         }

@@ -118,18 +118,22 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// old heading's axes while the model's C_b^n took the new one: the
     /// zero-velocity updates saw the tool-axis accelerometer bias from a
     /// direction the tool never took and read the inclination from it
-    /// (derivation section 4l). The corrections' turns are summed (a
-    /// rotation about one axis: w + k i multiply as complex numbers) until
-    /// they pass [`MAX_LINEARIZATION_HEADING_LAG_RAD`], as a fixed point's
-    /// lag is; a fixed point follows the estimate itself.
-    pub(super) fn turn_with_corrections(&mut self, before: &UnitQuaternion<f64>) {
+    /// (derivation section 4l). `heading` is the correction's vertical
+    /// component (rad, navigation frame: the estimate is turned by
+    /// exp(phi), `Strapdown::apply_correction`), whose twist about the
+    /// vertical is (1, heading / 2) to first order, the order of the whole
+    /// error model (no trigonometry: every cycle on the probe). The turns
+    /// are summed (rotations about one axis: w + k i multiply as complex
+    /// numbers) until they pass [`MAX_LINEARIZATION_HEADING_LAG_RAD`], as a
+    /// fixed point's lag is; a fixed point follows the estimate itself.
+    pub(super) fn turn_with_corrections(&mut self, heading: f64) {
         if self.linearization_attitude.is_some() {
             self.unturned_correction = (1.0, 0.0);
             return;
         }
-        let (w1, k1) = vertical_twist(&self.strapdown.state().attitude, before);
+        let half = 0.5 * heading;
         let (w0, k0) = self.unturned_correction;
-        let (w, k) = (w0 * w1 - k0 * k1, w0 * k1 + k0 * w1);
+        let (w, k) = (w0 - k0 * half, w0 * half + k0);
         self.unturned_correction = match self.turn_navigation_covariance(w, k) {
             Some(_) => (1.0, 0.0),
             None => (w, k),
