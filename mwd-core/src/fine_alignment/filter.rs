@@ -83,8 +83,10 @@ pub struct FineAlignment<T: FilterScalar, const N: usize = STATES> {
     /// The heading turn of the corrections fed back while the model is
     /// linearised at each step's estimate and not yet turned into the
     /// covariance: (w, k) of a rotation about the vertical, unnormalised
-    /// ([`turn_with_corrections`](Self::turn_with_corrections)).
-    pub(super) unturned_correction: (f64, f64),
+    /// ([`turn_with_corrections`](Self::turn_with_corrections)); `None`
+    /// in the alignment, which is the paper's filter (from
+    /// [`start_navigation`](Self::start_navigation) on: `Some`).
+    pub(super) unturned_correction: Option<(f64, f64)>,
 }
 
 impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
@@ -104,7 +106,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             linearization_attitude: None,
             bias_walk: BiasWalk::EveryStep,
             accel_walk_unlearned: [0.0; 3],
-            unturned_correction: (1.0, 0.0),
+            unturned_correction: None,
         };
         alignment.restart(initial, reference, config);
         alignment
@@ -154,7 +156,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
         self.linearization_attitude = None;
         self.bias_walk = BiasWalk::EveryStep;
         self.accel_walk_unlearned = [0.0; 3];
-        self.unturned_correction = (1.0, 0.0);
+        self.unturned_correction = None;
     }
 
     /// One sample: mechanization, time update, measurement updates,
@@ -307,12 +309,15 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// The filter goes on propagating, so the estimated biases keep being
     /// compensated and the covariance grows as the errors do; from here the
     /// gyro biases are constants and their instability rate noise
-    /// ([`BiasWalk::InstabilityAsRateNoise`]): navigation lasts hours.
+    /// ([`BiasWalk::InstabilityAsRateNoise`]): navigation lasts hours; and
+    /// heading corrections turn the navigation-frame covariance
+    /// ([`turn_with_corrections`](Self::turn_with_corrections)).
     pub fn start_navigation(&mut self) {
         self.config.zero_velocity_variance = None;
         self.config.zero_position_variance = None;
         self.config.specific_force = SpecificForceInModel::MeasuredSample;
         self.set_bias_walk(BiasWalk::InstabilityAsRateNoise);
+        self.unturned_correction = Some((1.0, 0.0));
     }
 
     /// Turns the zero-velocity update on (noise variance `variance`,

@@ -126,17 +126,20 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// are summed (rotations about one axis: w + k i multiply as complex
     /// numbers) until they pass [`MAX_LINEARIZATION_HEADING_LAG_RAD`], as a
     /// fixed point's lag is; a fixed point follows the estimate itself.
+    /// Navigation only: the alignment is the paper's filter as it is.
     pub(super) fn turn_with_corrections(&mut self, heading: f64) {
+        let Some((w0, k0)) = self.unturned_correction else {
+            return;
+        };
         if self.linearization_attitude.is_some() {
-            self.unturned_correction = (1.0, 0.0);
+            self.unturned_correction = Some((1.0, 0.0));
             return;
         }
         let half = 0.5 * heading;
-        let (w0, k0) = self.unturned_correction;
         let (w, k) = (w0 - k0 * half, w0 * half + k0);
         self.unturned_correction = match self.turn_navigation_covariance(w, k) {
-            Some(_) => (1.0, 0.0),
-            None => (w, k),
+            Some(_) => Some((1.0, 0.0)),
+            None => Some((w, k)),
         };
     }
 

@@ -378,6 +378,14 @@ fn heading_corrections_turn_the_navigation_covariance_with_the_estimate() {
         euler_from_quat(&fa.strapdown.state().attitude).heading
     };
     let start = heading(&fa);
+    // aligning (the paper's filter): no turn at all
+    fa.filter.x[ATT + 2] = 0.5 * DEG;
+    fa.feed_back();
+    assert_eq!(fa.filter.p, before);
+    assert!((heading(&fa) - start - 0.5 * DEG).abs() < 1e-9);
+    // navigating (the turn only, not the rest of `start_navigation`)
+    fa.unturned_correction = Some((1.0, 0.0));
+    let start = heading(&fa);
     // 0.06 deg: under the lag, nothing turns yet
     fa.filter.x[ATT + 2] = 0.06 * DEG;
     fa.feed_back();
