@@ -33,7 +33,7 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
             // sigma^2 in variance over any time (a stationary
             // Gauss-Markov process: 2 sigma^2 (1 - exp(-T/tau))); the
             // walk over an hour of drilling would add 72.
-            if k < 3 && !self.filter.consider.is_empty() {
+            if k < 3 && !self.learns_accel_bias() {
                 let most = 2.0 * bias.instability_sigma * bias.instability_sigma;
                 walk = walk.min((most - self.accel_walk_unlearned[k]).max(0.0));
                 self.accel_walk_unlearned[k] += walk;

@@ -239,6 +239,17 @@ mod tests {
         assert_ne!(blocked[20][10], value(10, 20), "the update changed nothing");
     }
 
+    /// A positive definite covariance of four states, all but one pair
+    /// correlated.
+    fn four_state_covariance() -> SMatrix<f64, 4, 4> {
+        SMatrix::from_row_slice(&[
+            4.0, 1.0, 0.5, 0.0, //
+            1.0, 3.0, 0.2, 0.1, //
+            0.5, 0.2, 2.0, 0.3, //
+            0.0, 0.1, 0.3, 1.0,
+        ])
+    }
+
     /// A scalar whose noise v is correlated with the prior error (E[x v]
     /// = s) is an ordinary scalar of the state augmented with v: z = h^T
     /// x + v with P_a = [[P, s], [s^T, r]] and a zero noise. The
@@ -246,12 +257,7 @@ mod tests {
     #[test]
     fn a_correlated_scalar_is_the_augmented_states_update() {
         const N: usize = 4;
-        let p: SMatrix<f64, N, N> = SMatrix::from_row_slice(&[
-            4.0, 1.0, 0.5, 0.0, //
-            1.0, 3.0, 0.2, 0.1, //
-            0.5, 0.2, 2.0, 0.3, //
-            0.0, 0.1, 0.3, 1.0,
-        ]);
+        let p = four_state_covariance();
         let s = [0.3, -0.2, 0.0, 0.1];
         let r = 0.8;
         let mut h = SparseRow::empty();
@@ -330,12 +336,7 @@ mod tests {
     #[test]
     fn a_consider_state_keeps_its_estimate_and_the_joseph_covariance_of_its_gain() {
         const N: usize = 4;
-        let p: SMatrix<f64, N, N> = SMatrix::from_row_slice(&[
-            4.0, 1.0, 0.5, 0.6, //
-            1.0, 3.0, 0.2, 0.1, //
-            0.5, 0.2, 2.0, 0.3, //
-            0.6, 0.1, 0.3, 1.0,
-        ]);
+        let p = four_state_covariance();
         let r = 0.8;
         let mut h = SparseRow::empty();
         h.push(0, 1.0);
