@@ -88,6 +88,8 @@ impl Drilling {
         // before each step (for lookups without summing).
         let mut offset = 0.0;
         let mut offsets = Vec::new();
+        // Whole turns of the connections' indexing, apart from `offset`.
+        let mut revolutions = 0.0;
         let push = |phases: &mut Vec<Phase>, t0: f64, length: f64, md0: f64, kind| {
             if length > 0.0 {
                 phases.push(Phase {
@@ -145,30 +147,59 @@ impl Drilling {
                             t1: te + turn,
                             delta,
                         });
-                        offsets.push(offset);
+                        offsets.push(revolutions + offset);
                         offset += delta;
                         te += turn;
                     }
                 }
             }
             md += length;
+            let still_start = t;
+            // Indexed: the dwells 360 deg / n apart, the orienter turning
+            // the same way between them; `offset` leaves out the whole turn
+            // they make with the last turn below (the toolface is an angle).
+            let dwells = p.connection_dwells.max(1);
+            let dwell = p.connection_still_s / f64::from(dwells);
+            let index_step = core::f64::consts::TAU / f64::from(dwells);
+            let mut indexed = 0.0;
+            for k in 0..dwells {
+                if k > 0 {
+                    let turn = index_step / turn_rate;
+                    steps.push(Ramp {
+                        t0: t,
+                        t1: t + turn,
+                        delta: index_step,
+                    });
+                    offsets.push(revolutions + offset + indexed);
+                    indexed += index_step;
+                    t = push(&mut phases, t, turn, md, PhaseKind::Turn);
+                }
+                t = push(&mut phases, t, dwell, md, PhaseKind::Still);
+            }
             connections.push(Connection {
-                still_start: t,
-                still_end: t + p.connection_still_s,
+                still_start,
+                still_end: t,
                 md,
             });
-            t = push(&mut phases, t, p.connection_still_s, md, PhaseKind::Still);
             let change = p.toolface_change_per_connection_deg * DEG;
-            if end - md > 1e-9 && change > 0.0 {
-                let delta = toward_section(offset, change, &mut rng);
-                let turn = change / turn_rate;
+            let index_rest = if dwells > 1 { index_step } else { 0.0 };
+            if end - md > 1e-9 && (change > 0.0 || index_rest > 0.0) {
+                let delta = if change > 0.0 {
+                    toward_section(offset, change, &mut rng)
+                } else {
+                    0.0
+                };
+                let turn = (change + index_rest) / turn_rate;
                 steps.push(Ramp {
                     t0: t,
                     t1: t + turn,
-                    delta,
+                    delta: index_rest + delta,
                 });
-                offsets.push(offset);
+                offsets.push(revolutions + offset + indexed);
                 offset += delta;
+                if dwells > 1 {
+                    revolutions += core::f64::consts::TAU;
+                }
                 t = push(&mut phases, t, turn, md, PhaseKind::Turn);
             }
         }
@@ -530,6 +561,49 @@ mod tests {
         // the depth log follows the drilled hole's TVD
         let (_, logged) = a.depth_log().last().expect("a log");
         assert_eq!(logged, a.logged_md(ta.md, ta.point.nev.z));
+    }
+
+    /// Four dwells: the still time in four equal still periods at the
+    /// connection's MD, the toolface 90 deg apart in them (the orienter
+    /// turning one way), and the drilling toolface after the connection
+    /// as without indexing (a whole turn more).
+    #[test]
+    fn an_indexed_connection_dwells_at_toolfaces_a_quarter_turn_apart() {
+        let mut indexed = hold_then_curve(3010.0, 20.0, 14.0);
+        indexed.drilling.connection_dwells = 4;
+        let sim = Drilling::new(indexed.build().expect("valid"), 3);
+        let plain = Drilling::new(plan(), 3);
+        let c = sim.connections()[1];
+        assert_eq!(c.md, plain.connections()[1].md);
+        // four dwells of 15 s, three 9-s turns of 90 deg between them
+        let dwell = 15.0;
+        let turn = 90.0 / 10.0;
+        assert!((c.still_end - c.still_start - (4.0 * dwell + 3.0 * turn)).abs() < 1e-9);
+        let mut toolfaces = Vec::new();
+        for k in 0..4 {
+            let t0 = c.still_start + k as f64 * (dwell + turn);
+            let (a, b) = (sim.truth(t0 + 0.1), sim.truth(t0 + dwell - 0.1));
+            assert_eq!((a.state, b.state), (DrillState::Still, DrillState::Still));
+            assert_eq!((a.md, a.toolface), (c.md, b.toolface));
+            assert!(sim.still_interval(t0 + 0.1, t0 + dwell - 0.1).is_some());
+            toolfaces.push(a.toolface);
+            if k < 3 {
+                assert_eq!(
+                    sim.truth(t0 + dwell + 0.5 * turn).state,
+                    DrillState::Connection
+                );
+            }
+        }
+        for pair in toolfaces.windows(2) {
+            let step = wrap_pi(pair[1] - pair[0]);
+            assert!((step - 90.0 * DEG).abs() < 1e-9, "{} deg", step / DEG);
+        }
+        // drilling again: the toolface as the plain schedule's (the same
+        // steps drawn), a whole turn on
+        let md = c.md + 4.5;
+        let (ti, tp) = (sim.time_at_md(md), plain.time_at_md(md));
+        let step = wrap_pi(sim.truth(ti).toolface - plain.truth(tp).toolface);
+        assert!(step.abs() < 1e-9, "{} deg", step / DEG);
     }
 
     #[test]

@@ -238,6 +238,14 @@ impl Default for DepthErrors {
     }
 }
 
+/// The most dwells a connection's still time is split into
+/// ([`DrillingParams::connection_dwells`]).
+pub const MAX_CONNECTION_DWELLS: u32 = 8;
+
+fn is_one(dwells: &u32) -> bool {
+    *dwells == 1
+}
+
 /// Drilling parameters, each with a default.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(default, deny_unknown_fields)]
@@ -250,6 +258,13 @@ pub struct DrillingParams {
     pub stand_length_m: f64,
     /// Still time at each connection (s): pumps off, the probe at rest.
     pub connection_still_s: f64,
+    /// The connection's still time in this many equal dwells, the orienter
+    /// turning the toolface by 360 deg / dwells between them and on to a
+    /// whole turn after the last (toolface indexing: the cross-axis gyro
+    /// biases turn against the earth rate; docs/toolface-indexing.md).
+    /// 1: one still period, no indexing.
+    #[serde(skip_serializing_if = "is_one")]
+    pub connection_dwells: u32,
     /// Still time at the tie-on before drilling starts (s): alignment.
     pub initial_still_s: f64,
     /// Toolface change at each connection (deg; back towards the section's
@@ -278,6 +293,7 @@ impl Default for DrillingParams {
             rop_ramp_s: 10.0,
             stand_length_m: 28.0,
             connection_still_s: 300.0,
+            connection_dwells: 1,
             initial_still_s: 600.0,
             toolface_change_per_connection_deg: 30.0,
             toolface_turn_rate_deg_s: 10.0,
@@ -336,6 +352,12 @@ impl DrillingParams {
                 "drilling.{name} must be a number from {lo} to {hi} (got {v})"
             );
         }
+        ensure!(
+            (1..=MAX_CONNECTION_DWELLS).contains(&self.connection_dwells),
+            "drilling.connection_dwells must be a whole number from 1 to {MAX_CONNECTION_DWELLS} \
+             (got {})",
+            self.connection_dwells
+        );
         self.vibration.check()?;
         self.tortuosity.check()?;
         let d = &self.depth_errors;

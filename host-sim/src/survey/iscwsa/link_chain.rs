@@ -143,6 +143,37 @@ impl LinkChain {
     }
 }
 
+/// The link of `later` back past `superseded`, the station before it that
+/// the survey drops (a later station at the same MD stands, e.g. the last
+/// dwell of an indexed connection): `X = X_later Sigma_sup^-1 X_sup`, the
+/// chain's own cov(z_later, z_before) through the dropped station (the
+/// Markov assumption of the module docs). `None` when `later` does not
+/// link back to `superseded`, or a number is not finite; a first station
+/// superseded leaves `later` first (no link back).
+pub fn through_superseded(superseded: &StationLink, later: &StationLink) -> Option<StationLink> {
+    if later.previous != superseded.station {
+        return None;
+    }
+    let cross_previous = match superseded.cross_previous {
+        None => None,
+        Some(before) => {
+            let x_later = matrix(&later.cross_previous?);
+            let m = x_later * pseudo_inverse(&matrix(&superseded.covariance)) * matrix(&before);
+            if m.iter().any(|v| !v.is_finite()) {
+                return None;
+            }
+            Some(std::array::from_fn(|r| {
+                std::array::from_fn(|c| m[(r, c)] as f32)
+            }))
+        }
+    };
+    Some(StationLink {
+        previous: superseded.previous,
+        cross_previous,
+        ..*later
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,6 +224,39 @@ mod tests {
             want.abs() > 0.05 * sigmas[5][(0, 0)],
             "the test's memory is long"
         );
+    }
+
+    /// A Markov chain's station 3 linked past station 2: the link says
+    /// what the chain without station 2 says, cov(z_3, z_1) = A^2 Sigma_1.
+    #[test]
+    fn a_link_through_a_superseded_station_is_the_chains_two_steps() {
+        let a = Matrix3::new(0.6, 1.0e5, 0.0, 0.0, 0.9, 0.0, 0.0, 0.1, 0.8);
+        let q = Matrix3::new(4e-6, 0.0, 0.0, 0.0, 1e-13, 0.0, 0.0, 0.0, 2e-13);
+        let s1 = Matrix3::new(1e-4, 0.0, 0.0, 0.0, 1e-12, 0.0, 0.0, 0.0, 1e-12);
+        let s2 = a * s1 * a.transpose() + q;
+        let s3 = a * s2 * a.transpose() + q;
+        let l2 = link(2, s2, Some(a * s1)).unwrap();
+        let l3 = link(3, s3, Some(a * s2)).unwrap();
+        let through = through_superseded(&l2, &l3).unwrap();
+        assert_eq!((through.station, through.previous), (3, 1));
+        assert_eq!(through.covariance, l3.covariance);
+        let want = a * a * s1;
+        let got = matrix(&through.cross_previous.unwrap());
+        for r in 0..3 {
+            for c in 0..3 {
+                // in correlation units: f32's rounding and the inverse's
+                let scale = (s3[(r, r)] * s1[(c, c)]).sqrt();
+                let (g, w) = (got[(r, c)], want[(r, c)]);
+                assert!((g - w).abs() <= 1e-5 * scale, "({r}, {c}): {g} against {w}");
+            }
+        }
+        // not linked to it: no link
+        let l4 = link(4, s3, Some(a * s2)).unwrap();
+        assert!(through_superseded(&l2, &l4).is_none());
+        // a superseded first station: the later one becomes the first
+        let first = link(2, s2, None).unwrap();
+        let alone = through_superseded(&first, &l3).unwrap();
+        assert_eq!((alone.previous, alone.cross_previous), (1, None));
     }
 
     #[test]

@@ -64,6 +64,7 @@ mod term_table;
 mod tests;
 mod weighting;
 
+pub use link_chain::through_superseded;
 pub use propagation::{cov_matrix, run, run_with, Cov6, ModelResult, Options, Propagator, TieOn};
 pub use stations::{check_stations, Site, Station, EARTH_RATE};
 pub use term_table::{load_term_table, parse_term_table, DataError, ErrorTerm, Propagation};

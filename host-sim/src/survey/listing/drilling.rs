@@ -415,24 +415,24 @@ pub fn survey(
             }
         }
         // Not beyond the previous station: the string did not move in
-        // between; the later station (more still time behind it) stands.
-        while let Some((previous, _, prev_md, ..)) = kept.last() {
+        // between; the later station (more still time behind it, or the
+        // last dwell of an indexed connection) stands, its link carried
+        // back past the one it supersedes.
+        let mut link = links.get(k).copied().flatten();
+        while let Some((previous, _, prev_md, _, prev_link)) = kept.last() {
             if md > *prev_md {
                 break;
             }
+            link = prev_link
+                .zip(link)
+                .and_then(|(dropped, later)| iscwsa::through_superseded(&dropped, &later));
             skipped.push(Skipped {
                 survey: *previous,
                 reason: format!("superseded by station {} at the same MD", s.station),
             });
             kept.pop();
         }
-        kept.push((
-            *s,
-            time_s,
-            md,
-            azi_before.get(k).copied().flatten(),
-            links.get(k).copied().flatten(),
-        ));
+        kept.push((*s, time_s, md, azi_before.get(k).copied().flatten(), link));
     }
     let Some(&(first_kept, _, first_md, ..)) = kept.first() else {
         bail!("no usable station survey in the capture");
