@@ -114,6 +114,7 @@ impl GradeTableArgs {
             rop_m_per_h: self.rop_m_per_h.map(exact_text),
             stand_length_m: None,
             connection_still_s: self.connection_still_s.map(exact_text),
+            connection_dwells: None,
             // the wells' own (each run drills its own hole around the plan)
             tortuosity_deg_per_30m: None,
             tortuosity_length_m: None,

@@ -82,6 +82,11 @@ pub struct LateralArgs {
     /// Still time at each connection, s (default: the plan's).
     #[arg(long = "connection-still", value_parser = connection_still)]
     pub connection_still_s: Option<f64>,
+    /// Split each connection's still time into N equal dwells, the
+    /// orienter indexing the toolface 360/N deg between them (2: 180 deg,
+    /// 4: 90 deg; default: the plan's, else 1; docs/toolface-indexing.md).
+    #[arg(long = "dwells", value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub connection_dwells: Option<u32>,
     /// The hole's tortuosity: RMS of each component (build, walk) of its
     /// curvature's deviation from the plan, deg/30 m; 0 drills the plan
     /// exactly (default: the plan's, else 1 deg/100 ft;
@@ -166,7 +171,14 @@ const PROGRESS: &str =
 /// errors; an error when it was interrupted.
 pub fn report(result: &LateralStudy, tie_in_sigma_deg: f64, outputs: &StudyOutputs) -> Result<()> {
     let names: Vec<&str> = result.grades.iter().map(|g| g.file.name.as_str()).collect();
-    let wells: Vec<&str> = result.wells.iter().map(|w| w.label.as_str()).collect();
+    let wells: Vec<String> = result
+        .wells
+        .iter()
+        .map(|w| match w.connection_dwells {
+            1 => w.label.clone(),
+            n => format!("{} (connections indexed: {n} dwells)", w.label),
+        })
+        .collect();
     outln!(
         "lateral study: grades {}; wells {}; {} runs each from seed {}; tie-in azimuth sigma {} deg; {} threads; filter {}; {:.1} s",
         names.join(", "),
@@ -275,6 +287,7 @@ fn spec(args: &LateralArgs) -> Result<StudySpec> {
         rop_m_per_h: args.rop_m_per_h,
         stand_length_m: args.stand_length_m,
         connection_still_s: args.connection_still_s,
+        connection_dwells: args.connection_dwells,
         tortuosity_deg_per_30m: args.tortuosity_deg_per_30m,
         tortuosity_length_m: args.tortuosity_length_m,
     };
@@ -286,6 +299,7 @@ fn spec(args: &LateralArgs) -> Result<StudySpec> {
         rop_m_per_h: text(args.rop_m_per_h),
         stand_length_m: text(args.stand_length_m),
         connection_still_s: text(args.connection_still_s),
+        connection_dwells: args.connection_dwells,
         tortuosity_deg_per_30m: text(args.tortuosity_deg_per_30m),
         tortuosity_length_m: text(args.tortuosity_length_m),
         tie_in_azimuth_sigma_deg: exact_text(args.tie_in_azimuth_sigma_deg),

@@ -473,6 +473,13 @@ fn run_in<T: NavigatorScalar>(config: &RunConfig, seed: u64) -> Result<RunOutcom
     let survey = collected.survey(&links, &setup, &depth);
     let (td, td_note, method_td_error_ne) = match survey {
         Ok(survey) => {
+            // the survey's stations: one superseded by a later one at the
+            // same MD (an indexed connection's earlier dwells) is not one
+            checks.retain(|c| {
+                !survey.skipped.iter().any(|k| {
+                    k.superseded_by.is_some() && k.survey.end_sample == c.survey.end_sample
+                })
+            });
             attach_positions(&mut checks, &survey, &drilling);
             let (td, note) = td_check(&survey, &drilling, end_md);
             let method = td.and(method_td_error(&survey, &drilling));

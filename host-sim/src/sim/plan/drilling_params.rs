@@ -242,7 +242,8 @@ impl Default for DepthErrors {
 /// ([`DrillingParams::connection_dwells`]).
 pub const MAX_CONNECTION_DWELLS: u32 = 8;
 
-fn is_one(dwells: &u32) -> bool {
+/// One dwell: no indexing (left out of a plan's output).
+pub fn is_single_dwell(dwells: &u32) -> bool {
     *dwells == 1
 }
 
@@ -263,7 +264,7 @@ pub struct DrillingParams {
     /// whole turn after the last (toolface indexing: the cross-axis gyro
     /// biases turn against the earth rate; docs/toolface-indexing.md).
     /// 1: one still period, no indexing.
-    #[serde(skip_serializing_if = "is_one")]
+    #[serde(skip_serializing_if = "is_single_dwell")]
     pub connection_dwells: u32,
     /// Still time at the tie-on before drilling starts (s): alignment.
     pub initial_still_s: f64,

@@ -18,6 +18,8 @@ mod tests;
 mod tortuosity;
 
 pub use built::{BuiltPlan, BuiltSection, PathPoint};
-pub use drilling_params::{DepthErrors, DrillingParams, Tortuosity, Vibration};
+pub use drilling_params::{
+    is_single_dwell, DepthErrors, DrillingParams, Tortuosity, Vibration, MAX_CONNECTION_DWELLS,
+};
 pub use file::{Plan, Section, Site, TieOnSpec, MAX_DLS_DEG_PER_30M, MAX_PLAN_LENGTH_M};
 pub use tortuosity::{CurvatureWalk, DrilledPath};

@@ -58,6 +58,10 @@ pub struct WellInfo {
     pub rop_m_per_h: f64,
     pub stand_length_m: f64,
     pub connection_still_s: f64,
+    /// The still time's dwells, the toolface indexed between them (1:
+    /// none, then left out of the output).
+    #[serde(skip_serializing_if = "crate::sim::plan::is_single_dwell")]
+    pub connection_dwells: u32,
     /// The hole's tortuosity (`drilling.tortuosity`).
     pub tortuosity: crate::sim::plan::Tortuosity,
 }
@@ -348,6 +352,7 @@ impl<'a> StudyJobs<'a> {
                     rop_m_per_h: w.plan.drilling.rop_m_per_h,
                     stand_length_m: w.plan.drilling.stand_length_m,
                     connection_still_s: w.plan.drilling.connection_still_s,
+                    connection_dwells: w.plan.drilling.connection_dwells,
                     tortuosity: w.plan.drilling.tortuosity,
                 })
                 .collect(),

@@ -54,6 +54,9 @@ pub struct StudySpec {
     pub rop_m_per_h: Option<String>,
     pub stand_length_m: Option<String>,
     pub connection_still_s: Option<String>,
+    /// `--dwells` (absent in the shards of a study without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub connection_dwells: Option<u32>,
     pub tortuosity_deg_per_30m: Option<String>,
     pub tortuosity_length_m: Option<String>,
     pub tie_in_azimuth_sigma_deg: String,
@@ -73,6 +76,7 @@ impl StudySpec {
             rop_m_per_h: read(&self.rop_m_per_h, "the rate of penetration")?,
             stand_length_m: read(&self.stand_length_m, "the stand length")?,
             connection_still_s: read(&self.connection_still_s, "the connection still time")?,
+            connection_dwells: self.connection_dwells,
             tortuosity_deg_per_30m: read(&self.tortuosity_deg_per_30m, "the tortuosity")?,
             tortuosity_length_m: read(
                 &self.tortuosity_length_m,

@@ -27,6 +27,9 @@ pub struct DrillingOverrides {
     pub rop_m_per_h: Option<f64>,
     pub stand_length_m: Option<f64>,
     pub connection_still_s: Option<f64>,
+    /// The connection's still time in this many dwells, the toolface
+    /// indexed between them (`DrillingParams::connection_dwells`).
+    pub connection_dwells: Option<u32>,
     /// The hole's tortuosity: RMS (deg/30 m) and correlation length (m).
     pub tortuosity_deg_per_30m: Option<f64>,
     pub tortuosity_length_m: Option<f64>,
@@ -59,6 +62,9 @@ impl Well {
         }
         if let Some(v) = overrides.connection_still_s {
             d.connection_still_s = v;
+        }
+        if let Some(n) = overrides.connection_dwells {
+            d.connection_dwells = n;
         }
         d.tortuosity = d.tortuosity.overridden(
             overrides.tortuosity_deg_per_30m,
@@ -118,6 +124,18 @@ mod tests {
         };
         let e = format!("{:#}", Well::builtin("100m", &bad).unwrap_err());
         assert!(e.contains("drilling.stand_length_m"), "{e}");
+        let indexed = DrillingOverrides {
+            connection_dwells: Some(4),
+            ..none
+        };
+        let plan = Well::builtin("1000m", &indexed).expect("ok").plan;
+        assert_eq!(plan.drilling.connection_dwells, 4);
+        let bad = DrillingOverrides {
+            connection_dwells: Some(0),
+            ..none
+        };
+        let e = format!("{:#}", Well::builtin("100m", &bad).unwrap_err());
+        assert!(e.contains("drilling.connection_dwells"), "{e}");
         let straight = DrillingOverrides {
             tortuosity_deg_per_30m: Some(0.0),
             ..none

@@ -89,6 +89,9 @@ pub struct QcReference {
 pub struct Skipped {
     pub survey: StationSurvey,
     pub reason: String,
+    /// The later station at the same MD that stands instead, if that is
+    /// why.
+    pub superseded_by: Option<u16>,
 }
 
 /// The survey of a drilling run.
@@ -393,6 +396,7 @@ pub fn survey(
             skipped.push(Skipped {
                 survey: *s,
                 reason: reason.into(),
+                superseded_by: None,
             });
             continue;
         }
@@ -429,6 +433,7 @@ pub fn survey(
             skipped.push(Skipped {
                 survey: *previous,
                 reason: format!("superseded by station {} at the same MD", s.station),
+                superseded_by: Some(s.station),
             });
             kept.pop();
         }

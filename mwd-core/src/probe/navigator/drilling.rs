@@ -49,10 +49,9 @@ pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
 
 impl<T: FilterScalar> Navigator<T> {
     /// Drilling mode starts afresh (a new attitude from an alignment or a
-    /// tie-in): no drilling since a station, no drilling cycles, no roll
-    /// turn remembered, an empty toolface block.
+    /// tie-in): no drilling cycles, no roll turn remembered, an empty
+    /// toolface block.
     pub(super) fn forget_drilling(&mut self) {
-        self.drilled_since_station = false;
         self.drilling_cycles = 0;
         self.last_roll_turn = None;
         self.toolface_block.clear();
@@ -101,17 +100,21 @@ impl<T: FilterScalar> Navigator<T> {
         }
     }
 
-    /// The first still cycle after drilling: the roll was
-    /// held through it, so the orienter's steps were not
-    /// sensed. The accelerometer roll shows how far off the
-    /// held roll is; that, with the sample's own roll noise,
-    /// goes into the variance about the tool axis, and the
+    /// The first still cycle after the tool moved or drilled: no gyro
+    /// senses the roll. Drilling held it, so the orienter's steps were not
+    /// sensed; a turn at rest followed the accelerometer roll's
+    /// differences, whose rate lags the turn by a sample, so the roll
+    /// overshoots where the turn stops (0.25 deg at the orienter's 10
+    /// deg/s, twelve times the roll sigma the turn's constraint updates
+    /// left; a toolface-indexed connection's second dwell then read it as
+    /// heading and tilt: derivation section 4h). The accelerometer roll
+    /// shows how far off the roll is; that, with the sample's own roll
+    /// noise, goes into the variance about the tool axis, and the
     /// station's zero-velocity updates re-level it.
-    pub(super) fn first_still_after_drilling(&mut self, sample: &ProbeSample) {
+    pub(super) fn first_still_after_moving(&mut self, sample: &ProbeSample) {
         let offset = roll_offset(self.filter.state(), sample);
         let variance = square(offset) + square(SINGLE_SAMPLE_ROLL_SIGMA_RAD);
         add_tool_axis_variance(&mut self.filter, variance);
-        self.drilled_since_station = false;
     }
 
     /// The first moving cycle after a still period: the

@@ -60,8 +60,8 @@ impl<T: FilterScalar> Navigator<T> {
         } else {
             self.toolface_block.clear();
         }
-        if still && self.drilled_since_station {
-            self.first_still_after_drilling(sample);
+        if still && !self.was_still {
+            self.first_still_after_moving(sample);
         }
         if !still && !drilling && self.was_still && report.sample_used {
             self.first_move_after_still(sample);
@@ -70,7 +70,7 @@ impl<T: FilterScalar> Navigator<T> {
             self.first_drilling_after_roll(turn);
         }
         self.keep_undetermined_heading_apart();
-        self.remember_roll(&input, still, drilling);
+        self.remember_roll(&input, still);
         self.still_gyro = (update && missing_gyro.is_none()).then_some(sample.gyro);
         self.held = Some(input.imu);
         if still {
@@ -174,8 +174,8 @@ impl<T: FilterScalar> Navigator<T> {
 
     /// What the next cycle's roll checks need to know of this one: the
     /// roll's turn when it followed the accelerometers, and whether the
-    /// tool was still or drilled.
-    fn remember_roll(&mut self, input: &CycleInput, still: bool, drilling: bool) {
+    /// tool was still.
+    fn remember_roll(&mut self, input: &CycleInput, still: bool) {
         self.last_roll_turn = match (input.source, input.tool_axis) {
             (ToolAxisSource::AccelerometerRoll, ToolAxisRate::Valid(rate)) => {
                 Some((rate - input.frame_rate.y) * SAMPLE_INTERVAL_S)
@@ -183,6 +183,5 @@ impl<T: FilterScalar> Navigator<T> {
             _ => None,
         };
         self.was_still = still;
-        self.drilled_since_station |= drilling;
     }
 }

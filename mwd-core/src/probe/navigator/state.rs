@@ -187,8 +187,6 @@ pub struct Navigator<T: FilterScalar = f32> {
     /// This still cycle's x and z gyro readings, for the rate gyrocompass
     /// (a zero-velocity cycle with both parts).
     pub(super) still_gyro: Option<[f64; 2]>,
-    /// The roll was held for drilling since the last still cycle.
-    pub(super) drilled_since_station: bool,
     /// The last navigation cycle was still (its roll held).
     pub(super) was_still: bool,
     /// Consecutive drilling cycles up to this one.
@@ -282,7 +280,6 @@ impl<T: FilterScalar> Navigator<T> {
             linked_station: 0,
             station_links: false,
             still_gyro: None,
-            drilled_since_station: false,
             was_still: false,
             drilling_cycles: 0,
             last_roll_turn: None,
