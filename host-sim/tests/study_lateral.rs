@@ -268,3 +268,32 @@ fn a_coverage_study_stopped_after_its_first_run_is_over_that_run_and_says_so() {
     let text = host_sim::study::drilling_coverage::table(&summary);
     assert!(text.starts_with("INTERRUPTED after 1 of 3 runs"), "{text}");
 }
+
+/// Toolface-indexed connections (two dwells 180 deg apart): the run's
+/// stations are the survey's, one per connection (each last dwell, which
+/// supersedes the first at the same MD), every one positioned, and the
+/// quiet gyro's azimuth and inclination errors inside 3 sigma at each.
+#[test]
+fn indexed_connections_give_one_positioned_station_per_connection() {
+    let mut well = short_well();
+    well.plan.drilling.connection_dwells = 2;
+    let grade = Grade::builtin()
+        .expect("built in")
+        .into_iter()
+        .find(|g| g.name() == "ge-mwd-2020")
+        .expect("the GE grade");
+    let config = RunConfig::new(well.plan.clone(), 0.5f64.to_radians(), grade).expect("config");
+    let outcome = drilling_run::run(&config, 3).expect("the run");
+    let drilling = host_sim::sim::drilling::Drilling::new(well.plan, 3);
+    assert_eq!(outcome.stations.len(), drilling.connections().len() + 1);
+    for pair in outcome.stations.windows(2) {
+        assert!(pair[1].truth_md > pair[0].truth_md + 1.0, "{pair:?}");
+    }
+    for c in &outcome.stations {
+        assert!(c.position.is_some(), "{c:?}");
+        let sigma = |i: usize| f64::from(c.survey.angles_std[i]);
+        assert!(c.error[0].abs() < 3.0 * sigma(0), "inclination {c:?}");
+        assert!(c.error[1].abs() < 3.0 * sigma(1), "azimuth {c:?}");
+    }
+    assert!(outcome.td.is_some(), "{:?}", outcome.td_note);
+}
