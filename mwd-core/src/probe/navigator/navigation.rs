@@ -7,6 +7,7 @@
 
 use super::drilling::{
     drilling_attitude_noise, vibration_onset_factor, DRILLING_JITTER_LIMIT_M_S2,
+    SINGLE_SAMPLE_ROLL_SIGMA_RAD,
 };
 use super::state::{square, Navigator};
 use super::stations::SURVEY_SETTLE_EPOCHS;
@@ -18,6 +19,11 @@ use crate::probe_sample::ProbeSample;
 use crate::protocol::frame::nav_flags;
 use crate::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
+
+/// The force (m/s^2) one sample's accelerometer roll noise misrotates
+/// across the tool: g times [`SINGLE_SAMPLE_ROLL_SIGMA_RAD`] (0.058 m/s^2,
+/// the SCC1300 accelerometer's own per-sample noise).
+const ROLL_NOISE_FORCE_M_S2: f64 = 9.80665 * SINGLE_SAMPLE_ROLL_SIGMA_RAD;
 
 /// A navigating cycle's sample for the mechanization, and how its
 /// tool-axis rate was found.
@@ -139,6 +145,19 @@ impl<T: FilterScalar> Navigator<T> {
         } else {
             0
         };
+        if !still && !drilling {
+            // The roll follows the accelerometer roll (`tool_axis_input`):
+            // each sample's roll is off by that sample's roll noise, white,
+            // and the force rotated with it is off across the tool by g
+            // times it, a velocity random walk the error model does not
+            // otherwise hold (its tool-axis rate model keeps the roll
+            // smooth). Left out, the moving tool's constraints read it as
+            // tilt, and through the tilt's correlation with the heading as
+            // heading: the 18-s turn between an indexed connection's dwells
+            // took a third of a high-end MEMS gyro's heading sigma while
+            // the error stayed (docs/toolface-indexing.md).
+            extra.velocity += square(ROLL_NOISE_FORCE_M_S2 * SAMPLE_INTERVAL_S);
+        }
         if drilling {
             // The measured lateral jitter is the vibration's force
             // noise per sample: white, a velocity random walk.
