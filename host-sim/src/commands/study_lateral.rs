@@ -7,6 +7,7 @@ use super::runs::{progress_bar, stop_on_ctrl_c, GradeChoice, SeedsAndThreads};
 use anyhow::{Context, Result};
 use host_sim::formats::files::{write_json, write_text};
 use host_sim::formats::text_records::read_small_file;
+use host_sim::sim::plan::MAX_CONNECTION_DWELLS;
 use host_sim::study::drilling_run::Scalar;
 use host_sim::study::grade::{self, Grade};
 use host_sim::study::lateral::figures::plots;
@@ -85,7 +86,8 @@ pub struct LateralArgs {
     /// Split each connection's still time into N equal dwells, the
     /// orienter indexing the toolface 360/N deg between them (2: 180 deg,
     /// 4: 90 deg; default: the plan's, else 1; docs/toolface-indexing.md).
-    #[arg(long = "dwells", value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long = "dwells", value_name = "N",
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_CONNECTION_DWELLS)))]
     pub connection_dwells: Option<u32>,
     /// The hole's tortuosity: RMS of each component (build, walk) of its
     /// curvature's deviation from the plan, deg/30 m; 0 drills the plan

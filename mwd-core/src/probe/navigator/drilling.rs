@@ -14,6 +14,7 @@ use crate::kalman::{FilterScalar, Stacked, UpdateReport};
 use crate::mechanization::NavState;
 use crate::probe_sample::ProbeSample;
 use crate::sensor_noise::ImuNoise;
+use crate::sensor_units::STANDARD_GRAVITY;
 use crate::timing::SAMPLE_INTERVAL_S;
 use nalgebra::{Matrix3, Vector3};
 
@@ -28,7 +29,7 @@ use nalgebra::{Matrix3, Vector3};
 /// is ~0.06 m/s^2 per sample; a 10 deg/s toolface turn adds 0.085 m/s^2
 /// per sample to the differences; the moderate simulated vibration is
 /// ~7 m/s^2 (docs/filter-derivation.md section 4d).
-pub const DRILLING_JITTER_LIMIT_M_S2: f64 = 9.80665 * 0.017_452_406;
+pub const DRILLING_JITTER_LIMIT_M_S2: f64 = STANDARD_GRAVITY * 0.017_452_406;
 
 /// Angular vibration reaching a gyro sample while drilling (rad/s, 1-sigma
 /// per sample, white): the drilling simulator's moderate level, 1 deg/s RMS
@@ -45,7 +46,7 @@ pub const DRILLING_TOOLFACE_VARIANCE_PER_S: f64 = 100.0 * DEG * DEG / 3600.0;
 
 /// One still sample's accelerometer roll noise (rad): the SCC1300's x
 /// accelerometer noise, 0.058 m/s^2 per sample (paper Table 4), over g.
-pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / 9.80665;
+pub const SINGLE_SAMPLE_ROLL_SIGMA_RAD: f64 = 0.058 / STANDARD_GRAVITY;
 
 impl<T: FilterScalar> Navigator<T> {
     /// Drilling mode starts afresh (a new attitude from an alignment or a

@@ -17,13 +17,14 @@ use crate::kalman::FilterScalar;
 use crate::mechanization::{ImuSample, ProbeInput, ToolAxisSource};
 use crate::probe_sample::ProbeSample;
 use crate::protocol::frame::nav_flags;
+use crate::sensor_units::STANDARD_GRAVITY;
 use crate::timing::SAMPLE_INTERVAL_S;
 use nalgebra::Vector3;
 
 /// The force (m/s^2) one sample's accelerometer roll noise misrotates
 /// across the tool: g times [`SINGLE_SAMPLE_ROLL_SIGMA_RAD`] (0.058 m/s^2,
 /// the SCC1300 accelerometer's own per-sample noise).
-const ROLL_NOISE_FORCE_M_S2: f64 = 9.80665 * SINGLE_SAMPLE_ROLL_SIGMA_RAD;
+const ROLL_NOISE_FORCE_M_S2: f64 = STANDARD_GRAVITY * SINGLE_SAMPLE_ROLL_SIGMA_RAD;
 
 /// A navigating cycle's sample for the mechanization, and how its
 /// tool-axis rate was found.
