@@ -3,7 +3,8 @@
 //! inclined tool, whose gyros tell the two apart, still gets its azimuth;
 //! the tie-in then gives the horizontal tool its azimuth. A heading whose
 //! sigma passed the first-order limit in navigation stays undetermined
-//! until the next tie-in, flagged lost (a heading never found is not).
+//! until the next tie-in, flagged lost (a heading never found is not). A
+//! turn at rest tells nothing of the heading.
 
 use super::*;
 use crate::calibration::ProbeCalibration;
@@ -199,4 +200,44 @@ fn a_heading_never_found_is_undetermined_but_not_lost() {
     let flags = navigator.station_survey().0.flags;
     assert_ne!(flags & station_flags::AZIMUTH_UNDETERMINED, 0);
     assert_eq!(flags & station_flags::HEADING_LOST, 0);
+}
+
+/// A turn at rest (an indexed connection's 180 deg at the orienter's 10
+/// deg/s) tells nothing of the heading: no gyro senses the earth rate
+/// better for turning, and the moving tool's constraints see velocity, not
+/// heading. Before the error model's force was gravity's reaction in every
+/// navigating cycle, the sample's force rotated through the roll's error
+/// at the turn's start (the roll held through the still detector's delay)
+/// coupled the heading into the velocity along the tool axis, and this
+/// turn took a 5-deg heading sigma to 1.8 deg on error-free samples
+/// (docs/filter-derivation.md section 4h).
+#[test]
+fn a_turn_at_rest_takes_no_heading_information() {
+    let heading = 60f64.to_radians();
+    let level = Euler::new(0.0, 0.0, heading);
+    let (mut navigator, _) = aligned(&level);
+    navigator.start_from_tie_in(&tie_in_at(&level));
+    let start = ALL_ALIGNMENT + 200;
+    step_still(&mut navigator, &level, start, 400);
+    // A heading known to 5 deg, as an SCC1300's after an hour of
+    // drilling, and nothing the station learned tied to it.
+    let sigma = 5f64.to_radians();
+    navigator.filter.set_heading(0.0, sigma * sigma);
+    let before = navigator.filter.euler_std().z;
+    let rate = 10f64.to_radians();
+    let turn = 360; // 18 s: 180 deg
+    let first = start + 400;
+    for k in 0..turn {
+        let attitude = Euler::new(f64::from(k + 1) * 0.05 * rate, 0.0, heading);
+        let (time, counter, s) = earth_rate_sample(first + k, &attitude, Vector3::zeros());
+        navigator.step_sample(time, counter, &s);
+        navigator.take_station();
+    }
+    let after = navigator.filter.euler_std().z;
+    assert!(
+        after >= 0.99 * before,
+        "heading sigma {} deg before the turn, {} deg after",
+        before.to_degrees(),
+        after.to_degrees()
+    );
 }
