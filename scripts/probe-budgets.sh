@@ -12,7 +12,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 target=thumbv7em-none-eabihf
-target_dir="${CARGO_TARGET_DIR:-target}/qemu-probe"
+# absolute: the drilling run starts QEMU from its own scratch directory
+target_dir="$(realpath -m "${CARGO_TARGET_DIR:-target}")/qemu-probe"
 CARGO_TARGET_DIR="$target_dir" cargo build -q -p firmware --profile probe --target "$target" \
   --features board-qemu --bin probe-qemu
 elf="$target_dir/$target/probe/probe-qemu"

@@ -31,7 +31,11 @@ impl<T: FilterScalar, const N: usize> FineAlignment<T, N> {
     /// at the measured one: while drilling the measured force is mostly
     /// vibration (~0.74 g per sample), which the mechanization integrates
     /// as noise; linearised at it the filter would read that noise, through
-    /// the constraints, as azimuth information (derivation section 4d).
+    /// the constraints, as azimuth information (derivation section 4d). A
+    /// tool turning at rest is the same case: the sample's force, rotated
+    /// through the roll's error, leans across the tool (derivation section
+    /// 4h, seventh item). The probe's navigator takes gravity in every
+    /// navigating cycle.
     pub fn linearize_at_gravity(&mut self, at_gravity: bool) {
         self.config.specific_force = if at_gravity {
             SpecificForceInModel::GravityAtRest
