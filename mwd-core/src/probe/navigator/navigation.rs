@@ -146,23 +146,15 @@ impl<T: FilterScalar> Navigator<T> {
             extra.velocity += square(jitter * SAMPLE_INTERVAL_S) * onset;
         }
         // F21's force is gravity's reaction in every navigating cycle,
-        // not the sample's C~ f~: still or drilling, and turning at rest
-        // too. While the roll follows the accelerometers, the sample's
-        // force rotated by the computed attitude carries the roll's error
-        // across the tool (1.5 deg at a turn's start, held through the
-        // still detector's delay: 0.26 m/s^2), and [f^n x] phi turned the
-        // heading error into velocity along the tool axis: a coupling the
-        // true error dynamics do not have (their f^n is the true force,
-        // gravity's reaction at rest; derivation sections 4h and 6). The
-        // moving tool's constraints then read heading from it: on an
-        // indexed connection an SCC1300's heading variance fell by a
-        // quarter in the 18-s turn and by as much again in the next
-        // dwell's first seconds while the error did not follow (over 245
-        // connections the heading's change did not depend on its error
-        // before), and its indexed stations were 38 % within 2 sigma. A
-        // string's true acceleration along the hole (tripping, the
-        // drilling ramps) is a few hundredths of g for seconds, and the
-        // heading error it would couple is left out with it.
+        // turning at rest too: the sample's force rotated by the computed
+        // attitude carries the roll's error across the tool (the roll held
+        // through the still detector's delay at a turn's start), and
+        // [f^n x] phi then couples the heading error into the velocity
+        // along the tool axis, a term the true error dynamics do not have;
+        // the moving tool's constraints read heading from it (derivation
+        // section 4h, seventh item). A string's true acceleration along the
+        // hole (tripping, the drilling ramps) is a few hundredths of g for
+        // seconds, and the heading error it would couple is left out with it.
         self.filter.linearize_at_gravity(true);
         // A still tool's attitude does not change: once the
         // station's first block has re-levelled it, the error model
